@@ -1,0 +1,110 @@
+"""Argument parsing shared by the subcommands."""
+from __future__ import annotations
+
+import argparse
+
+import numpy as np
+
+from ..errors import SatmdError
+from ..physics import Rig, effect
+
+
+def parse_number(text: str, what: str) -> float:
+    try:
+        x = float(text)
+    except ValueError:
+        raise SatmdError(f"{what}: {text!r} is not a number") from None
+    if not np.isfinite(x):
+        raise SatmdError(f"{what}: {text!r} is not finite")
+    return x
+
+
+def parse_freq(text: str) -> np.ndarray:
+    """LO:HI:N -> linspace(LO, HI, N)."""
+    parts = text.split(":")
+    if len(parts) != 3:
+        raise SatmdError(f"--freq {text!r}: expected LO:HI:N, e.g. 40:130:60")
+    lo, hi = parse_number(parts[0], "--freq LO"), parse_number(parts[1], "--freq HI")
+    try:
+        n = int(parts[2])
+    except ValueError:
+        raise SatmdError(f"--freq {text!r}: N must be an integer") from None
+    if not (0 < lo < hi) or n < 2:
+        raise SatmdError(f"--freq {text!r}: need 0 < LO < HI and N >= 2")
+    return np.linspace(lo, hi, n)
+
+
+def parse_band(text: str | None):
+    if not text:
+        return None, None
+    lo, sep, hi = text.partition(":")
+    if not sep:
+        raise SatmdError(f"--band {text!r}: expected LO:HI in Hz")
+    lo = parse_number(lo, "--band LO") if lo else None
+    hi = parse_number(hi, "--band HI") if hi else None
+    if lo is not None and hi is not None and lo >= hi:
+        raise SatmdError(f"--band {text!r}: LO must be below HI")
+    return lo, hi
+
+
+def parse_kv(text: str, what: str) -> dict:
+    """'a=1,b=2' -> {'a': 1.0, 'b': 2.0}."""
+    out = {}
+    for item in filter(None, (s.strip() for s in text.split(","))):
+        key, sep, value = item.partition("=")
+        if not sep or not key.strip():
+            raise SatmdError(f"{what}: {item!r} is not key=value")
+        out[key.strip()] = parse_number(value.strip(), f"{what} {key.strip()}")
+    return out
+
+
+def parse_effect(text: str):
+    """'extra_mode:f_hz=66,zeta=0.01' or 'parameter_offset:k1:value=2e5' -> Effect."""
+    name, params = text, {}
+    if "=" in text:
+        name, _, kv = text.rpartition(":")
+        if not name:
+            raise SatmdError(f"--effect {text!r}: expected NAME:key=value,...")
+        params = parse_kv(kv, f"--effect {name}")
+    try:
+        return effect(name, **params)
+    except (TypeError, ValueError) as exc:
+        raise SatmdError(f"--effect {text!r}: {exc}") from None
+
+
+def parse_names(text: str, allowed, what: str) -> tuple[str, ...]:
+    names = tuple(s.strip() for s in text.split(",") if s.strip())
+    bad = [n for n in names if n not in allowed]
+    if bad or not names:
+        raise SatmdError(f"{what}: unknown {', '.join(bad) or '(empty)'}; choose from {', '.join(allowed)}")
+    return names
+
+
+def add_rig_options(parser: argparse.ArgumentParser, names=("m2", "kp", "R", "L")):
+    for n in names:
+        parser.add_argument(f"--{n}", type=float, default=None, help=f"{n} (default {getattr(Rig(), n):g})")
+
+
+def rig_from_args(args, names=("m2", "kp", "R", "L")) -> Rig:
+    changes = {n: getattr(args, n) for n in names if getattr(args, n, None) is not None}
+    return Rig().replace(**changes).validate()
+
+
+def add_data_options(parser: argparse.ArgumentParser):
+    """DATA positional plus the options every data-taking command shares."""
+    parser.add_argument("data", metavar="DATA", help="FRF file (any format satmd.io.load_frf reads)")
+    parser.add_argument("--band", default=None, metavar="LO:HI", help="use only LO <= f <= HI Hz")
+    parser.add_argument("--map", default=None, metavar="a1=NODE:DIR,a2=NODE:DIR",
+                        help="channel mapping for UFF files with more than two responses")
+
+
+def load_data(args):
+    """Load DATA with the --band and --map options applied."""
+    from ..io import load_frf
+
+    options = {}
+    if getattr(args, "map", None):
+        options["channel_map"] = args.map
+    data = load_frf(args.data, **options)
+    lo, hi = parse_band(getattr(args, "band", None))
+    return data.band(lo, hi) if (lo is not None or hi is not None) else data

@@ -1,0 +1,20 @@
+"""satmd reproduce: the paper's results and satmd's extensions as a report."""
+from __future__ import annotations
+
+
+def register(sub):
+    p = sub.add_parser("reproduce", help="reproduce the paper and the discovery demo as a report",
+                       description="Compute every section of the satmd report into DIR (index.md, index.html, "
+                                   "figures/, results.json).")
+    p.add_argument("--out", default="report", metavar="DIR", help="output folder (default: report)")
+    p.add_argument("--only", default=None, metavar="SECTIONS", help="comma-separated section keys, e.g. forward")
+    p.add_argument("--quick", action="store_true", help="smaller runs (for smoke tests)")
+    p.set_defaults(func=run)
+
+
+def run(args):
+    from ..report import reproduce
+
+    only = [s.strip() for s in args.only.split(",")] if args.only else None
+    index = reproduce(args.out, only=only, quick=args.quick)
+    print(f"report written to {index} (and index.html)")

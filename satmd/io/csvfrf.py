@@ -1,0 +1,141 @@
+"""The `satmd-frf v1` CSV format (SPEC §7): strict reader, exact writer."""
+from __future__ import annotations
+
+import math
+import os
+from pathlib import Path
+
+import numpy as np
+
+from ..errors import FormatError
+from .frfdata import CHANNELS, FRFData
+
+MAGIC = "# satmd-frf v1"
+_SUFFIXES = ("re", "im", "std")
+
+
+def read_csv(path) -> FRFData:
+    """Read a SPEC §7 file; any malformation raises FormatError (file, line, column)."""
+    path = Path(path)
+    try:
+        raw = path.read_bytes()
+    except OSError as exc:
+        raise FormatError(path, f"cannot read file ({exc.strerror or exc})") from None
+    if not raw.strip():
+        raise FormatError(path, "empty file")
+    try:
+        text = raw.decode("utf-8-sig")
+    except UnicodeDecodeError as exc:
+        line = raw[: exc.start].count(b"\n") + 1
+        raise FormatError(path, "not a text file (invalid UTF-8)", line=line) from None
+    if "\x00" in text:
+        raise FormatError(path, "not a text file (contains NUL bytes)")
+
+    meta, header, header_line, rows = {}, None, None, []
+    for lineno, line in enumerate(text.splitlines(), start=1):
+        stripped = line.strip()
+        if not stripped:
+            continue
+        if stripped.startswith("#"):
+            body = stripped[1:].strip()
+            if body.lower().startswith("satmd-frf"):
+                if body.split()[1:] != ["v1"]:
+                    raise FormatError(path, f"unsupported format version {body!r} (this reader knows satmd-frf v1)", line=lineno)
+            elif ":" in body and header is None:
+                key, _, value = body.partition(":")
+                meta[key.strip()] = value.strip()
+            continue
+        cells = [c.strip() for c in stripped.split(",")]
+        if header is None:
+            header, header_line = cells, lineno
+            columns = _parse_header(path, header, lineno)
+            continue
+        rows.append((lineno, cells))
+    if header is None:
+        raise FormatError(path, "no column header (expected freq_hz,a1_re,a1_im,...)")
+    if not rows:
+        raise FormatError(path, "no data rows after the header", line=header_line)
+
+    values = np.empty((len(rows), len(header)))
+    for i, (lineno, cells) in enumerate(rows):
+        if len(cells) != len(header):
+            raise FormatError(path, f"{len(cells)} fields, header has {len(header)}", line=lineno)
+        for j, cell in enumerate(cells):
+            try:
+                x = float(cell)
+            except ValueError:
+                raise FormatError(path, f"not a number: {cell!r}", line=lineno, column=f"{j + 1} ({header[j]})") from None
+            if not math.isfinite(x):
+                raise FormatError(path, f"{cell} is not a finite number", line=lineno, column=f"{j + 1} ({header[j]})")
+            values[i, j] = x
+
+    freq = values[:, 0]
+    for i, (lineno, _) in enumerate(rows):
+        if freq[i] <= 0:
+            raise FormatError(path, f"frequency must be > 0, got {freq[i]:g}", line=lineno, column="1 (freq_hz)")
+        if i and freq[i] <= freq[i - 1]:
+            raise FormatError(path, f"frequency not strictly increasing ({freq[i]:g} after {freq[i - 1]:g})",
+                              line=lineno, column="1 (freq_hz)")
+    chans, std = {}, {}
+    for ch, cols in columns.items():
+        chans[ch] = values[:, cols["re"]] + 1j * values[:, cols["im"]]
+        if "std" in cols:
+            s = values[:, cols["std"]]
+            bad = np.flatnonzero(s < 0)
+            if bad.size:
+                k = bad[0]
+                raise FormatError(path, f"negative std {s[k]:g}", line=rows[k][0],
+                                  column=f"{cols['std'] + 1} ({ch}_std)")
+            std[ch] = s
+    meta.setdefault("source", str(path))
+    return FRFData(freq, chans, std, meta)
+
+
+def _parse_header(path, header, lineno):
+    if header[0] != "freq_hz":
+        raise FormatError(path, f"first column must be freq_hz, got {header[0]!r}", line=lineno, column=1)
+    columns: dict = {}
+    for j, name in enumerate(header[1:], start=2):
+        ch, _, suffix = name.rpartition("_")
+        if suffix not in _SUFFIXES or not ch:
+            raise FormatError(path, f"bad column name {name!r} (expected <channel>_re, _im or _std)", line=lineno, column=j)
+        if ch not in CHANNELS:
+            raise FormatError(path, f"unknown channel {ch!r} in column {name!r} (known: {', '.join(CHANNELS)})",
+                              line=lineno, column=j)
+        if suffix in columns.setdefault(ch, {}):
+            raise FormatError(path, f"duplicate column {name!r}", line=lineno, column=j)
+        columns[ch][suffix] = j - 1
+    if not columns:
+        raise FormatError(path, "no channel columns after freq_hz", line=lineno)
+    for ch, cols in columns.items():
+        for need in ("re", "im"):
+            if need not in cols:
+                raise FormatError(path, f"channel {ch} has no {ch}_{need} column", line=lineno)
+    return columns
+
+
+def write_csv(data: FRFData, path) -> Path:
+    """Write SPEC §7 CSV; floats with 17 significant digits so a read gives the same bits.
+
+    The file is written to a temporary name and renamed, so a failure never
+    leaves a half-written file in place of an existing one.
+    """
+    path = Path(path)
+    names = list(data.channels)
+    header = ["freq_hz"] + [f"{c}_{p}" for c in names for p in ("re", "im")]
+    header += [f"{c}_std" for c in names if c in data.std]
+    cols = [data.freq_hz]
+    for c in names:
+        cols += [data.channels[c].real, data.channels[c].imag]
+    cols += [data.std[c] for c in names if c in data.std]
+    table = np.column_stack(cols)
+    lines = [MAGIC]
+    for k, v in data.meta.items():
+        if k != "source" and "\n" not in f"{k}{v}":
+            lines.append(f"# {k}: {v}")
+    lines.append(",".join(header))
+    lines += [",".join(f"{x:.17g}" for x in row) for row in table]
+    tmp = path.with_name(f".{path.name}.tmp{os.getpid()}")
+    tmp.write_text("\n".join(lines) + "\n", encoding="utf-8")
+    os.replace(tmp, path)
+    return path

@@ -1,0 +1,32 @@
+"""The SATMD forward model: the rig, the effects and the batched FRF solver.
+
+>>> from satmd.physics import Rig, frf, effect, PAPER_GRID_HZ
+>>> r = frf(PAPER_GRID_HZ, Rig(), effects=[effect("time_delay", tau_s=1e-4)], wrt=["R", "L"])
+>>> r.a1.shape, r.jac["a1"].shape
+((60,), (60, 2))
+
+The torch twin lives in ``satmd.physics.torch`` (imported on demand).
+"""
+from .effects import (
+    OFFSET_PARAMETERS,
+    VOCABULARY,
+    VOCABULARY_NAMES,
+    DielectricLoss,
+    Effect,
+    ExtraMode,
+    ParameterOffset,
+    SensorGain,
+    ShuntCapacitance,
+    StructuralDamping,
+    TimeDelay,
+    effect,
+)
+from .model import CHANNELS, STATES, Response, frf, parameter_names, solve, terms
+from .rig import PAPER_GRID_HZ, PARAMETER_INFO, Rig
+
+__all__ = [
+    "CHANNELS", "STATES", "OFFSET_PARAMETERS", "VOCABULARY", "VOCABULARY_NAMES", "PAPER_GRID_HZ",
+    "PARAMETER_INFO", "Rig", "Response", "frf", "parameter_names", "solve", "terms", "effect", "Effect",
+    "SensorGain", "TimeDelay", "StructuralDamping", "DielectricLoss", "ShuntCapacitance", "ExtraMode",
+    "ParameterOffset",
+]

@@ -1,0 +1,361 @@
+"""The coupled electromechanical FRF model (SPEC §2) and its analytic Jacobian.
+
+This module is the only place that writes the dynamic stiffness Z. The shunt
+charge Q is eliminated in closed form (Schur complement): the piezo branch
+between the two masses becomes the complex stiffness
+
+    K(ω) = kp + iω cp - b² / Z33,      b = e / Cp,  Z33 = 1/Cp + iω Zs(ω),
+
+and the remaining 2x2 system is solved by Cramer's rule,
+
+    det = K1 (K - m2 ω²) - K m2 ω²,    U1 = F0 (K - m2 ω²) / det,
+    U2  = F0 K / det,                  Q  = -b (U1 - U2) / Z33,
+
+with K1 = k1 + i ω c1 - m1 ω² (plus host effects). Everything is elementwise
+over (batch, frequency) in float64/complex128.
+
+Jacobians are forward-mode: the small intermediate quantities (K1, K's parts,
+Z33, ...) carry exact tangents through `dual.Dual`; the solve propagates them
+in closed form, dx/dθ = -Z⁻¹ (dZ/dθ) x, written out for the eliminated system.
+"""
+from __future__ import annotations
+
+import os
+from concurrent.futures import ThreadPoolExecutor
+from dataclasses import dataclass, field
+from typing import Iterable, Sequence
+
+import numpy as np
+
+from . import dual
+from .effects import Effect
+from .rig import Rig
+
+STATES = ("u1", "u2", "q")
+CHANNELS = ("u1", "u2", "q", "a1", "a2")
+# complex elements per chunk: keeps the working set in cache
+_CHUNK_ELEMENTS = 16384
+# below this many (batch x frequency) points threads cost more than they give
+_THREADED_POINTS = 100_000
+
+
+@dataclass
+class Terms:
+    """The entries of the eliminated system at each (batch, frequency) point."""
+
+    omega: object
+    K1: object  # host: k1 - m1 ω² + iω c1 (+ host effects)
+    Kp: object  # piezo mechanical branch: kp + iω cp
+    b: object  # e / Cp
+    Z33: object  # 1/Cp + iω Zs
+    M2: object  # m2 ω²
+    F0: object
+    s1: object = None  # sensor factor on a1 (None = 1)
+    s2: object = None
+
+
+def terms(omega, rig: Rig, effects: Sequence[Effect] = ()) -> Terms:
+    """Z's entries, written once. Works for NumPy, torch tensors and duals."""
+    for eff in effects:
+        rig = eff.rig(rig)
+    w2 = omega * omega
+    K1 = rig.k1 - rig.m1 * w2 + 1j * omega * rig.c1
+    Cp = rig.Cp
+    Zs = rig.R + 1j * omega * rig.L
+    s1 = s2 = None
+    for eff in effects:
+        K1 = eff.host(omega, rig, K1)
+        Cp = eff.capacitance(omega, rig, Cp)
+        Zs = eff.shunt(omega, rig, Zs)
+        s1 = eff.sensor(omega, "a1", s1)
+        s2 = eff.sensor(omega, "a2", s2)
+    return Terms(
+        omega=omega,
+        K1=K1,
+        Kp=rig.kp + 1j * omega * rig.cp,
+        b=rig.e / Cp,
+        Z33=1.0 / Cp + 1j * omega * Zs,
+        M2=rig.m2 * w2,
+        F0=rig.F0,
+        s1=s1,
+        s2=s2,
+    )
+
+
+def solve(t: Terms) -> dict:
+    """Closed-form solution of Z x = [F0, 0, 0] (plus measured accelerations)."""
+    bz = t.b / t.Z33
+    K = t.Kp - t.b * bz
+    KmM = K - t.M2
+    inv = t.F0 / (t.K1 * KmM - K * t.M2)
+    u1 = KmM * inv
+    u2 = K * inv
+    q = (bz * t.M2) * inv  # = -b (u1 - u2) / Z33 since u1 - u2 = -M2 inv
+    mw2 = -(t.omega * t.omega)
+    a1 = mw2 * u1 if t.s1 is None else (mw2 * t.s1) * u1
+    a2 = mw2 * u2 if t.s2 is None else (mw2 * t.s2) * u2
+    return {"u1": u1, "u2": u2, "q": q, "a1": a1, "a2": a2}
+
+
+def solve_with_tangents(t: Terms, wrt: Sequence[str], outputs: Sequence[str], out_values: dict, out_jac: dict):
+    """Values and d(output)/d(parameter) for each name in ``wrt``, written into
+    ``out_values[ch]`` (rows, F) and ``out_jac[ch]`` (rows, F, P).
+
+    ``t`` holds duals; the solve is done on their values and tangents are
+    pushed through the closed form. Every parameter acts through a handful of
+    intermediates (K, m2 ω², K1, F0, b, Z33, sensor factors), so the
+    coefficient d(output)/d(intermediate) is computed once and shared by all
+    parameters: a 4-parameter Jacobian costs a few FRFs, not four.
+    """
+    v = {k: dual.value(getattr(t, k)) for k in ("omega", "K1", "Kp", "b", "Z33", "M2", "F0", "s1", "s2")}
+    K1, b, Z33, M2, F0 = v["K1"], v["b"], v["Z33"], v["M2"], v["F0"]
+    bz = b / Z33
+    K = v["Kp"] - b * bz
+    KmM = K - M2
+    rdet = 1.0 / (K1 * KmM - K * M2)
+    inv = F0 * rdet
+    u = {"u1": KmM * inv, "u2": K * inv}
+    q = (bz * M2) * inv
+    mw2 = -(v["omega"] * v["omega"])
+    gain = {"a1": mw2 if v["s1"] is None else mw2 * v["s1"], "a2": mw2 if v["s2"] is None else mw2 * v["s2"]}
+    values = {"u1": u["u1"], "u2": u["u2"], "q": q, "a1": gain["a1"] * u["u1"], "a2": gain["a2"] * u["u2"]}
+    for ch in outputs:
+        out_values[ch][...] = values[ch]
+
+    base = {}  # d(u1, u2)/d(intermediate)
+
+    def du(key):
+        if key not in base:
+            if key == "K":
+                T = (K1 - M2) * rdet
+                base[key] = (inv - u["u1"] * T, inv - u["u2"] * T)
+            elif key == "M2":
+                S = (K1 + K) * rdet
+                base[key] = (u["u1"] * S - inv, u["u2"] * S)
+            elif key == "K1":
+                base[key] = (-u["u1"] * KmM * rdet, -u["u2"] * KmM * rdet)
+            else:  # F0
+                base[key] = (KmM * rdet, K * rdet)
+        return base[key]
+
+    coefs = {}  # d(channel)/d(intermediate)
+
+    def coef(key, ch):
+        if (key, ch) not in coefs:
+            d1, d2 = du(key)
+            if ch == "q":
+                coefs[key, ch] = -bz * (d1 - d2)
+            elif ch in ("a1", "a2"):
+                coefs[key, ch] = gain[ch] * (d1 if ch == "a1" else d2)
+            else:
+                coefs[key, ch] = d1 if ch == "u1" else d2
+        return coefs[key, ch]
+
+    for j, name in enumerate(wrt):
+        d = {k: dual.tangent(getattr(t, k), name) for k in ("K1", "Kp", "b", "Z33", "M2", "F0", "s1", "s2")}
+        dK = d["Kp"]
+        if d["b"] is not None:
+            dK = _acc(dK, (-2.0 * bz) * d["b"])
+        if d["Z33"] is not None:
+            dK = _acc(dK, (bz * bz) * d["Z33"])
+        moves = [(key, dx) for key, dx in (("K", dK), ("M2", d["M2"]), ("K1", d["K1"]), ("F0", d["F0"])) if dx is not None]
+        for ch in outputs:
+            col = None
+            for key, dx in moves:
+                c = coef(key, ch)
+                col = _acc(col, c if _is_one(dx) else c * dx)
+            if ch == "q":  # q = b M2 F0 / (det Z33) depends on b and Z33 directly too
+                if d["b"] is not None:
+                    col = _acc(col, (q / b) * d["b"])
+                if d["Z33"] is not None:
+                    col = _acc(col, (-q / Z33) * d["Z33"])
+            elif ch in ("a1", "a2") and d["s" + ch[1]] is not None:
+                col = _acc(col, (mw2 * d["s" + ch[1]]) * u["u" + ch[1]])
+            out_jac[ch][..., j] = 0.0 if col is None else col
+
+
+def _is_one(x):
+    return isinstance(x, (int, float)) and x == 1.0
+
+
+def _acc(total, x):
+    return x if total is None else total + x
+
+
+@dataclass
+class Response:
+    """FRFs of a rig (batch of rigs) on a frequency grid.
+
+    Each of ``u1, u2, q, a1, a2`` is complex with shape ``(*batch, n_freq)``.
+    ``a1, a2`` are what the sensors report (sensor effects applied);
+    ``u1, u2, q`` are the physical states. When a Jacobian was asked for,
+    ``jac[channel]`` has shape ``(*batch, n_freq, len(wrt))``.
+    """
+
+    freq_hz: np.ndarray
+    u1: np.ndarray | None = None
+    u2: np.ndarray | None = None
+    q: np.ndarray | None = None
+    a1: np.ndarray | None = None
+    a2: np.ndarray | None = None
+    wrt: tuple = ()
+    jac: dict = field(default_factory=dict)
+
+    def channel(self, name: str) -> np.ndarray:
+        if name not in CHANNELS:
+            raise ValueError(f"unknown channel {name!r}; known: {', '.join(CHANNELS)}")
+        value = getattr(self, name)
+        if value is None:
+            raise ValueError(f"channel {name} was not computed")
+        return value
+
+    def stack(self, channels: Iterable[str]) -> np.ndarray:
+        """Channels side by side: shape (*batch, n_channels, n_freq)."""
+        return np.stack([self.channel(c) for c in channels], axis=-2)
+
+
+def parameter_names(rig: Rig, effects: Sequence[Effect]) -> list[str]:
+    """Every name a Jacobian can be taken with respect to."""
+    names = list(Rig.names())
+    for eff in effects:
+        names += [eff.qualified(p) for p in eff.parameter_names]
+    return names
+
+
+def resolve_parameter(name: str, effects: Sequence[Effect]) -> tuple[int, str]:
+    """Map a Jacobian name to (-1, rig field) or (effect index, parameter).
+
+    Effect parameters are named ``effect.param`` (``extra_mode.f_hz``); a bare
+    parameter name is accepted when exactly one effect has it.
+    """
+    if name in Rig.names():
+        return -1, name
+    hits = []
+    for i, eff in enumerate(effects):
+        for p in eff.parameter_names:
+            if name in (eff.qualified(p), p):
+                hits.append((i, p))
+    if len(hits) == 1:
+        return hits[0]
+    if not hits:
+        raise ValueError(f"no parameter {name!r}; known: {', '.join(parameter_names(Rig(), effects))}")
+    raise ValueError(f"parameter name {name!r} is ambiguous; use the qualified form effect.param")
+
+
+def frf(
+    freq_hz,
+    rig: Rig | None = None,
+    effects: Sequence[Effect] = (),
+    wrt: Sequence[str] | None = None,
+    outputs: Sequence[str] = CHANNELS,
+    threads: int | None = None,
+) -> Response:
+    """FRFs of the SATMD for a unit force on the primary mass.
+
+    Parameters
+    ----------
+    freq_hz : array_like, shape (n_freq,)
+        Frequencies in Hz (> 0 not required; 0 gives the static solution).
+    rig : Rig
+        Parameters; fields may be arrays that broadcast to a batch shape.
+    effects : sequence of Effect
+        Missing-physics effects (SPEC §8) applied in order. Their parameters
+        may also be arrays that broadcast with the rig.
+    wrt : sequence of str, optional
+        Parameter names for the analytic Jacobian: rig fields
+        (``"m2"``, ``"R"``, ...) or effect parameters (``"extra_mode.f_hz"``).
+    outputs : sequence of str
+        Channels to return (and differentiate).
+    threads : int, optional
+        Worker threads for large batches (default: all cores, one for small
+        problems).
+
+    Returns
+    -------
+    Response
+    """
+    rig = Rig() if rig is None else rig
+    rig.validate()
+    freq = np.asarray(freq_hz, dtype=float)
+    if freq.ndim != 1:
+        raise ValueError(f"freq_hz must be 1-D, got shape {freq.shape}")
+    if not np.all(np.isfinite(freq)):
+        raise ValueError("freq_hz contains NaN or infinite values")
+    unknown = [o for o in outputs if o not in CHANNELS]
+    if unknown:
+        raise ValueError(f"unknown output channel(s) {unknown}; known: {', '.join(CHANNELS)}")
+    wrt = tuple(wrt or ())
+    targets = [resolve_parameter(n, effects) for n in wrt]
+
+    leaves = [getattr(rig, n) for n in Rig.names()]
+    for eff in effects:
+        leaves += [eff.params[p] for p in eff.parameter_names]
+    batch = np.broadcast_shapes(*(np.shape(x) for x in leaves))
+    n_rows = int(np.prod(batch, dtype=int))
+    n_freq = freq.size
+    omega = 2.0 * np.pi * freq
+
+    out = {ch: np.empty((n_rows, n_freq), dtype=complex) for ch in outputs}
+    jac = {ch: np.empty((n_rows, n_freq, len(wrt)), dtype=complex) for ch in outputs} if wrt else {}
+    step = max(1, _CHUNK_ELEMENTS // max(n_freq, 1))
+    flat_rig = {n: _flatten(getattr(rig, n), batch) for n in Rig.names()}
+    flat_eff = [{p: _flatten(eff.params[p], batch) for p in eff.parameter_names} for eff in effects]
+
+    def run(sl):
+        rig_c = Rig(**{n: _rows(v, sl) for n, v in flat_rig.items()})
+        effs_c = [eff.replace(**{p: _rows(v, sl) for p, v in fp.items()}) for eff, fp in zip(effects, flat_eff)]
+        if wrt:
+            rig_c, effs_c = _seed_duals(rig_c, effs_c, wrt, targets)
+            solve_with_tangents(
+                terms(omega, rig_c, effs_c), wrt, outputs,
+                {ch: out[ch][sl] for ch in outputs}, {ch: jac[ch][sl] for ch in outputs},
+            )
+        else:
+            values = solve(terms(omega, rig_c, effs_c))
+            for ch in outputs:
+                out[ch][sl] = values[ch]
+
+    chunks = [slice(i, min(i + step, n_rows)) for i in range(0, n_rows, step)]
+    n_threads = _threads(threads, n_rows * n_freq, len(chunks))
+    if n_threads > 1:  # NumPy releases the GIL inside ufuncs
+        with ThreadPoolExecutor(n_threads) as pool:
+            list(pool.map(run, chunks))
+    else:
+        for sl in chunks:
+            run(sl)
+
+    shape = batch + (n_freq,)
+    res = Response(freq_hz=freq, wrt=wrt)
+    for ch in outputs:
+        setattr(res, ch, out[ch].reshape(shape))
+    res.jac = {ch: a.reshape(shape + (len(wrt),)) for ch, a in jac.items()}
+    return res
+
+
+def _threads(requested, n_points, n_chunks):
+    if requested is not None:
+        return max(1, min(int(requested), n_chunks))
+    if n_points < _THREADED_POINTS:
+        return 1
+    return max(1, min(os.cpu_count() or 1, 8, n_chunks))
+
+
+def _seed_duals(rig, effects, wrt, targets):
+    rig_changes = {}
+    effects = list(effects)
+    for name, (i, p) in zip(wrt, targets):
+        if i < 0:
+            rig_changes[p] = dual.Dual.variable(getattr(rig, p), name)
+        else:
+            effects[i] = effects[i].replace(**{p: dual.Dual.variable(effects[i].params[p], name)})
+    return rig.replace(**rig_changes) if rig_changes else rig, effects
+
+
+def _flatten(x, batch):
+    if np.ndim(x) == 0:
+        return x
+    return np.broadcast_to(np.asarray(x, dtype=float), batch).reshape(-1)
+
+
+def _rows(x, sl):
+    return x[sl, None] if isinstance(x, np.ndarray) else x

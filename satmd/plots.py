@@ -1,0 +1,77 @@
+"""Figures. Everything draws with matplotlib's Agg backend into files."""
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Sequence
+
+import numpy as np
+
+from .io.frfdata import UNITS
+
+LABELS = {"a1": "A1 (primary)", "a2": "A2 (absorber)", "u1": "U1", "u2": "U2", "q": "Q (charge)"}
+
+
+def _plt():
+    import matplotlib
+
+    matplotlib.use("Agg", force=True)
+    import matplotlib.pyplot as plt
+
+    return plt
+
+
+def save(fig, path) -> Path:
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fig.savefig(path, dpi=120, bbox_inches="tight")
+    _plt().close(fig)
+    return path
+
+
+def frf_figure(curves: Sequence[tuple], channels: Sequence[str], title: str = "", bands=(), phase: bool = True):
+    """Magnitude (and phase) of several FRF sets.
+
+    ``curves`` are (label, freq_hz, {channel: complex array}, style dict).
+    ``bands`` are (lo, hi) frequency ranges to shade.
+    """
+    plt = _plt()
+    rows = 2 if phase else 1
+    fig, axes = plt.subplots(rows, len(channels), figsize=(4.2 * len(channels), 3.0 * rows), squeeze=False,
+                             sharex=True)
+    for j, ch in enumerate(channels):
+        for label, f, data, style in curves:
+            if ch not in data:
+                continue
+            axes[0, j].semilogy(f, np.abs(data[ch]), label=label, **style)
+            if phase:
+                axes[1, j].plot(f, np.degrees(np.angle(data[ch])), **style)
+        axes[0, j].set_title(LABELS.get(ch, ch))
+        axes[0, j].set_ylabel(f"|{ch}| [{UNITS.get(ch, '')}]")
+        if phase:
+            axes[1, j].set_ylabel("phase [deg]")
+        axes[-1, j].set_xlabel("frequency [Hz]")
+        for ax in axes[:, j]:
+            for lo, hi in bands:
+                ax.axvspan(lo, hi, color="tab:red", alpha=0.12, lw=0)
+            ax.grid(True, which="both", alpha=0.3)
+    axes[0, 0].legend(fontsize=8)
+    if title:
+        fig.suptitle(title)
+    fig.tight_layout()
+    return fig
+
+
+def plot_frfdata(data, path, title="", others: Sequence[tuple] = ()):
+    """Plot an FRFData (with ±2σ band when std is given) and optional model curves."""
+    plt = _plt()
+    channels = list(data.channels)
+    curves = [("data", data.freq_hz, data.channels, {"color": "k", "marker": ".", "ms": 3, "lw": 0.6})]
+    curves += [(lbl, f, d, st) for lbl, f, d, st in others]
+    fig = frf_figure(curves, channels, title)
+    if data.std:
+        for j, ch in enumerate(channels):
+            if ch in data.std:
+                mag, s = np.abs(data[ch]), data.std[ch]
+                fig.axes[j].fill_between(data.freq_hz, np.maximum(mag - 2 * s, mag * 1e-3), mag + 2 * s,
+                                         color="0.6", alpha=0.3, lw=0, label="±2σ")
+    return save(fig, path)
