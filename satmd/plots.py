@@ -75,3 +75,46 @@ def plot_frfdata(data, path, title="", others: Sequence[tuple] = ()):
                 fig.axes[j].fill_between(data.freq_hz, np.maximum(mag - 2 * s, mag * 1e-3), mag + 2 * s,
                                          color="0.6", alpha=0.3, lw=0, label="±2σ")
     return save(fig, path)
+
+
+def fit_figure(data, curves: Sequence[tuple], residuals: Sequence[tuple] = (), bands=(), title=""):
+    """Measured vs model magnitude and phase, with standardised residuals below.
+
+    ``curves``: (label, {channel: complex array}, style) on the data grid.
+    ``residuals``: (label, {channel: complex standardised residual}, style).
+    """
+    plt = _plt()
+    channels = [c for c in data.channels if any(c in d for _, d, _ in curves)] or list(data.channels)
+    rows = 3 if residuals else 2
+    fig, axes = plt.subplots(rows, len(channels), figsize=(4.6 * len(channels), 2.6 * rows), squeeze=False,
+                             sharex=True)
+    f = data.freq_hz
+    for j, ch in enumerate(channels):
+        y = data[ch]
+        axes[0, j].semilogy(f, np.abs(y), "k.", ms=3, label="measured")
+        axes[1, j].plot(f, np.degrees(np.angle(y)), "k.", ms=3)
+        for label, d, style in curves:
+            if ch in d:
+                axes[0, j].semilogy(f, np.abs(d[ch]), label=label, **style)
+                axes[1, j].plot(f, np.degrees(np.angle(d[ch])), **style)
+        axes[0, j].set_title(LABELS.get(ch, ch))
+        axes[0, j].set_ylabel(f"|{ch}| [{UNITS.get(ch, '')}]")
+        axes[1, j].set_ylabel("phase [deg]")
+        if residuals:
+            ax = axes[2, j]
+            for label, d, style in residuals:
+                if ch in d:
+                    ax.plot(f, np.abs(d[ch]), label=label, **style)
+            ax.axhline(np.sqrt(2 * 3.0), color="0.5", ls=":", lw=1)  # |z|² ~ χ²₂/2: 3 = rough 95 % level
+            ax.set_ylabel("|standardised residual|")
+            ax.legend(fontsize=7)
+        axes[-1, j].set_xlabel("frequency [Hz]")
+        for ax in axes[:, j]:
+            for lo, hi in bands:
+                ax.axvspan(lo, hi, color="tab:red", alpha=0.12, lw=0)
+            ax.grid(True, alpha=0.3)
+    axes[0, 0].legend(fontsize=8)
+    if title:
+        fig.suptitle(title)
+    fig.tight_layout()
+    return fig
