@@ -42,6 +42,11 @@ def main(argv=None) -> int:
     args = parser.parse_args(argv)
     try:
         return args.func(args) or 0
+    except BrokenPipeError:  # e.g. `satmd ... | head`: the reader left, nothing to report
+        import os
+
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        return 0
     except (SatmdError, ValueError, OSError) as exc:
         message = " ".join(str(exc).split()) or type(exc).__name__
         print(f"satmd {args.command}: error: {message}", file=sys.stderr)
@@ -49,11 +54,6 @@ def main(argv=None) -> int:
     except ImportError as exc:
         print(f"satmd {args.command}: error: {exc}", file=sys.stderr)
         return 2
-    except BrokenPipeError:  # e.g. `satmd ... | head`: the reader left, nothing to report
-        import os
-
-        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
-        return 0
     except KeyboardInterrupt:
         print("satmd: interrupted", file=sys.stderr)
         return 130
