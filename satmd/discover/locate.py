@@ -1,0 +1,86 @@
+"""Where and whether the model misses: calibrated tests on standardised residuals.
+
+Under the null hypothesis (the model is right and σ is the noise std) each
+standardised residual z = (model − data)/σ is complex Gaussian with unit
+variance per part, so |z|² summed over channels and a window of w points is
+χ² with 2·C·w degrees of freedom (the fit's few parameters take little of
+that). A window is significant when its p-value survives a Bonferroni
+correction over all windows of all widths; significant windows merge into
+bands. The global test is χ² of the whole fit against its degrees of
+freedom. Both run at level ``alpha`` (default 1e-3), split between them.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from scipy import stats
+
+WIDTHS = (1, 3, 7, 15)
+
+
+@dataclass
+class MismatchTest:
+    significant: bool
+    p_global: float
+    p_band: float  # smallest Bonferroni-corrected window p-value
+    bands_hz: list
+    whiteness: dict  # lag-1 autocorrelation of the residual per channel
+    chi2_per_point: np.ndarray  # Σ_channels |z|² at each frequency
+
+
+def standardized(fit) -> dict:
+    return fit.standardized_residuals()
+
+
+def test_mismatch(fit, alpha: float = 1e-3, noise_dof: float | None = None) -> MismatchTest:
+    """Global and band-wise χ² tests of a fit (see module docstring).
+
+    ``noise_dof``: degrees of freedom behind an estimated σ; the global test
+    is then an F test, which accounts for the uncertainty of the estimate.
+    """
+    z = standardized(fit)
+    freq = fit._problem.omega_hz
+    per_point = sum(np.abs(v) ** 2 for v in z.values())  # ~ χ²_{2C}
+    C = len(z)
+    if noise_dof:
+        p_global = float(stats.f.sf(fit.chi2_reduced, fit.dof, noise_dof))
+    else:
+        p_global = float(stats.chi2.sf(fit.chi2, fit.dof))
+    n = per_point.size
+    windows = []
+    for w in WIDTHS:
+        if w > n:
+            break
+        s = np.convolve(per_point, np.ones(w), mode="valid")
+        dof = 2 * C * w
+        if noise_dof:  # estimated σ: F(dof, noise_dof) for the window mean
+            p = stats.f.sf(s / dof, dof, noise_dof)
+        else:
+            p = stats.chi2.sf(s, dof)
+        windows += [(p[i], i, i + w - 1) for i in range(p.size)]
+    n_tests = len(windows)
+    p_adj = np.minimum(np.array([p for p, _, _ in windows]) * n_tests, 1.0)
+    hit = p_adj < alpha / 2
+    spans = sorted((i0, i1) for (p, i0, i1), h in zip(windows, hit) if h)
+    bands = []
+    for i0, i1 in spans:
+        if bands and i0 <= bands[-1][1] + 1:
+            bands[-1][1] = max(bands[-1][1], i1)
+        else:
+            bands.append([i0, i1])
+    bands_hz = [[float(freq[a]), float(freq[b])] for a, b in bands]
+    whiteness = {c: _lag1(v) for c, v in z.items()}
+    p_band = float(p_adj.min()) if p_adj.size else 1.0
+    significant = (p_global < alpha / 2) or (p_band < alpha / 2)
+    return MismatchTest(significant, p_global, p_band, bands_hz, whiteness, per_point)
+
+
+def _lag1(v: np.ndarray) -> float:
+    """Lag-1 autocorrelation across frequency (≈ 0 for white residuals)."""
+    if v.size < 3:
+        return 0.0
+    x = np.concatenate([v.real - v.real.mean(), v.imag - v.imag.mean()])
+    lagged = np.concatenate([v.real[:-1] - v.real.mean(), v.imag[:-1] - v.imag.mean()])
+    ahead = np.concatenate([v.real[1:] - v.real.mean(), v.imag[1:] - v.imag.mean()])
+    return float(np.sum(lagged * ahead) / np.sum(x * x))

@@ -1,0 +1,179 @@
+"""Model selection over the vocabulary: greedy forward steps, backward checks, swaps.
+
+Every model is the nominal model with the free parameters (m2, kp, R, L by
+default) plus a set of effects, fitted by `identify`. Models are compared by
+BIC. An effect enters only when (i) the current model still fails the
+calibrated mismatch test and (ii) it lowers BIC by more than
+``min_delta_bic`` (10: "very strong" evidence on Kass & Raftery's scale).
+After each step every earlier effect must still earn its place (backward
+elimination), and each effect is swapped for every other candidate: a swap
+that fits better is taken; one within ``min_delta_bic`` is reported as an
+equivalent explanation, because FRFs alone cannot tell them apart.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..identify import identify
+from ..identify.problem import Problem
+from .candidates import neutral_effect, start_grid
+
+MIN_DELTA_BIC = 10.0
+
+
+@dataclass
+class Model:
+    names: tuple  # effect names, in the order found
+    effects: list  # fitted Effect objects
+    fit: object  # FitResult
+
+    @property
+    def bic(self):
+        return self.fit.bic
+
+
+@dataclass
+class Search:
+    data: object
+    rig: object
+    base_free: tuple
+    channels: tuple
+    candidates: tuple
+    cache: dict = field(default_factory=dict)  # frozenset(names) -> Model
+    log: list = field(default_factory=list)
+
+    def free_names(self, effects):
+        return self.base_free + tuple(e.qualified(p) for e in effects for p in e.parameter_names)
+
+    def fit(self, effects, starts) -> object:
+        return identify(self.data, self.rig, self.free_names(effects), self.channels, effects, start=starts,
+                        global_search=False, tol=1e-9, max_nfev=300)
+
+    def add(self, model: Model, name: str) -> Model:
+        """Best fit of ``model`` plus effect ``name`` (screened starts, then least squares)."""
+        key = frozenset(model.names + (name,))
+        if key in self.cache:
+            return self.cache[key]
+        new = neutral_effect(name, self.rig)
+        effects = list(model.effects) + [new]
+        problem = Problem(self.data, self.rig, self.free_names(effects), self.channels, effects)
+        base = dict(model.fit.values)
+        grid = start_grid(name, self.rig, self.data.freq_hz)
+        thetas = np.array([[{**base, **{new.qualified(k): v for k, v in g.items()}}.get(n, np.nan)
+                            for n in problem.names] for g in grid])
+        thetas = np.clip(thetas, problem.lower, problem.upper)
+        cost = problem.batch_cost(thetas)
+        keep = _distinct_best(thetas, cost, problem.names, new, 3 if name == "extra_mode" else 2)
+        starts = [dict(zip(problem.names, thetas[k])) for k in keep]
+        fit = self.fit(effects, starts)
+        fitted = [_with_values(e, fit.values) for e in effects]
+        result = Model(model.names + (name,), fitted, fit)
+        self.cache[key] = result
+        self.log.append((model.names + (name,), fit.bic))
+        return result
+
+    def remove(self, model: Model, name: str, nominal: Model) -> Model:
+        """``model`` without effect ``name``, refitted from the current values."""
+        keep = [(n, e) for n, e in zip(model.names, model.effects) if n != name]
+        if not keep:
+            return nominal
+        key = frozenset(n for n, _ in keep)
+        if key in self.cache:
+            return self.cache[key]
+        effects = [e for _, e in keep]
+        start = {k: v for k, v in model.fit.values.items() if k in self.free_names(effects)}
+        fit = self.fit(effects, [start])
+        result = Model(tuple(n for n, _ in keep), [_with_values(e, fit.values) for e in effects], fit)
+        self.cache[key] = result
+        return result
+
+
+def _with_values(effect, values):
+    return effect.replace(**{p: values[effect.qualified(p)] for p in effect.parameter_names})
+
+
+def _distinct_best(thetas, cost, names, effect, k):
+    """Indices of the k lowest-cost starts whose own effect parameters differ."""
+    own = [i for i, n in enumerate(names) if n.startswith(effect.name + ".")]
+    order = np.argsort(cost)
+    picked = []
+    for i in order:
+        if not np.isfinite(cost[i]):
+            continue
+        z = np.log(np.abs(thetas[i, own]) + 1e-30)
+        if all(np.max(np.abs(z - np.log(np.abs(thetas[j, own]) + 1e-30))) > 0.02 for j in picked):
+            picked.append(i)
+        if len(picked) == k:
+            break
+    return picked
+
+
+def select(search: Search, nominal: Model, still_significant, max_effects: int = 3):
+    """Greedy forward selection with backward elimination and swaps.
+
+    ``still_significant(fit)`` is the calibrated mismatch test. Returns the
+    chosen Model and, per chosen effect, a list of (equivalent name, ΔBIC).
+    """
+    current = nominal
+    while len(current.names) < max_effects and still_significant(current.fit):
+        trials = [search.add(current, c) for c in search.candidates if c not in current.names]
+        best = min(trials, key=lambda m: m.bic)
+        if current.bic - best.bic <= MIN_DELTA_BIC:
+            break
+        current = best
+        current = _backward(search, current, nominal)
+        current = _swaps(search, current, nominal)
+    return current
+
+
+def _backward(search, model, nominal):
+    changed = True
+    while changed and len(model.names) > 1:
+        changed = False
+        for name in model.names[:-1]:
+            without = search.remove(model, name, nominal)
+            if without.bic - model.bic <= MIN_DELTA_BIC:
+                model, changed = without, True
+                break
+    return model
+
+
+def _swaps(search, model, nominal):
+    improved = True
+    while improved:
+        improved = False
+        for name in model.names:
+            rest = search.remove(model, name, nominal)
+            for c in search.candidates:
+                if c in model.names:
+                    continue
+                alt = search.add(rest, c)
+                if alt.bic < model.bic - 1e-6:
+                    model, improved = alt, True
+                    break
+            if improved:
+                break
+    return model
+
+
+def equivalents(search, model, nominal, limit: int = 3) -> dict:
+    """For each effect of ``model``: other candidates explaining the data as well (|ΔBIC| < 10)."""
+    out = {}
+    for name in model.names:
+        rest = search.remove(model, name, nominal)
+        alts = []
+        for c in search.candidates:
+            if c in model.names:
+                continue
+            alt = search.add(rest, c)
+            if abs(alt.bic - model.bic) < MIN_DELTA_BIC:
+                alts.append((alt.bic - model.bic, c))
+        out[name] = [c for _, c in sorted(alts)[:limit]]
+    return out
+
+
+def delta_bic(search, model, nominal) -> dict:
+    """BIC(model without the effect) − BIC(model), per effect."""
+    return {name: search.remove(model, name, nominal).bic - model.bic for name in model.names}
