@@ -29,7 +29,7 @@ from .discrepancy import fit_discrepancy
 from .locate import test_mismatch
 from .noise import estimate_std
 from .report import SCHEMA, DiscoveryReport, explain
-from .select import Model, Search, delta_bic, equivalents, select
+from .select import Model, Search, equivalents, select
 
 __all__ = ["discover", "DiscoveryReport", "SCHEMA"]
 
@@ -87,11 +87,14 @@ def discover(
     effects = []
     if final.names:
         equiv = equivalents(search, final, nominal)
-        dbic = delta_bic(search, final, nominal)
+        without = {n: search.remove(final, n, nominal) for n in final.names}
+        dbic = {n: m.bic - final.bic for n, m in without.items()}
         for name in sorted(final.names, key=lambda n: -dbic[n]):
             eff = final.effects[final.names.index(name)]
             params = {k: float(v) for k, v in eff.params.items()}
-            shifts = {k: final.fit.values[k] / nominal_fit.values[k] - 1 for k in free if nominal_fit.values[k]}
+            # what accounting for this effect does to the free parameters (vs the model without it)
+            ref = without[name].fit.values
+            shifts = {k: final.fit.values[k] / ref[k] - 1 for k in free if ref[k]}
             effects.append({"name": name, "parameters": params, "equivalent": equiv[name],
                             "delta_bic": round(float(dbic[name]), 2), "explanation": explain(name, params, rig, shifts)})
     after = _fit_summary(final.fit)

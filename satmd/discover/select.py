@@ -60,7 +60,10 @@ class Search:
         effects = list(model.effects) + [new]
         problem = Problem(self.data, self.rig, self.free_names(effects), self.channels, effects)
         base = dict(model.fit.values)
-        grid = start_grid(name, self.rig, self.data.freq_hz)
+        if name == "extra_mode":
+            grid = mode_scan(model, self.data.freq_hz)
+        else:
+            grid = start_grid(name, self.rig, self.data.freq_hz)
         thetas = np.array([[{**base, **{new.qualified(k): v for k, v in g.items()}}.get(n, np.nan)
                             for n in problem.names] for g in grid])
         thetas = np.clip(thetas, problem.lower, problem.upper)
@@ -69,10 +72,8 @@ class Search:
         starts = [dict(zip(problem.names, thetas[k])) for k in keep]
         fit = self.fit(effects, starts)
         fitted = [_with_values(e, fit.values) for e in effects]
-        result = Model(model.names + (name,), fitted, fit)
-        self.cache[key] = result
         self.log.append((model.names + (name,), fit.bic))
-        return result
+        return self._keep(key, Model(model.names + (name,), fitted, fit))
 
     def remove(self, model: Model, name: str, nominal: Model) -> Model:
         """``model`` without effect ``name``, refitted from the current values."""
@@ -80,14 +81,45 @@ class Search:
         if not keep:
             return nominal
         key = frozenset(n for n, _ in keep)
-        if key in self.cache:
-            return self.cache[key]
         effects = [e for _, e in keep]
         start = {k: v for k, v in model.fit.values.items() if k in self.free_names(effects)}
-        fit = self.fit(effects, [start])
-        result = Model(tuple(n for n, _ in keep), [_with_values(e, fit.values) for e in effects], fit)
-        self.cache[key] = result
-        return result
+        fit = self.fit(effects, [start])  # warm start from the larger model: often a better basin
+        return self._keep(key, Model(tuple(n for n, _ in keep), [_with_values(e, fit.values) for e in effects], fit))
+
+    def _keep(self, key, model: Model) -> Model:
+        """Remember the best fit found so far for a set of effects."""
+        old = self.cache.get(key)
+        if old is None or model.bic < old.bic:
+            self.cache[key] = model
+        return self.cache[key]
+
+
+def mode_scan(model: Model, freq_hz, zetas=(0.002, 0.005, 0.01, 0.02, 0.05)) -> list[dict]:
+    """Matched-filter scan for an unmodelled mode: for every (f3, ζ) the mode
+    mass enters linearly near zero, so the best mass and the χ² it removes
+    follow in closed form from one batched Jacobian at μ = 0."""
+    from ..physics import frf
+    from ..physics.effects import effect
+
+    fit = model.fit
+    p = fit._problem
+    rig, effects = p.apply(fit.theta)
+    lo, hi = float(freq_hz[0]), float(freq_hz[-1])
+    f3 = np.geomspace(lo, hi, int(np.ceil(np.log(hi / lo) / np.log(1.002))) + 1)
+    F, Z = np.meshgrid(f3, np.asarray(zetas), indexing="ij")
+    mode = effect("extra_mode", f_hz=F.ravel(), zeta=Z.ravel(), mass_ratio=0.0)
+    r = frf(p.omega_hz, rig, list(effects) + [mode], wrt=["extra_mode.mass_ratio"], outputs=p.channels)
+    resid = p.target - p.prediction(fit.theta)  # data - model, (C, F)
+    num = np.zeros(F.size)
+    den = np.zeros(F.size)
+    for k, c in enumerate(p.channels):
+        J = r.jac[c][..., 0] / p.sigma[k]  # (N, F)
+        num += np.real(np.sum(np.conj(J) * (resid[k] / p.sigma[k]), axis=-1))
+        den += np.sum(np.abs(J) ** 2, axis=-1)
+    mu = np.clip(num / np.maximum(den, 1e-300), 1e-5, 0.2)
+    gain = np.where(num > 0, num**2 / np.maximum(den, 1e-300), 0.0)
+    order = np.argsort(-gain)[:40]
+    return [{"f_hz": float(F.ravel()[i]), "zeta": float(Z.ravel()[i]), "mass_ratio": float(mu[i])} for i in order]
 
 
 def _with_values(effect, values):
@@ -172,8 +204,3 @@ def equivalents(search, model, nominal, limit: int = 3) -> dict:
                 alts.append((alt.bic - model.bic, c))
         out[name] = [c for _, c in sorted(alts)[:limit]]
     return out
-
-
-def delta_bic(search, model, nominal) -> dict:
-    """BIC(model without the effect) − BIC(model), per effect."""
-    return {name: search.remove(model, name, nominal).bic - model.bic for name in model.names}

@@ -218,7 +218,8 @@ def build_result(problem, theta, nominal, nfev, wall, opt, reg) -> FitResult:
     Js = J * sc
     u, sv, vt = np.linalg.svd(Js, full_matrices=False)
     cond = float((sv[0] / sv[-1]) ** 2) if sv[-1] > 0 else np.inf
-    inv_sv2 = np.where(sv > sv[0] * 1e-14, 1.0 / sv**2, np.inf)
+    with np.errstate(divide="ignore"):
+        inv_sv2 = np.where(sv > sv[0] * 1e-14, 1.0 / sv**2, np.inf)
     cov_s = (vt.T * inv_sv2) @ vt if np.all(np.isfinite(inv_sv2)) else np.full((k, k), np.inf)
     cov = cov_s * np.outer(sc, sc) * (1.0 if problem.weighted else chi2_red)
     std = np.sqrt(np.abs(np.diag(cov)))
