@@ -2,6 +2,9 @@
 from __future__ import annotations
 
 import argparse
+import contextlib
+import sys
+import warnings
 
 import numpy as np
 
@@ -92,19 +95,57 @@ def rig_from_args(args, names=("m2", "kp", "R", "L")) -> Rig:
 
 def add_data_options(parser: argparse.ArgumentParser):
     """DATA positional plus the options every data-taking command shares."""
-    parser.add_argument("data", metavar="DATA", help="FRF file (any format satmd.io.load_frf reads)")
+    parser.add_argument("data", metavar="DATA",
+                        help="FRF file (.csv, .uff/.unv, .mat, .npz, .txt) or a time recording "
+                             "(.csv, .uff, .wav, .npz, .mat; FRFs are then estimated with default settings)")
     parser.add_argument("--band", default=None, metavar="LO:HI", help="use only LO <= f <= HI Hz")
     parser.add_argument("--map", default=None, metavar="a1=NODE:DIR,a2=NODE:DIR",
-                        help="channel mapping for UFF files with more than two responses")
+                        help="channel mapping for UFF files with more than two responses (or a1=#N: dataset N)")
+    parser.add_argument("--freq-axis", default=None, metavar="START:STEP",
+                        help="frequency axis in Hz for .txt files of complex values (one per line)")
+
+
+@contextlib.contextmanager
+def one_line_warnings(command: str):
+    """Show warnings raised while loading data as one line each on stderr (no source lines)."""
+    from ..io import DataWarning
+
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always", DataWarning)  # others keep their default filters
+        try:
+            yield
+        finally:
+            seen = set()
+            for w in caught:
+                text = " ".join(str(w.message).split())
+                if text not in seen:
+                    seen.add(text)
+                    print(f"satmd {command}: warning: {text}", file=sys.stderr)
 
 
 def load_data(args):
-    """Load DATA with the --band and --map options applied."""
-    from ..io import load_frf
+    """Load DATA with the --band, --map and --freq-axis options applied.
 
-    options = {}
-    if getattr(args, "map", None):
-        options["channel_map"] = args.map
-    data = load_frf(args.data, **options)
+    A time recording is turned into FRFs with `satmd.io.estimate_frf`'s
+    defaults (a note on stderr says so; `satmd estimate-frf` gives control).
+    """
+    from ..io import estimate_frf, is_recording, load_frf, load_recording
+
+    command = getattr(args, "command", None) or "satmd"
     lo, hi = parse_band(getattr(args, "band", None))
+    with one_line_warnings(command):
+        if is_recording(args.data):
+            rec = load_recording(args.data, channel_map=getattr(args, "map", None))
+            data = estimate_frf(rec, band=(lo, hi))
+            m = data.meta
+            print(f"satmd {command}: note: {args.data} is a time recording: FRFs estimated with {m['estimator']}, "
+                  f"nperseg={m['nperseg']} ({m['resolution_hz']} Hz), {m['segments']} averages "
+                  f"(use `satmd estimate-frf` for control)", file=sys.stderr)
+            return data
+        options = {}
+        if getattr(args, "map", None):
+            options["channel_map"] = args.map
+        if getattr(args, "freq_axis", None):
+            options["freq_axis"] = args.freq_axis
+        data = load_frf(args.data, **options)
     return data.band(lo, hi) if (lo is not None or hi is not None) else data

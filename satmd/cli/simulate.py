@@ -1,11 +1,19 @@
-"""satmd simulate: write model FRFs (optionally noisy) as a SPEC §7 file."""
+"""satmd simulate: write model FRFs (optionally noisy) as a SPEC §7 file, or a time recording (--time)."""
 from __future__ import annotations
 
 from ..errors import SatmdError
 from ..io import CHANNELS, save_frf
 from ..physics import PAPER_GRID_HZ
 from ..simulate import simulate
-from ._common import add_rig_options, parse_effect, parse_freq, parse_names, parse_number, rig_from_args
+from ._common import (
+    add_rig_options,
+    parse_band,
+    parse_effect,
+    parse_freq,
+    parse_names,
+    parse_number,
+    rig_from_args,
+)
 
 
 def register(sub):
@@ -20,7 +28,17 @@ def register(sub):
     p.add_argument("--seed", type=int, default=None, help="random seed for the noise")
     p.add_argument("--freq", default="40:130:60", metavar="LO:HI:N", help="frequency grid (default 40:130:60)")
     p.add_argument("--channels", default="a1,a2", help="channels to write, from a1,a2,u1,u2,q (default a1,a2)")
-    p.add_argument("-o", "--out", required=True, metavar="OUT.csv", help="output file")
+    p.add_argument("-o", "--out", required=True, metavar="OUT.csv",
+                   help="output file (FRFs: .csv .uff .mat .npz; with --time: .csv .uff .wav .mat .npz)")
+    t = p.add_argument_group("time recordings (--time)")
+    t.add_argument("--time", action="store_true",
+                   help="write a time recording (force, acc1, acc2) instead of FRFs: band-limited random force "
+                        "through the linear model; --noise REL is then sensor noise relative to each channel's RMS")
+    t.add_argument("--duration", type=float, default=60.0, metavar="S", help="recording length in s (default 60)")
+    t.add_argument("--fs", type=float, default=1000.0, metavar="HZ", help="sample rate in Hz (default 1000)")
+    t.add_argument("--force-band", default="20:200", metavar="LO:HI",
+                   help="excitation band in Hz (default 20:200)")
+    t.add_argument("--force-rms", type=float, default=1.0, metavar="N", help="RMS force in N (default 1)")
     p.add_argument("--plot", default=None, metavar="OUT.png", help="also plot the FRFs")
     p.set_defaults(func=run)
 
@@ -38,6 +56,8 @@ def parse_noise(text):
 def run(args):
     rig = rig_from_args(args)
     effects = [parse_effect(e) for e in args.effect]
+    if args.time:
+        return run_time(args, rig, effects)
     freq = parse_freq(args.freq) if args.freq else PAPER_GRID_HZ
     channels = parse_names(args.channels, CHANNELS, "--channels")
     data = simulate(freq, rig, effects, channels, noise=parse_noise(args.noise), seed=args.seed)
@@ -47,3 +67,22 @@ def run(args):
 
         plot_frfdata(data, args.plot, title=f"simulated: {', '.join(e.name for e in effects) or 'nominal model'}")
     print(f"wrote {args.out} ({len(data)} points, channels {', '.join(channels)})")
+
+
+def run_time(args, rig, effects):
+    """--time: a simulated recording (satmd.io.simulate_recording)."""
+    from ..io import save_recording, simulate_recording
+
+    if args.plot:
+        raise SatmdError("--plot does not apply with --time (plot the estimate: satmd estimate-frf REC --plot FIG.png)")
+    noise = parse_noise(args.noise)
+    if noise and noise[1]:
+        raise SatmdError("--noise with --time takes REL only (sensor noise relative to each channel's RMS)")
+    lo, hi = parse_band(args.force_band)
+    if lo is None or hi is None:
+        raise SatmdError(f"--force-band {args.force_band!r}: expected LO:HI in Hz")
+    rec = simulate_recording(args.duration, args.fs, rig, effects, band_hz=(lo, hi), force_rms=args.force_rms,
+                             noise=noise[0] if noise else 0.0, seed=args.seed)
+    save_recording(rec, args.out)
+    print(f"wrote {args.out} ({rec.n_samples} samples at {rec.fs_hz:g} Hz = {rec.duration_s:g} s, "
+          f"channels {', '.join(rec.channels)})")

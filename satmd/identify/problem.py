@@ -63,7 +63,7 @@ class Problem:
             raise DataError(f"scale must be 'channel' or 'global', got {scale!r}")
         self.data = data
         self.scale_mode = scale
-        self.rig = Rig() if rig is None else rig
+        self.rig = (Rig() if rig is None else rig).validate()
         self.effects = list(effects)
         self.channels = tuple(channels) if channels else _default_channels(data)
         missing = [c for c in self.channels if c not in data.channels]
@@ -136,7 +136,9 @@ class Problem:
     # --- residuals -------------------------------------------------------------
     def model(self, theta, wrt=False):
         rig, effects = self.apply(theta)
-        return frf(self.omega_hz, rig, effects, wrt=self.names if wrt else None, outputs=self.channels)
+        # θ stays inside the bounds, so the rig was checked once (in __init__) rather than per call
+        return frf(self.omega_hz, rig, effects, wrt=self.names if wrt else None, outputs=self.channels,
+                   validate=False)
 
     def prediction(self, theta) -> np.ndarray:
         r = self.model(theta)
@@ -160,7 +162,7 @@ class Problem:
         """Sum of squared residuals for many parameter sets at once; thetas (N, P)."""
         thetas = np.asarray(thetas, dtype=float)
         rig, effects = self.apply(thetas.T)
-        r = frf(self.omega_hz, rig, effects, outputs=self.channels)
+        r = frf(self.omega_hz, rig, effects, outputs=self.channels, validate=False)
         cost = np.zeros(thetas.shape[0])
         for k, c in enumerate(self.channels):
             cost += np.sum(np.abs((r.channel(c) - self.target[k]) / self.sigma[k]) ** 2, axis=-1)

@@ -1,23 +1,50 @@
-"""Reading and writing FRFs.
+"""Reading and writing FRFs and time recordings.
 
 ``load_frf(path)`` dispatches on the file's suffix; ``save_frf(data, path)``
 likewise. Readers are registered in ``READERS`` / ``WRITERS`` so that new
 formats plug in without touching the callers.
+
+FRF formats: ``.csv`` (SPEC §7), ``.uff``/``.unv`` (UFF 58/58b, function
+type 4), ``.mat`` and ``.npz`` (documented variable names, see
+`satmd.io.matfile`), ``.txt`` (one complex value per line; needs
+``freq_axis``). Time recordings (`load_recording`): ``.csv``, ``.uff``,
+``.wav``, ``.npz``, ``.mat``; `estimate_frf` turns them into FRFs.
 """
 from __future__ import annotations
 
+import inspect
 from pathlib import Path
 
-from ..errors import FormatError
+from ..errors import DataError, FormatError
+from ._common import DataWarning
 from .csvfrf import read_csv, write_csv
+from .estimate import (
+    Transmissibility,
+    default_nperseg,
+    estimate_frf,
+    model_transmissibility,
+    save_transmissibility,
+    transmissibility,
+)
 from .frfdata import CHANNELS, UNITS, FRFData
+from .matfile import read_frf_variables, write_frf_variables
+from .recording import Recording, clipped_channels, is_recording, load_recording, save_recording
+from .timesim import simulate_recording
+from .txtfrf import read_txt
+from .uff import read_uff, write_uff
 
-READERS = {".csv": read_csv}
-WRITERS = {".csv": write_csv}
+READERS = {".csv": read_csv, ".uff": read_uff, ".unv": read_uff, ".mat": read_frf_variables,
+           ".npz": read_frf_variables, ".txt": read_txt}
+WRITERS = {".csv": write_csv, ".uff": write_uff, ".unv": write_uff, ".mat": write_frf_variables,
+           ".npz": write_frf_variables}
 
 
 def load_frf(path, **options) -> FRFData:
-    """Load FRFs from a file; the reader is chosen by the suffix."""
+    """Load FRFs from a file; the reader is chosen by the suffix.
+
+    Options go to the reader: ``channel_map`` (UFF), ``freq_axis`` and
+    ``channel`` (.txt). An option the format has no use for is refused.
+    """
     path = Path(path)
     if not path.exists():
         raise FormatError(path, "no such file")
@@ -26,7 +53,16 @@ def load_frf(path, **options) -> FRFData:
     reader = READERS.get(path.suffix.lower())
     if reader is None:
         raise FormatError(path, f"unknown file type {path.suffix!r} (known: {', '.join(sorted(READERS))})")
-    return reader(path, **options)
+    accepted = inspect.signature(reader).parameters
+    for name, value in options.items():
+        if name not in accepted and value is not None:
+            raise FormatError(path, f"option {name} does not apply to {path.suffix} files")
+    try:
+        return reader(path, **{k: v for k, v in options.items() if k in accepted})
+    except FormatError:
+        raise
+    except DataError as exc:  # FRFData's checks, without the file name
+        raise FormatError(path, str(exc)) from None
 
 
 def save_frf(data: FRFData, path, **options) -> Path:
@@ -40,4 +76,9 @@ def save_frf(data: FRFData, path, **options) -> Path:
     return writer(data, path, **options)
 
 
-__all__ = ["FRFData", "CHANNELS", "UNITS", "load_frf", "save_frf", "READERS", "WRITERS"]
+__all__ = [
+    "FRFData", "CHANNELS", "UNITS", "load_frf", "save_frf", "READERS", "WRITERS", "DataWarning",
+    "Recording", "load_recording", "save_recording", "is_recording", "clipped_channels", "estimate_frf",
+    "default_nperseg", "transmissibility", "Transmissibility", "model_transmissibility", "save_transmissibility",
+    "simulate_recording",
+]

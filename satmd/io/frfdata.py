@@ -22,12 +22,15 @@ class FRFData:
     std : dict name -> (n,) float array; standard deviation of the noise on
         each of the real and imaginary parts (SPEC §7); may be empty.
     meta : dict of strings (source, units, comments)
+    coherence : dict name -> (n,) float array in [0, 1]; ordinary coherence
+        of an FRF estimated from time data (may be empty).
     """
 
     freq_hz: np.ndarray
     channels: dict
     std: dict = field(default_factory=dict)
     meta: dict = field(default_factory=dict)
+    coherence: dict = field(default_factory=dict)
 
     def __post_init__(self):
         f = np.asarray(self.freq_hz, dtype=float)
@@ -57,10 +60,21 @@ class FRFData:
             if not np.all(np.isfinite(s)) or np.any(s < 0):
                 raise DataError(f"std of {name} must be finite and >= 0")
             stds[name] = s
+        cohs = {}
+        for name, g in (self.coherence or {}).items():
+            if name not in chans:
+                raise DataError(f"coherence given for channel {name}, which has no data")
+            g = np.asarray(g, dtype=float)
+            if g.shape != f.shape:
+                raise DataError(f"coherence of {name} has shape {g.shape}, frequency grid has {f.shape}")
+            if not np.all(np.isfinite(g)) or np.any(g < 0) or np.any(g > 1):
+                raise DataError(f"coherence of {name} must lie in [0, 1]")
+            cohs[name] = g
         object.__setattr__(self, "freq_hz", f)
         object.__setattr__(self, "channels", chans)
         object.__setattr__(self, "std", stds)
         object.__setattr__(self, "meta", dict(self.meta or {}))
+        object.__setattr__(self, "coherence", cohs)
 
     @property
     def names(self) -> tuple[str, ...]:
@@ -82,7 +96,8 @@ class FRFData:
     def select(self, channels) -> "FRFData":
         chans = {c: self[c] for c in channels}
         std = {c: self.std[c] for c in channels if c in self.std}
-        return FRFData(self.freq_hz, chans, std, self.meta)
+        coh = {c: self.coherence[c] for c in channels if c in self.coherence}
+        return FRFData(self.freq_hz, chans, std, self.meta, coh)
 
     def band(self, lo: float | None = None, hi: float | None = None) -> "FRFData":
         """Only the points with lo <= f <= hi."""
@@ -99,10 +114,11 @@ class FRFData:
             {c: v[keep] for c, v in self.channels.items()},
             {c: s[keep] for c, s in self.std.items()},
             self.meta,
+            {c: g[keep] for c, g in self.coherence.items()},
         )
 
     def with_std(self, std: dict) -> "FRFData":
-        return FRFData(self.freq_hz, self.channels, std, self.meta)
+        return FRFData(self.freq_hz, self.channels, std, self.meta, self.coherence)
 
     @classmethod
     def from_response(cls, response, channels=("a1", "a2"), std=None, meta=None) -> "FRFData":

@@ -249,6 +249,7 @@ def frf(
     wrt: Sequence[str] | None = None,
     outputs: Sequence[str] = CHANNELS,
     threads: int | None = None,
+    validate: bool = True,
 ) -> Response:
     """FRFs of the SATMD for a unit force on the primary mass.
 
@@ -269,13 +270,17 @@ def frf(
     threads : int, optional
         Worker threads for large batches (default: all cores, one for small
         problems).
+    validate : bool
+        Check the rig for impossible values (fitting loops that keep the
+        parameters inside bounds switch this off).
 
     Returns
     -------
     Response
     """
     rig = Rig() if rig is None else rig
-    rig.validate()
+    if validate:
+        rig.validate()
     freq = np.asarray(freq_hz, dtype=float)
     if freq.ndim != 1:
         raise ValueError(f"freq_hz must be 1-D, got shape {freq.shape}")

@@ -1,0 +1,112 @@
+"""satmd estimate-frf: FRFs (or transmissibilities) with coherence and std from a time recording."""
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from ..errors import SatmdError
+from ._common import add_rig_options, one_line_warnings, parse_band, parse_kv, rig_from_args
+
+
+def register(sub):
+    p = sub.add_parser("estimate-frf", help="FRFs with coherence and std from a force/acceleration recording",
+                       description="Welch-averaged H1/H2 FRFs A1 = acc1/force, A2 = acc2/force with coherence and "
+                                   "the coherence-based std of Bendat & Piersol (written as std columns). A "
+                                   "recording without force (output-only) gives the transmissibility A2/A1.")
+    p.add_argument("recording", metavar="REC", help="time recording (.csv time_s,force,acc1,acc2; .uff; .wav; "
+                                                    ".npz; .mat)")
+    p.add_argument("-o", "--out", required=True, metavar="FRF.csv",
+                   help="output: FRFs as .csv, .uff, .npz or .mat (coherence kept except in .csv); "
+                        "a transmissibility as .csv")
+    p.add_argument("--nperseg", type=int, default=None, metavar="N",
+                   help="samples per segment (default: ≈0.5 Hz resolution, at least 16 averages)")
+    p.add_argument("--window", default="hann", help="window (any scipy.signal.get_window name; default hann)")
+    p.add_argument("--overlap", type=float, default=0.5, help="segment overlap fraction (default 0.5)")
+    p.add_argument("--estimator", default="H1", choices=("H1", "H2"), help="H1: noise on the responses (default); "
+                                                                          "H2: noise on the force")
+    p.add_argument("--band", default=None, metavar="LO:HI", help="keep only LO <= f <= HI Hz")
+    p.add_argument("--map", default=None, metavar="force=#1,a1=NODE:DIR,a2=#3",
+                   help="which UFF records / WAV channels are force, a1 and a2")
+    p.add_argument("--scale", default=None, metavar="force=K,acc1=K,...",
+                   help="calibration of WAV channels: SI units per stored unit")
+    p.add_argument("--plot", default=None, metavar="FIG.png", help="plot magnitude, phase and coherence")
+    g = p.add_argument_group("model overlay for transmissibility plots")
+    add_rig_options(g)
+    p.set_defaults(func=run)
+
+
+def run(args):
+    from ..io import estimate_frf, load_recording, save_frf, save_transmissibility, transmissibility
+
+    scale = parse_kv(args.scale, "--scale") if args.scale else None
+    band = parse_band(args.band)
+    out = Path(args.out)
+    with one_line_warnings("estimate-frf"):
+        rec = load_recording(args.recording, channel_map=args.map, scale=scale)
+        options = dict(nperseg=args.nperseg, window=args.window, overlap=args.overlap,
+                       estimator=args.estimator, band=band)
+        if rec.has_force:
+            data = estimate_frf(rec, **options)
+            save_frf(data, out)
+            kind = f"FRFs {', '.join(data.channels)}"
+            freq, coh = data.freq_hz, data.coherence
+            curves = {ch: (data[ch], data.std[ch], None) for ch in data.channels}
+        else:
+            if not {"acc1", "acc2"} <= set(rec.channels):
+                raise SatmdError(f"{args.recording}: no force channel, and not both acc1 and acc2 for a "
+                                 f"transmissibility (channels: {', '.join(rec.channels)}); choose them with "
+                                 f"--map a1=#N,a2=#M")
+            if out.suffix.lower() != ".csv":
+                raise SatmdError(f"{out}: a transmissibility is written as .csv")
+            t = transmissibility(rec, **options)
+            save_transmissibility(t, out)
+            kind = "transmissibility A2/A1 (output-only recording)"
+            freq, coh = t.freq_hz, {"T": t.coherence}
+            curves = {"T": (t.value, t.std, t.model(rig_from_args(args)))}
+            data = t
+    m = data.meta
+    print(f"wrote {out}: {kind}, {len(freq)} points {freq[0]:.6g}..{freq[-1]:.6g} Hz, {m['estimator']}, "
+          f"nperseg={m['nperseg']} ({m['resolution_hz']} Hz), {m['segments']} averages, "
+          f"median coherence {np.median(np.concatenate(list(coh.values()))):.3f}")
+    if args.plot:
+        plot_estimate(freq, curves, coh, args.plot, title=f"{Path(args.recording).name}: {kind}")
+        print(f"plot: {args.plot}")
+    return 0
+
+
+LABELS = {"a1": "A1 = acc1/force", "a2": "A2 = acc2/force", "T": "T = A2/A1"}
+
+
+def plot_estimate(freq, curves, coherence, path, title=""):
+    """|H| with ±2σ, phase and coherence for each curve; a model overlay where given."""
+    from ..plots import _plt, save
+
+    plt = _plt()
+    names = list(curves)
+    fig, axes = plt.subplots(3, len(names), figsize=(4.4 * len(names), 7.5), squeeze=False, sharex=True)
+    for j, name in enumerate(names):
+        h, std, model = curves[name]
+        mag = np.abs(h)
+        ax = axes[0, j]
+        ax.semilogy(freq, mag, color="k", lw=0.8, label="estimate")
+        ax.fill_between(freq, np.maximum(mag - 2 * std, mag * 1e-3), mag + 2 * std, color="0.6", alpha=0.4, lw=0,
+                        label="±2σ")
+        if model is not None:
+            ax.semilogy(freq, np.abs(model), color="tab:blue", lw=1.0, label="model (nominal rig)")
+            axes[1, j].plot(freq, np.degrees(np.angle(model)), color="tab:blue", lw=1.0)
+        ax.set_title(LABELS.get(name, name))
+        ax.set_ylabel("magnitude")
+        ax.legend(fontsize=8)
+        axes[1, j].plot(freq, np.degrees(np.angle(h)), color="k", lw=0.8)
+        axes[1, j].set_ylabel("phase [deg]")
+        axes[2, j].plot(freq, coherence[name], color="tab:green", lw=0.8)
+        axes[2, j].set_ylim(0, 1.05)
+        axes[2, j].set_ylabel("coherence γ²")
+        axes[2, j].set_xlabel("frequency [Hz]")
+        for ax in axes[:, j]:
+            ax.grid(True, which="both", alpha=0.3)
+    if title:
+        fig.suptitle(title)
+    fig.tight_layout()
+    return save(fig, path)

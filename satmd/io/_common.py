@@ -1,0 +1,153 @@
+"""Helpers shared by the file readers: warnings, raw reads, unit labels, channel maps."""
+from __future__ import annotations
+
+import re
+import warnings
+from pathlib import Path
+
+from ..errors import FormatError
+
+G0 = 9.80665  # standard gravity, for accelerations in g
+
+
+class DataWarning(UserWarning):
+    """Something in a file is suspicious but usable (clipping, dropped points, unknown units).
+
+    The CLI prints these as one line each; library users can filter them with
+    ``warnings.simplefilter("error", DataWarning)``.
+    """
+
+
+def warn(path, message: str):
+    warnings.warn(f"{path}: {message}", DataWarning, stacklevel=3)
+
+
+def read_bytes(path) -> bytes:
+    """The whole file, refusing missing, unreadable and empty files with a one-line FormatError."""
+    path = Path(path)
+    try:
+        raw = path.read_bytes()
+    except IsADirectoryError:
+        raise FormatError(path, "is a directory, not a file") from None
+    except OSError as exc:
+        raise FormatError(path, f"cannot read file ({exc.strerror or exc})") from None
+    if not raw.strip():
+        raise FormatError(path, "empty file")
+    return raw
+
+
+def decode_text(path, raw: bytes) -> str:
+    """UTF-8 text (BOM allowed); binary content is refused naming the first bad line."""
+    try:
+        text = raw.decode("utf-8-sig")
+    except UnicodeDecodeError as exc:
+        line = raw[: exc.start].count(b"\n") + 1
+        raise FormatError(path, "not a text file (invalid UTF-8)", line=line) from None
+    if "\x00" in text:
+        raise FormatError(path, "not a text file (contains NUL bytes)", line=text[: text.index("\x00")].count("\n") + 1)
+    return text
+
+
+# --- units -------------------------------------------------------------------
+# A physical quantity is described by its "power": 0 displacement, 1 velocity,
+# 2 acceleration (time derivatives of a length), or "force". Unit labels are
+# turned into (quantity, factor to SI).
+_LENGTHS = {"m": 1.0, "mm": 1e-3, "cm": 1e-2, "um": 1e-6, "µm": 1e-6, "μm": 1e-6, "nm": 1e-9,
+            "in": 0.0254, "ft": 0.3048}
+_FORCES = {"N": 1.0, "kN": 1e3, "mN": 1e-3, "lbf": 4.4482216152605, "lb": 4.4482216152605}
+_CHARGES = {"C": 1.0, "mC": 1e-3, "uC": 1e-6, "µC": 1e-6, "nC": 1e-9, "pC": 1e-12}
+_LENGTH_RE = re.compile(r"^(?P<len>[a-zµμ]+)(?:/s(?P<pow>2)?)?$")
+
+
+def _normalise(label: str) -> str:
+    s = label.strip().replace(" ", "").replace("²", "2").replace("^", "").replace("**", "")
+    s = s.replace("sec", "s")
+    if s.startswith("(") and s.endswith(")") and s.count("(") == 1:
+        s = s[1:-1]
+    return s
+
+
+def parse_quantity_unit(label: str | None):
+    """'m/s^2' -> (2, 1.0), 'g' -> (2, 9.80665), 'mm' -> (0, 1e-3), 'kN' -> ('force', 1e3).
+
+    Returns None for an absent label (None, '', 'NONE') and raises ValueError
+    for a label it does not know.
+    """
+    if label is None or label.strip().upper() in ("", "NONE"):
+        return None
+    s = _normalise(label)
+    if s in _FORCES:
+        return "force", _FORCES[s]
+    if s in _CHARGES:
+        return "charge", _CHARGES[s]
+    if s.lower() in ("g", "gn"):
+        return 2, G0
+    m = _LENGTH_RE.match(s)
+    if m and m["len"] in _LENGTHS:
+        power = 0 if "/s" not in s else (2 if m["pow"] else 1)
+        return power, _LENGTHS[m["len"]]
+    raise ValueError(f"unknown unit {label!r}")
+
+
+def parse_frf_unit(label: str | None):
+    """'(m/s^2)/N' or 'g/N' -> (power, factor to SI per newton); None if absent."""
+    if label is None or label.strip().upper() in ("", "NONE"):
+        return None
+    s = _normalise(label)
+    num, sep, den = s.rpartition("/")
+    if not sep or den not in _FORCES:
+        raise ValueError(f"unknown FRF unit {label!r}")
+    q = parse_quantity_unit(num)
+    if q is None or q[0] == "force":
+        raise ValueError(f"unknown FRF unit {label!r}")
+    return q[0], q[1] / _FORCES[den]
+
+
+# --- channel maps ---------------------------------------------------------------
+_DIRS = {"x": 1, "y": 2, "z": 3, "rx": 4, "ry": 5, "rz": 6}
+
+
+def parse_dof(text: str):
+    """'12:3', '12:+Z', '12:-x' -> ('dof', 12, 3); '#4' -> ('index', 4, None)."""
+    t = text.strip()
+    if t.startswith("#"):
+        if not t[1:].isdigit() or int(t[1:]) < 1:
+            raise ValueError(f"{text!r}: a record number is #1, #2, ...")
+        return "index", int(t[1:]), None
+    node, sep, d = t.partition(":")
+    if not sep:
+        raise ValueError(f"{text!r}: expected NODE:DIR (e.g. 3:+Z or 3:3) or #RECORD")
+    try:
+        node = int(node)
+    except ValueError:
+        raise ValueError(f"{text!r}: node {node!r} is not an integer") from None
+    d = d.strip()
+    sign = -1 if d.startswith("-") else 1
+    body = d.lstrip("+-").lower()
+    if body.isdigit() and 0 <= int(body) <= 6:
+        direction = sign * int(body)
+    elif body in _DIRS:
+        direction = sign * _DIRS[body]
+    else:
+        raise ValueError(f"{text!r}: direction {d!r} is not 0..6 or ±X/Y/Z/RX/RY/RZ")
+    return "dof", node, direction
+
+
+def parse_channel_map(spec, allowed, aliases=None) -> dict:
+    """'a1=1:3,a2=#2' (or a dict) -> {'a1': ('dof', 1, 3), 'a2': ('index', 2, None)}."""
+    aliases = aliases or {}
+    items = spec.items() if isinstance(spec, dict) else (
+        part.partition("=")[::2] for part in str(spec).split(",") if part.strip())
+    out = {}
+    for key, value in items:
+        key = aliases.get(key.strip(), key.strip())
+        if key not in allowed:
+            raise ValueError(f"channel map: unknown channel {key!r} (use {', '.join(allowed)})")
+        if not str(value).strip():
+            raise ValueError(f"channel map: {key}= needs NODE:DIR or #RECORD")
+        if key in out:
+            raise ValueError(f"channel map: {key} given twice")
+        out[key] = parse_dof(str(value))
+    if not out:
+        raise ValueError("channel map is empty")
+    return out
