@@ -20,11 +20,23 @@ from .physics import (
     frf,
 )
 from .simulate import simulate
+from .identify import FitResult, identify, identify_many  # noqa: E402  (binds the functions over the subpackages)
+from .discover import DiscoveryReport, discover  # noqa: E402
 
 __version__ = "0.1.0"
+
+
+def __getattr__(name):
+    # torch is optional: the inverse model loads on first use, so `import satmd` works without it
+    if name == "InverseModel":
+        from .inverse import InverseModel
+
+        return InverseModel
+    raise AttributeError(f"module 'satmd' has no attribute {name!r}")
 
 __all__ = [
     "Rig", "frf", "effect", "Effect", "FRFData", "load_frf", "save_frf", "simulate", "PAPER_GRID_HZ",
     "SensorGain", "TimeDelay", "StructuralDamping", "DielectricLoss", "ShuntCapacitance", "ExtraMode",
-    "ParameterOffset", "SatmdError", "DataError", "FormatError",
+    "ParameterOffset", "SatmdError", "DataError", "FormatError", "identify", "identify_many", "FitResult",
+    "discover", "DiscoveryReport", "InverseModel",
 ]
