@@ -41,7 +41,8 @@ class Search:
     base_free: tuple
     channels: tuple
     candidates: tuple
-    cache: dict = field(default_factory=dict)  # frozenset(names) -> Model
+    cache: dict = field(default_factory=dict)  # frozenset(names) -> best Model found for that set
+    tried: set = field(default_factory=set)  # (parent names, added name) already fitted
     log: list = field(default_factory=list)
 
     def free_names(self, effects):
@@ -54,8 +55,10 @@ class Search:
     def add(self, model: Model, name: str) -> Model:
         """Best fit of ``model`` plus effect ``name`` (screened starts, then least squares)."""
         key = frozenset(model.names + (name,))
-        if key in self.cache:
+        tried = (frozenset(model.names), name)  # another parent may lead to a better basin of the same set
+        if tried in self.tried:
             return self.cache[key]
+        self.tried.add(tried)
         new = neutral_effect(name, self.rig)
         effects = list(model.effects) + [new]
         problem = Problem(self.data, self.rig, self.free_names(effects), self.channels, effects)
@@ -142,22 +145,38 @@ def _distinct_best(thetas, cost, names, effect, k):
     return picked
 
 
-def select(search: Search, nominal: Model, still_significant, max_effects: int = 3):
-    """Greedy forward selection with backward elimination and swaps.
+def select(search: Search, nominal: Model, still_significant, max_effects: int = 3, beam: int = 3):
+    """Beam search over effect sets, then backward elimination and swaps.
 
-    ``still_significant(fit)`` is the calibrated mismatch test. Returns the
-    chosen Model and, per chosen effect, a list of (equivalent name, ΔBIC).
+    A model may grow by one effect only while it still fails the calibrated
+    mismatch test (``still_significant(fit)``) and only when the new effect
+    lowers BIC by more than MIN_DELTA_BIC. The ``beam`` best models of each
+    size are expanded, so a first effect that fits well alone but wrongly
+    (a broad fake mode standing in for damping, say) cannot block the right
+    pair. The answer is the lowest-BIC model reached this way.
     """
-    current = nominal
-    while len(current.names) < max_effects and still_significant(current.fit):
-        trials = [search.add(current, c) for c in search.candidates if c not in current.names]
-        best = min(trials, key=lambda m: m.bic)
-        if current.bic - best.bic <= MIN_DELTA_BIC:
+    layer, reached = [nominal], [nominal]
+    for _ in range(max_effects):
+        grown = {}
+        for parent in layer:
+            if not still_significant(parent.fit):
+                continue
+            for c in search.candidates:
+                if c in parent.names:
+                    continue
+                child = search.add(parent, c)
+                if parent.bic - child.bic > MIN_DELTA_BIC:
+                    key = frozenset(child.names)
+                    if key not in grown or child.bic < grown[key].bic:
+                        grown[key] = child
+        if not grown:
             break
-        current = best
-        current = _backward(search, current, nominal)
-        current = _swaps(search, current, nominal)
-    return current
+        layer = sorted(grown.values(), key=lambda m: m.bic)[:beam]
+        reached += layer
+    best = min(reached, key=lambda m: m.bic)
+    if best.names:
+        best = _swaps(search, _backward(search, best, nominal), nominal)
+    return best
 
 
 def _backward(search, model, nominal):
