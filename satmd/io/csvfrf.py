@@ -41,8 +41,8 @@ def read_csv(path) -> FRFData:
             if body.lower().startswith("satmd-frf"):
                 if body.split()[1:] != ["v1"]:
                     raise FormatError(path, f"unsupported format version {body!r} (this reader knows satmd-frf v1)", line=lineno)
-            elif ":" in body and header is None:
-                key, _, value = body.partition(":")
+            elif ": " in body and header is None:  # "# key: value"; keys may contain ':' themselves
+                key, _, value = body.partition(": ")
                 meta[key.strip()] = value.strip()
             continue
         cells = [c.strip() for c in stripped.split(",")]
@@ -78,7 +78,9 @@ def read_csv(path) -> FRFData:
                               line=lineno, column="1 (freq_hz)")
     chans, std = {}, {}
     for ch, cols in columns.items():
-        chans[ch] = values[:, cols["re"]] + 1j * values[:, cols["im"]]
+        z = np.empty(len(rows), dtype=complex)  # not re + 1j*im, which turns a real part of -0.0 into +0.0
+        z.real, z.imag = values[:, cols["re"]], values[:, cols["im"]]
+        chans[ch] = z
         if "std" in cols:
             s = values[:, cols["std"]]
             bad = np.flatnonzero(s < 0)

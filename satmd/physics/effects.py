@@ -178,6 +178,16 @@ class StructuralDamping(Effect):
 
 
 class DielectricLoss(Effect):
+    """SPEC §8 form: Cp -> Cp (1 - i tanδ) in Z13, Z23 and Z33 (where Cp appears).
+
+    Kept exactly as the SPEC defines it (measured data and the shared
+    acceptance files use this form). Note that it is not strictly passive:
+    Im(Z) gets an indefinite block, and for large tanδ (≳ 0.5) the input
+    power can turn negative near the first resonance (tests/physics record
+    this). A passive variant would also add e²(1/Cp' - 1/Cp) to the
+    mechanical block.
+    """
+
     name = "dielectric_loss"
     parameter_names = ("tan_delta",)
     defaults = {"tan_delta": 0.0}

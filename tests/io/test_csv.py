@@ -12,7 +12,15 @@ from satmd.errors import FormatError
 from satmd.io import CHANNELS, FRFData, load_frf, save_frf
 from satmd.io.csvfrf import read_csv, write_csv
 
-finite = st.floats(allow_nan=False, allow_infinity=False)
+# every finite double, subnormals included; -0.0 is mapped to +0.0 here (signed zeros: see below)
+finite = st.floats(allow_nan=False, allow_infinity=False).map(lambda x: x + 0.0)
+
+
+def _complex(re, im):
+    """Complex array with exactly these real and imaginary bits (re + 1j*im can lose a -0.0)."""
+    z = np.empty(len(re), dtype=complex)
+    z.real, z.imag = re, im
+    return z
 
 
 def _bits_equal(a, b):
@@ -36,8 +44,8 @@ def frf_data(draw):
     n = draw(st.integers(1, 12))
     freq = np.array(sorted(draw(st.lists(st.floats(1e-3, 1e6), min_size=n, max_size=n, unique=True))))
     names = draw(st.lists(st.sampled_from(CHANNELS), min_size=1, max_size=5, unique=True))
-    chans = {c: np.array(draw(st.lists(finite, min_size=n, max_size=n)))
-             + 1j * np.array(draw(st.lists(finite, min_size=n, max_size=n))) for c in names}
+    chans = {c: _complex(draw(st.lists(finite, min_size=n, max_size=n)), draw(st.lists(finite, min_size=n, max_size=n)))
+             for c in names}
     with_std = draw(st.lists(st.sampled_from(names), unique=True))  # none, some or all channels
     std = {c: np.array(draw(st.lists(st.floats(0, 1e300), min_size=n, max_size=n))) for c in with_std}
     return FRFData(freq, chans, std)
@@ -56,8 +64,9 @@ def test_round_trip_all_five_channels_with_and_without_std(tmp_path):
     freq = np.linspace(40.0, 130.0, 60)
     chans = {c: rng.standard_normal(60) * 10.0 ** rng.uniform(-12, 3, 60)
              + 1j * rng.standard_normal(60) * 10.0 ** rng.uniform(-12, 3, 60) for c in CHANNELS}
-    chans["a1"][3] = -0.0 + 0.0j
-    chans["a2"][5] = 5e-324 - 1j * 1.7976931348623157e308  # subnormal and the largest double
+    chans["a1"][3] = 0.0
+    chans["a2"][5] = complex(5e-324, -1.7976931348623157e308)  # subnormal and the largest double
+    chans["u1"][7] = complex(2.2250738585072014e-308, -4.9406564584124654e-324)
     std = {c: np.abs(chans[c]) * 1e-3 for c in CHANNELS}
     for s in (std, {}):
         data = FRFData(freq, chans, s, {"note": "round trip"})
@@ -72,6 +81,14 @@ def test_round_trip_all_five_channels_with_and_without_std(tmp_path):
     header = next(line for line in text if not line.startswith("#"))
     assert header.startswith("freq_hz,")
     assert {f"{c}_{p}" for c in CHANNELS for p in ("re", "im", "std")} == set(header.split(",")[1:])
+
+
+def test_round_trip_keeps_signed_zeros(tmp_path):
+    data = FRFData([40.0, 50.0, 60.0], {"a1": _complex([-0.0, 0.0, -0.0], [0.0, -0.0, -0.0])})
+    path = tmp_path / "zeros.csv"
+    save_frf(data, path)
+    assert path.read_text().splitlines()[-3:] == ["40,-0,0", "50,0,-0", "60,-0,-0"]  # the writer keeps them
+    _assert_same(load_frf(path), data)
 
 
 def test_reader_accepts_comments_blank_lines_and_any_column_order(tmp_path):
@@ -208,3 +225,11 @@ def test_writer_replaces_atomically(tmp_path):
     write_csv(b, path)
     _assert_same(read_csv(path), b)
     assert [p.name for p in tmp_path.iterdir()] == ["out.csv"]  # no temporary left behind
+
+
+def test_metadata_keys_with_colons_survive(tmp_path):
+    data = FRFData([40.0, 50.0], {"a1": np.array([1 + 1j, 2 - 1j])},
+                   meta={"effect parameter_offset:k1": "value=200000"})
+    path = tmp_path / "meta.csv"
+    save_frf(data, path)
+    assert load_frf(path).meta["effect parameter_offset:k1"] == "value=200000"
