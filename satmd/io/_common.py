@@ -1,6 +1,10 @@
 """Helpers shared by the file readers: warnings, raw reads, unit labels, channel maps."""
 from __future__ import annotations
 
+import math
+
+import numpy as np
+
 import re
 import warnings
 from pathlib import Path
@@ -151,3 +155,50 @@ def parse_channel_map(spec, allowed, aliases=None) -> dict:
     if not out:
         raise ValueError("channel map is empty")
     return out
+
+
+def split_csv(path, text: str, magic: str):
+    """Comment lines, one header row, then data rows of a satmd CSV.
+
+    ``# <magic> vN`` lines check the version (v1 only); ``# key: value``
+    comments before the header become metadata (keys may contain ':').
+    Returns (header cells, header line number, [(line number, cells)], meta).
+    """
+    header, header_line, rows, meta = None, None, [], {}
+    for lineno, line in enumerate(text.splitlines(), start=1):
+        stripped = line.strip()
+        if not stripped:
+            continue
+        if stripped.startswith("#"):
+            body = stripped[1:].strip()
+            if body.lower().startswith(magic):
+                if body.split()[1:] != ["v1"]:
+                    raise FormatError(path, f"unsupported format version {body!r} (this reader knows {magic} v1)",
+                                      line=lineno)
+            elif ": " in body and header is None:
+                key, _, value = body.partition(": ")
+                meta[key.strip()] = value.strip()
+            continue
+        cells = [c.strip() for c in stripped.split(",")]
+        if header is None:
+            header, header_line = cells, lineno
+        else:
+            rows.append((lineno, cells))
+    return header, header_line, rows, meta
+
+
+def numeric_table(path, header, rows) -> np.ndarray:
+    """Rows of finite numbers, one per header column; any bad cell names line and column."""
+    values = np.empty((len(rows), len(header)))
+    for i, (lineno, cells) in enumerate(rows):
+        if len(cells) != len(header):
+            raise FormatError(path, f"{len(cells)} fields, header has {len(header)}", line=lineno)
+        for j, cell in enumerate(cells):
+            try:
+                x = float(cell)
+            except ValueError:
+                raise FormatError(path, f"not a number: {cell!r}", line=lineno, column=f"{j + 1} ({header[j]})") from None
+            if not math.isfinite(x):
+                raise FormatError(path, f"{cell} is not a finite number", line=lineno, column=f"{j + 1} ({header[j]})")
+            values[i, j] = x
+    return values

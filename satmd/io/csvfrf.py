@@ -1,13 +1,13 @@
 """The `satmd-frf v1` CSV format (SPEC §7): strict reader, exact writer."""
 from __future__ import annotations
 
-import math
 import os
 from pathlib import Path
 
 import numpy as np
 
 from ..errors import FormatError
+from ._common import decode_text, numeric_table, read_bytes, split_csv
 from .frfdata import CHANNELS, FRFData
 
 MAGIC = "# satmd-frf v1"
@@ -17,57 +17,14 @@ _SUFFIXES = ("re", "im", "std")
 def read_csv(path) -> FRFData:
     """Read a SPEC §7 file; any malformation raises FormatError (file, line, column)."""
     path = Path(path)
-    try:
-        raw = path.read_bytes()
-    except OSError as exc:
-        raise FormatError(path, f"cannot read file ({exc.strerror or exc})") from None
-    if not raw.strip():
-        raise FormatError(path, "empty file")
-    try:
-        text = raw.decode("utf-8-sig")
-    except UnicodeDecodeError as exc:
-        line = raw[: exc.start].count(b"\n") + 1
-        raise FormatError(path, "not a text file (invalid UTF-8)", line=line) from None
-    if "\x00" in text:
-        raise FormatError(path, "not a text file (contains NUL bytes)")
-
-    meta, header, header_line, rows = {}, None, None, []
-    for lineno, line in enumerate(text.splitlines(), start=1):
-        stripped = line.strip()
-        if not stripped:
-            continue
-        if stripped.startswith("#"):
-            body = stripped[1:].strip()
-            if body.lower().startswith("satmd-frf"):
-                if body.split()[1:] != ["v1"]:
-                    raise FormatError(path, f"unsupported format version {body!r} (this reader knows satmd-frf v1)", line=lineno)
-            elif ": " in body and header is None:  # "# key: value"; keys may contain ':' themselves
-                key, _, value = body.partition(": ")
-                meta[key.strip()] = value.strip()
-            continue
-        cells = [c.strip() for c in stripped.split(",")]
-        if header is None:
-            header, header_line = cells, lineno
-            columns = _parse_header(path, header, lineno)
-            continue
-        rows.append((lineno, cells))
+    text = decode_text(path, read_bytes(path))
+    header, header_line, rows, meta = split_csv(path, text, "satmd-frf")
     if header is None:
         raise FormatError(path, "no column header (expected freq_hz,a1_re,a1_im,...)")
+    columns = _parse_header(path, header, header_line)
     if not rows:
         raise FormatError(path, "no data rows after the header", line=header_line)
-
-    values = np.empty((len(rows), len(header)))
-    for i, (lineno, cells) in enumerate(rows):
-        if len(cells) != len(header):
-            raise FormatError(path, f"{len(cells)} fields, header has {len(header)}", line=lineno)
-        for j, cell in enumerate(cells):
-            try:
-                x = float(cell)
-            except ValueError:
-                raise FormatError(path, f"not a number: {cell!r}", line=lineno, column=f"{j + 1} ({header[j]})") from None
-            if not math.isfinite(x):
-                raise FormatError(path, f"{cell} is not a finite number", line=lineno, column=f"{j + 1} ({header[j]})")
-            values[i, j] = x
+    values = numeric_table(path, header, rows)
 
     freq = values[:, 0]
     for i, (lineno, _) in enumerate(rows):

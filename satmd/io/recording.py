@@ -35,7 +35,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import DataError, FormatError
-from ._common import decode_text, parse_channel_map, parse_quantity_unit, read_bytes, warn
+from ._common import decode_text, numeric_table, parse_channel_map, parse_quantity_unit, read_bytes, split_csv, warn
 
 ROLES = ("force", "acc1", "acc2")
 SI_UNITS = {"force": "N", "acc1": "m/s^2", "acc2": "m/s^2"}
@@ -154,42 +154,13 @@ def read_recording_csv(path) -> Recording:
     """A ``time_s,force,acc1,acc2`` CSV (SI units); malformed input names file, line and column."""
     path = Path(path)
     text = decode_text(path, read_bytes(path))
-    header, rows, meta = None, [], {}
-    for lineno, line in enumerate(text.splitlines(), start=1):
-        s = line.strip()
-        if not s:
-            continue
-        if s.startswith("#"):
-            body = s[1:].strip()
-            if body.lower().startswith("satmd-recording") and body.split()[1:] != ["v1"]:
-                raise FormatError(path, f"unsupported format version {body!r}", line=lineno)
-            if ":" in body and header is None and not body.lower().startswith("satmd-"):
-                key, _, value = body.partition(":")
-                meta[key.strip()] = value.strip()
-            continue
-        cells = [c.strip() for c in s.split(",")]
-        if header is None:
-            header, header_line = cells, lineno
-            _check_header(path, header, lineno)
-            continue
-        rows.append((lineno, cells))
+    header, header_line, rows, meta = split_csv(path, text, "satmd-recording")
     if header is None:
         raise FormatError(path, "no column header (expected time_s,force,acc1,acc2)")
+    _check_header(path, header, header_line)
     if len(rows) < 2:
         raise FormatError(path, f"{len(rows)} data row(s): a recording needs at least 2 samples", line=header_line)
-    values = np.empty((len(rows), len(header)))
-    for i, (lineno, cells) in enumerate(rows):
-        if len(cells) != len(header):
-            raise FormatError(path, f"{len(cells)} fields, header has {len(header)}", line=lineno)
-        for j, cell in enumerate(cells):
-            try:
-                x = float(cell)
-            except ValueError:
-                raise FormatError(path, f"not a number: {cell!r}", line=lineno,
-                                  column=f"{j + 1} ({header[j]})") from None
-            if not math.isfinite(x):
-                raise FormatError(path, f"{cell} is not a finite number", line=lineno, column=f"{j + 1} ({header[j]})")
-            values[i, j] = x
+    values = numeric_table(path, header, rows)
     fs = _uniform_rate(path, values[:, 0], [ln for ln, _ in rows])
     channels = {name: values[:, j] for j, name in enumerate(header) if j}
     meta.update({"source": str(path), "format": "csv"})
