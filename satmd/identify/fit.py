@@ -141,21 +141,22 @@ def _local_fit(problem: Problem, theta0, nominal, reg, max_nfev, tol):
             J = np.vstack([J, sqrt_reg * np.eye(x.size)])
         return r, J
 
-    cache = {}
-
-    def fun(x):
-        key = x.tobytes()
-        if key not in cache:
-            cache.clear()
-            cache[key] = fun_jac(x)
-        return cache[key][0]
-
-    def jac(x):
-        key = x.tobytes()
-        if key not in cache:
-            cache.clear()
-            cache[key] = fun_jac(x)
-        return cache[key][1]
-
+    fun, jac = _split(fun_jac)
     return least_squares(fun, x0, jac=jac, bounds=(lo, hi), method="trf", x_scale="jac",
                          ftol=tol, xtol=tol, gtol=tol, max_nfev=max_nfev)
+
+
+def _split(fun_jac):
+    """fun(x) and jac(x) sharing one evaluation of fun_jac(x): least_squares asks for both at each x."""
+    last = {}
+
+    def part(i):
+        def f(x):
+            key = x.tobytes()
+            if key not in last:
+                last.clear()
+                last[key] = fun_jac(x)
+            return last[key][i]
+        return f
+
+    return part(0), part(1)
