@@ -153,7 +153,8 @@ def select(search: Search, nominal: Model, still_significant, max_effects: int =
     lowers BIC by more than MIN_DELTA_BIC. The ``beam`` best models of each
     size are expanded, so a first effect that fits well alone but wrongly
     (a broad fake mode standing in for damping, say) cannot block the right
-    pair. The answer is the lowest-BIC model reached this way.
+    pair. The answer is the model with the fewest effects among those reached
+    within MIN_DELTA_BIC of the lowest BIC.
     """
     layer, reached = [nominal], [nominal]
     for _ in range(max_effects):
@@ -173,7 +174,9 @@ def select(search: Search, nominal: Model, still_significant, max_effects: int =
             break
         layer = sorted(grown.values(), key=lambda m: m.bic)[:beam]
         reached += layer
-    best = min(reached, key=lambda m: m.bic)
+    # parsimony: models within MIN_DELTA_BIC of the best explain the data as well; take the fewest effects
+    lowest = min(m.bic for m in reached)
+    best = min((m for m in reached if m.bic - lowest < MIN_DELTA_BIC), key=lambda m: (len(m.names), m.bic))
     if best.names:
         best = _swaps(search, _backward(search, best, nominal), nominal)
     return best
