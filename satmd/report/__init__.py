@@ -23,6 +23,7 @@ class Context:
     out: Path
     quick: bool = False
     results: dict = field(default_factory=dict)  # numbers a section wants kept in results.json
+    shared: dict = field(default_factory=dict)  # objects later sections may reuse (e.g. a trained net)
 
     @property
     def fig_dir(self) -> Path:

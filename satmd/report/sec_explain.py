@@ -23,6 +23,9 @@ def _model(ctx):
     except ImportError as exc:
         return None, f"The neural analyses are skipped: the inverse package is not available ({exc})."
     torch.set_num_threads(1)
+    shared = ctx.shared.get("physics_paper_model")
+    if shared is not None:  # trained by the use case II section of this same run
+        return shared, "The physics net of the use case II section above (same run)."
     cache = os.environ.get(MODEL_ENV)
     if cache and (Path(cache) / "model.json").is_file():
         model = InverseModel.load(cache)
