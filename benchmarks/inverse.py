@@ -38,12 +38,17 @@ def main(argv=None):
     ap.add_argument("--noises", default="0,0.005,0.01,0.02")
     ap.add_argument("--presets", default="paper,box")
     ap.add_argument("--out", default=str(RESULTS / "inverse.json"))
+    ap.add_argument("--render", action="store_true", help="only rewrite inverse.md from an existing inverse.json")
     args = ap.parse_args(argv)
+    out = Path(args.out)
+    if args.render:
+        res = json.loads(out.read_text(encoding="utf-8"))
+        write_markdown(res, out)
+        return
 
     import torch
 
-    from satmd.inverse.ablation import (ablation_markdown, headline, off_curve_markdown, run_ablation,
-                                        table2_markdown)
+    from satmd.inverse.ablation import run_ablation
 
     torch.set_num_threads(args.threads)
     noises = tuple(float(x) for x in args.noises.split(","))
@@ -53,9 +58,14 @@ def main(argv=None):
                        log=lambda m: print(m, file=sys.stderr, flush=True))
     res["benchmark_wall_s"] = time.perf_counter() - t0
     res["date"] = time.strftime("%Y-%m-%d %H:%M:%S")
-    out = Path(args.out)
     out.parent.mkdir(parents=True, exist_ok=True)
     out.write_text(json.dumps(res, indent=1, default=float), encoding="utf-8")
+    write_markdown(res, out)
+
+
+def write_markdown(res, out: Path):
+    from satmd.inverse.ablation import ablation_markdown, headline, off_curve_markdown, table2_markdown
+
     md = ["## Table 2 (six blind pairs, noise-free)", "", table2_markdown(res), "",
           "## Ablation (blind pairs + neighbours, noise at the training level)", "", ablation_markdown(res), "",
           "## Off-curve check (noise-free)", "", off_curve_markdown(res), ""]
@@ -66,8 +76,9 @@ def main(argv=None):
                f"L {p['table2']['mae_L']:.3g} H.", ""]
     if "speedup" in res:
         s = res["speedup"]
-        md += [f"Physics epoch ({s['n_train']} samples, {s['n_members']} members): vectorised {s['vectorised_epoch_s']:.2f} s, "
-               f"per-sample loop {s['per_sample_epoch_s']:.1f} s: x{s['speedup']:.0f}.", ""]
+        md += [f"Physics epoch ({s['n_train']} samples, {s['n_members']} members): "
+               f"vectorised {s['vectorised_epoch_s']:.2f} s, per-sample loop {s['per_sample_epoch_s']:.1f} s: "
+               f"x{s['speedup']:.0f}.", ""]
     out.with_suffix(".md").write_text("\n".join(md), encoding="utf-8")
     print(headline(res))
 

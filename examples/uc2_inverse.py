@@ -15,8 +15,6 @@ from __future__ import annotations
 
 import sys
 
-import numpy as np
-
 
 def main(quick: bool = False) -> int:
     import torch
@@ -26,7 +24,9 @@ def main(quick: bool = False) -> int:
     from satmd.inverse.ablation import _as_hybrid
 
     torch.set_num_threads(1)  # the machines this runs on are small and shared
-    kw = {"epochs": 4, "warm_start_epochs": 2, "n_members": 2, "samples_per_pair": 10, "n_samples": 400} if quick else {}
+    kw = {}
+    if quick:  # a smoke run: tiny training, meaningless numbers
+        kw = {"epochs": 4, "warm_start_epochs": 2, "n_members": 2, "samples_per_pair": 10, "n_samples": 400}
     print("Use case II: amortized inverse, six blind pairs (paper Table 2)\n")
     model = InverseModel("physics", "paper", **kw).fit()
     info = model.fit_info_
@@ -38,7 +38,8 @@ def main(quick: bool = False) -> int:
     blind = pairs_dataset(BLIND_PAIRS)
     phys = evaluate(model, blind)
     hyb = evaluate(_as_hybrid(model), blind)
-    print(f"\n{'R':>5} {'L':>6} | {'paper R̂':>8} {'paper L̂':>8} | {'physics R̂ ± σ':>18} {'physics L̂ ± σ':>20} | "
+    print(f"\n{'R':>5} {'L':>6} | {'paper R̂':>8} {'paper L̂':>8} | "
+          f"{'physics R̂ ± σ':>18} {'physics L̂ ± σ':>20} | "
           f"{'hybrid R̂':>9} {'hybrid L̂':>9}")
     for i, (R, L) in enumerate(BLIND_PAIRS):
         print(f"{R:5.1f} {L:6.3f} | {PAPER_TABLE2[i, 2]:8.4f} {PAPER_TABLE2[i, 3]:8.5f} | "
@@ -46,7 +47,8 @@ def main(quick: bool = False) -> int:
               f"{hyb['R'][i]:9.5f} {hyb['L'][i]:9.6f}")
     print(f"\nMAE R / L: paper 0.0823 Ω / 5.72e-4 H;  physics {phys['mae_R']:.4f} Ω / {phys['mae_L']:.2e} H;  "
           f"hybrid {hyb['mae_R']:.1e} Ω / {hyb['mae_L']:.1e} H")
-    print(f"inference: physics {1e3 * phys['infer_s_per_frf']:.2f} ms/FRF, hybrid {1e3 * hyb['infer_s_per_frf']:.1f} ms/FRF")
+    print(f"inference: physics {1e3 * phys['infer_s_per_frf']:.2f} ms/FRF, "
+          f"hybrid {1e3 * hyb['infer_s_per_frf']:.1f} ms/FRF")
 
     print("\nOff the paper's R-L line (noise-free):")
     off = pairs_dataset(OFF_CURVE_PAIRS)

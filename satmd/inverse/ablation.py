@@ -208,9 +208,12 @@ def off_curve_markdown(res: dict) -> str:
     lines = ["| trained on | kind | on-curve MAE R / L | off-curve MAE R / L | ratio R / L |", "|---|---|---|---|---|"]
     for o in res["off_curve"]:
         a, b = o["on_curve"], o["off_curve"]
+        if max(a["rel_R"], a["rel_L"], b["rel_R"], b["rel_L"]) < 1e-9:
+            ratio = "round-off"  # least squares: both errors at machine precision
+        else:
+            ratio = f"{b['mae_R'] / a['mae_R']:.2g} / {b['mae_L'] / a['mae_L']:.2g}"
         lines.append(f"| {o['preset']} | {o['kind']} | {a['mae_R']:.3g} Ω / {a['mae_L']:.3g} H | "
-                     f"{b['mae_R']:.3g} Ω / {b['mae_L']:.3g} H | "
-                     f"{b['mae_R'] / a['mae_R']:.2g} / {b['mae_L'] / a['mae_L']:.2g} |")
+                     f"{b['mae_R']:.3g} Ω / {b['mae_L']:.3g} H | {ratio} |")
     return "\n".join(lines)
 
 

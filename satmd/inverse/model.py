@@ -5,8 +5,11 @@ Kinds
 ``physics``
     A deep ensemble of the SPEC §5 net trained through the torch twin with
     the physics-consistent loss of eq. 22 (predictions go back through the
-    forward model). A short supervised warm start precedes it by default
-    (``warm_start_epochs``; reported in ``fit_info_``).
+    forward model). A supervised warm start precedes it by default
+    (``warm_start_epochs`` of the ``epochs``; reported in ``fit_info_``), and
+    the eq. 22 gradient is preconditioned per sample by its 2x2 Gauss-Newton
+    matrix (``precondition``), because the FRFs are far less sensitive to R
+    than to L (`satmd.inverse.training.physics_objective`).
 ``supervised``
     The same ensemble trained by MSE on normalised labels (the baseline the
     paper's discussion asks for).
@@ -24,8 +27,9 @@ the ensemble members, σ_noise the spread of the ensemble mean when the input
 is perturbed again by its measurement noise (Monte Carlo, ``mc_samples``
 draws: the noise std columns of FRFData when given, else the training noise
 level), and ``c`` a factor fitted on the validation pairs so that
-``|error| <= 2 std`` holds for 95 % of them (``std_scale_``). The optimisation
-kinds report the Jacobian standard errors of their fit.
+``|error| <= 2 std`` holds for 95 % of them (``std_scale_``). With ``refit``
+(default) the nets are then trained again on every pair, keeping ``c``. The
+optimisation kinds report the Jacobian standard errors of their fit.
 
 Contract for the explainability package
 ---------------------------------------
@@ -91,6 +95,8 @@ class InverseModel:
     refine_nfev : least-squares evaluations of the hybrid refinement
     seed : every random number derives from it
     device : "cpu", "cuda" or None (CUDA when present)
+    threads : torch CPU threads during training (default 1, the fastest for
+        this small net; None leaves torch's setting)
     verbose : progress bar (only on a terminal)
     rig : fixed mechanical parameters (default: the paper's rig)
     freq_hz : frequency grid (default: the paper's 60 points)
@@ -99,7 +105,7 @@ class InverseModel:
     def __init__(self, kind: str = "physics", preset: str = "paper", noise: float = 0.0, *,
                  epochs: int | None = None, warm_start_epochs: int | None = None, batch_size: int = 64,
                  lr: float = 1e-3, physics_lr: float = 3e-4, lr_final: float = 1e-5, n_members: int = 5,
-                 precondition: bool = True,
+                 precondition: bool = True, threads: int | None = 1,
                  samples_per_pair: int | None = None, n_samples: int | None = None, val_fraction: float = 0.2,
                  refit: bool = True, mc_samples: int = 64, refine_nfev: int | None = 20, seed: int = 0,
                  device: str | None = None, verbose: bool = True, rig: Rig | None = None, freq_hz=None):
@@ -112,6 +118,7 @@ class InverseModel:
         self.lr = lr
         self.physics_lr = physics_lr
         self.precondition = precondition
+        self.threads = threads
         self.lr_final = lr_final
         self.n_members = n_members
         self.samples_per_pair = samples_per_pair
@@ -192,7 +199,7 @@ class InverseModel:
             objective="supervised" if self.kind == "supervised" else "physics",
             epochs=int(self._resolved("epochs")), warm_start_epochs=int(self._resolved("warm_start_epochs")),
             batch_size=int(self.batch_size), lr=float(self.lr), physics_lr=float(self.physics_lr),
-            lr_final=float(self.lr_final), precondition=bool(self.precondition),
+            lr_final=float(self.lr_final), precondition=bool(self.precondition), threads=self.threads,
             n_members=int(self.n_members), noise=float(self.noise), seed=int(self.seed), device=self.device)
         torch.manual_seed(int(self.seed))
         self.scaler_ = Scaler.fit(train.features())
@@ -413,9 +420,9 @@ class InverseModel:
         return load_model(path)
 
     def get_params(self) -> dict:
-        names = ("kind", "preset", "noise", "epochs", "warm_start_epochs", "batch_size", "lr", "physics_lr", "lr_final", "precondition",
-                 "n_members", "samples_per_pair", "n_samples", "val_fraction", "refit", "mc_samples", "refine_nfev", "seed",
-                 "device", "verbose")
+        names = ("kind", "preset", "noise", "epochs", "warm_start_epochs", "batch_size", "lr", "physics_lr", "lr_final",
+                 "precondition", "n_members", "samples_per_pair", "n_samples", "val_fraction", "refit", "mc_samples",
+                 "refine_nfev", "seed", "device", "threads", "verbose")
         return {n: getattr(self, n) for n in names}
 
     def __repr__(self):

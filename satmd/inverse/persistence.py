@@ -83,7 +83,10 @@ def load_model(path):
         raise DataError(f"{meta_file}: invalid JSON ({exc.msg}, line {exc.lineno})") from None
     if meta.get("schema") != SCHEMA:
         raise DataError(f"{meta_file}: schema {meta.get('schema')!r}, expected {SCHEMA!r}")
-    params = dict(meta["params"])
+    import inspect
+
+    known = set(inspect.signature(InverseModel.__init__).parameters) - {"self", "rig", "freq_hz"}
+    params = {k: v for k, v in dict(meta["params"]).items() if k in known}
     params["verbose"] = False
     model = InverseModel(**params, rig=Rig(**meta["rig"]), freq_hz=np.array(meta["freq_hz"]))
     model.bounds = {k: tuple(v) for k, v in meta["bounds"].items()}
