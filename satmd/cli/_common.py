@@ -75,8 +75,21 @@ def parse_effect(text: str):
         raise SatmdError(f"--effect {text!r}: {exc}") from None
 
 
+def parse_list(text: str | None) -> tuple[str, ...] | None:
+    """'a, b,c' -> ('a', 'b', 'c'); None or '' -> None."""
+    if not text:
+        return None
+    return tuple(s.strip() for s in text.split(",") if s.strip()) or None
+
+
+def add_model_options(parser: argparse.ArgumentParser, free_help: str):
+    """--free and --channels, shared by the commands that fit the model."""
+    parser.add_argument("--free", default="m2,kp,R,L", help=free_help)
+    parser.add_argument("--channels", default=None, help="channels to fit (default a1,a2 when present)")
+
+
 def parse_names(text: str, allowed, what: str) -> tuple[str, ...]:
-    names = tuple(s.strip() for s in text.split(",") if s.strip())
+    names = parse_list(text) or ()
     bad = [n for n in names if n not in allowed]
     if bad or not names:
         raise SatmdError(f"{what}: unknown {', '.join(bad) or '(empty)'}; choose from {', '.join(allowed)}")

@@ -4,7 +4,7 @@ from __future__ import annotations
 import json
 
 from ..physics.effects import VOCABULARY_NAMES
-from ._common import add_data_options, load_data, parse_names
+from ._common import add_data_options, add_model_options, load_data, parse_list, parse_names
 
 
 def register(sub):
@@ -12,9 +12,8 @@ def register(sub):
                        description="Fit the nominal model, test the mismatch against the noise, and explain it "
                                    "with the missing-physics vocabulary (SPEC §8); report as SPEC §9.")
     add_data_options(p)
-    p.add_argument("--free", default="m2,kp,R,L", help="parameters fitted in every model (default m2,kp,R,L)")
+    add_model_options(p, "parameters fitted in every model (default m2,kp,R,L)")
     p.add_argument("--candidates", default=None, help="comma-separated effect names (default: all)")
-    p.add_argument("--channels", default=None, help="channels to use (default a1,a2)")
     p.add_argument("--alpha", type=float, default=1e-3, help="level of the mismatch test (default 1e-3)")
     p.add_argument("--json", action="store_true", help="print exactly the SPEC §9 JSON document")
     p.add_argument("--plot", default=None, metavar="FIG.png",
@@ -26,9 +25,9 @@ def run(args):
     from ..discover import discover
 
     data = load_data(args)
-    free = tuple(s.strip() for s in args.free.split(",") if s.strip())
+    free = parse_list(args.free) or ("m2", "kp", "R", "L")
     candidates = parse_names(args.candidates, VOCABULARY_NAMES, "--candidates") if args.candidates else None
-    channels = tuple(s.strip() for s in args.channels.split(",")) if args.channels else None
+    channels = parse_list(args.channels)
     rep = discover(data, free=free, candidates=candidates, channels=channels, alpha=args.alpha)
     if args.plot:
         rep.plot(args.plot)

@@ -3,7 +3,7 @@ from __future__ import annotations
 
 import json
 
-from ._common import add_data_options, load_data, parse_effect, parse_kv
+from ._common import add_data_options, add_model_options, load_data, parse_list, parse_effect, parse_kv
 
 
 def register(sub):
@@ -11,9 +11,8 @@ def register(sub):
                        description="Global grey-box identification with scipy least squares and the analytic "
                                    "Jacobian; standard errors, correlations and fit statistics.")
     add_data_options(p)
-    p.add_argument("--free", default="m2,kp,R,L", help="parameters to fit (default m2,kp,R,L)")
+    add_model_options(p, "parameters to fit (default m2,kp,R,L)")
     p.add_argument("--init", default=None, metavar="m2=0.3,...", help="start values (also the nominal values)")
-    p.add_argument("--channels", default=None, help="channels to fit (default a1,a2 when present)")
     p.add_argument("--effect", action="append", default=[], metavar="NAME:key=value,...",
                    help="include a known effect in the model (repeatable)")
     p.add_argument("--reg", type=float, default=0.0, help="λ_reg of paper eq. 13 (default 0: unbiased)")
@@ -28,8 +27,8 @@ def run(args):
     from ..identify import identify
 
     data = load_data(args)
-    free = tuple(s.strip() for s in args.free.split(",") if s.strip())
-    channels = tuple(s.strip() for s in args.channels.split(",")) if args.channels else None
+    free = parse_list(args.free) or ("m2", "kp", "R", "L")
+    channels = parse_list(args.channels)
     effects = [parse_effect(e) for e in args.effect]
     start = parse_kv(args.init, "--init") if args.init else None
     fit = identify(data, free=free, channels=channels, effects=effects, start=start, reg=args.reg,
