@@ -83,4 +83,5 @@ def _lag1(v: np.ndarray) -> float:
     x = np.concatenate([v.real - v.real.mean(), v.imag - v.imag.mean()])
     lagged = np.concatenate([v.real[:-1] - v.real.mean(), v.imag[:-1] - v.imag.mean()])
     ahead = np.concatenate([v.real[1:] - v.real.mean(), v.imag[1:] - v.imag.mean()])
-    return float(np.sum(lagged * ahead) / np.sum(x * x))
+    power = np.sum(x * x)
+    return float(np.sum(lagged * ahead) / power) if power > 0 else 0.0

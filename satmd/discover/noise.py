@@ -29,10 +29,13 @@ def estimate_channel_std(residual: np.ndarray, magnitude: np.ndarray, nu: float 
     peak = magnitude.max()
     m2 = magnitude**2
 
+    # below the model's round-off no noise can be estimated (noise-free data fit exactly)
+    floor2 = (1e-13 * peak) ** 2
+
     def sigma2(params):
         a, b = np.exp(params)
         s = a * magnitude + b * peak
-        return s**2
+        return np.maximum(s**2, floor2)
 
     def nll(params):
         s2 = sigma2(params)

@@ -125,3 +125,18 @@ def test_cli_bad_input_exits_2(tmp_path, capsys):
     assert main(["discover", str(bad), "--json"]) == 2
     err = capsys.readouterr().err.strip()
     assert len(err.splitlines()) == 1 and "bad.csv" in err
+
+
+@pytest.mark.parametrize("effects, expected", [([], []), ([effect("time_delay", tau_s=1e-4)], ["time_delay"])])
+def test_noise_free_data_without_std(effects, expected, recwarn):
+    # an exact fit leaves a zero residual: the noise estimate must not break (no NaN, no warnings)
+    data = simulate(GRID, Rig(m2=0.6, kp=1.3e5, R=30.0, L=0.1), effects)
+    rep = discover(data)
+    assert rep.effect_names == expected and rep.noise == "estimated"
+    assert not [w for w in recwarn if issubclass(w.category, RuntimeWarning)]
+
+
+def test_single_channel_data():
+    rig = Rig(m2=0.6, kp=1.3e5, R=30.0, L=0.1)
+    data = simulate(GRID, rig, [effect("parameter_offset:k1", value=2.05e5)], noise=NOISE, seed=1).select(["a1"])
+    assert discover(data).effect_names == ["parameter_offset:k1"]
