@@ -8,8 +8,8 @@
 Inputs are z-scored with the mean and std (ddof 0) of the whole dataset, as
 the paper's x0..x3, then split 80/20 (``seed`` 42). The back end searches on
 the training part; every candidate is converted to sympy, constants are
-refitted on the training part (``polish``) and rounded to 4 significant
-digits, and *all* reported metrics are computed from that rounded sympy
+refitted on the training part (``polish``), constants the others can absorb
+are dropped (``prune``), the rest rounded to 4 significant digits, and *all* reported metrics are computed from that rounded sympy
 expression. Complexity is `satmd.explain.symbolic.node_count`.
 
 Back ends: ``operon`` (pyoperon, default), ``pysr`` (needs a Julia runtime;
@@ -27,6 +27,7 @@ from sklearn.model_selection import train_test_split
 
 from ..errors import DataError, SatmdError
 from ._backends import BACKENDS
+from .anova import grid_ceiling  # noqa: F401 - re-exported: it bounds what distill can reach
 
 
 def _symbolic():
@@ -135,8 +136,10 @@ def pareto_front(entries: list, key: str = "r2_train") -> list:
 
 
 def distill(X, y, backend: str = "operon", names=None, *, max_complexity: int | None = None,
-            test_size: float = 0.2, seed: int = 42, zscore: bool = True, n_threads: int = 1,
-            time_limit: float | None = None, polish: bool | None = None, digits: int = 4, **options) -> DistillResult:
+            test_size: float = 0.2, seed: int = 42, search_seed: int | None = None, zscore: bool = True,
+            n_threads: int = 1,
+            time_limit: float | None = None, polish: bool | None = None, prune: bool | None = None, digits: int = 4,
+            **options) -> DistillResult:
     """Fit a compact formula y ≈ f(z(X)).
 
     Parameters
@@ -144,6 +147,8 @@ def distill(X, y, backend: str = "operon", names=None, *, max_complexity: int | 
     X : (n, d) physical inputs; y : (n,) target (non-finite rows are dropped)
     backend : "operon" (default), "pysr" or "sindy"
     names : names of the d inputs (default x0..)
+    seed : seed of the train/test split (SPEC §6: 42); ``search_seed``: of the
+        back end's search (default: ``seed``)
     max_complexity : return the most accurate (training R²) candidate with at
         most this many nodes; None: the back end's own choice (operon: MDL;
         sindy: best training R²)
@@ -151,6 +156,8 @@ def distill(X, y, backend: str = "operon", names=None, *, max_complexity: int | 
     zscore : standardise the inputs first (the paper's x_i); False: x_i are the raw inputs
     polish : refit each candidate's constants on the training data (default:
         yes, except for SINDy's polynomial library whose fit is already least squares)
+    prune : drop the constants the others can absorb (`symbolic.prune`: the
+        squared error may grow by 1e-4 relative); default: when polishing
     options : passed to the back end (e.g. max_length, generations, degree, rational)
     """
     if backend not in BACKENDS:
@@ -161,17 +168,21 @@ def distill(X, y, backend: str = "operon", names=None, *, max_complexity: int | 
     d = Ztr.shape[1]
     names = tuple(names) if names is not None else tuple(f"x{i}" for i in range(d))
     t0 = time.perf_counter()
-    candidates, chosen, info = BACKENDS[backend](Ztr, ytr, seed=seed, n_threads=n_threads, time_limit=time_limit,
+    search_seed = seed if search_seed is None else search_seed
+    candidates, chosen, info = BACKENDS[backend](Ztr, ytr, seed=search_seed, n_threads=n_threads, time_limit=time_limit,
                                                  **options)
     search_s = time.perf_counter() - t0
     if polish is None:
         polish = not (backend == "sindy" and not options.get("rational", False))
+    prune = polish if prune is None else prune
     entries, seen = [], set()
     for i, text in enumerate(candidates):
         expr = symbolic.parse(text, d) if isinstance(text, str) else sp.sympify(text)
         if polish:
             expr = symbolic.polish(expr, Ztr, ytr)
-        expr = symbolic.compact(symbolic.round_floats(expr, digits))
+        if prune:
+            expr = symbolic.prune(expr, Ztr, ytr)
+        expr = symbolic.round_floats(symbolic.compact(symbolic.round_floats(expr, digits)), digits)
         key = sp.srepr(expr)
         if key in seen:
             continue
@@ -203,17 +214,3 @@ def paper_formula_result(X, y, test_size: float = 0.2, seed: int = 42) -> dict:
     expr = symbolic.compact(symbolic.parse(symbolic.PAPER_FORMULA, Ztr.shape[1]))
     return {"expression": symbolic.PAPER_FORMULA, "complexity": symbolic.node_count(expr),
             **metrics(expr, Ztr, Zte, ytr, yte)}
-
-
-def grid_ceiling(X, y, columns) -> float:
-    """R² of the per-cell means of y over the distinct value combinations of
-    ``X[:, columns]``: on grid data, the most any function of only those
-    inputs can explain."""
-    X = np.asarray(X, float)
-    y = np.asarray(y, float).ravel()
-    keep = np.isfinite(y)
-    X, y = X[keep], y[keep]
-    _, cell = np.unique(X[:, list(columns)], axis=0, return_inverse=True)
-    cell = cell.ravel()
-    means = np.bincount(cell, y) / np.bincount(cell)
-    return float(1.0 - np.sum((y - means[cell]) ** 2) / np.sum((y - y.mean()) ** 2))

@@ -7,7 +7,8 @@ sympy.preorder_traversal(expr)))``. Every operator node (n-ary ``Add`` and
 node. Subtraction is ``Add`` with a negative coefficient, division is ``Pow``
 with exponent -1 and ``square`` is ``Pow`` with exponent 2. Of the algebraically
 identical forms tried by `compact` (as given, expanded, common factors pulled
-out, over a common denominator) the smallest count is used, for the paper's
+out, over a common denominator, a coefficient pulled out of a sum in a product) the
+smallest count is used, for the paper's
 formula exactly as for ours.
 """
 from __future__ import annotations
@@ -56,7 +57,37 @@ def compact(expr: sp.Expr, max_nodes: int = 80) -> sp.Expr:
             forms.append(f(expr))
         except Exception:  # pragma: no cover - sympy corner cases
             pass
-    return min(forms, key=node_count)
+    return _monic(min(forms, key=node_count))
+
+
+def _monic(expr: sp.Expr) -> sp.Expr:
+    """Pull a float coefficient out of a sum inside a product, ``(a x + b) f``
+    -> ``a (x + b/a) f``, wherever that shortens the tree."""
+    best, size = expr, node_count(expr)
+    improved = True
+    while improved:
+        improved = False
+        for prod in sp.preorder_traversal(best):
+            if not isinstance(prod, sp.Mul):
+                continue
+            for k, inner in enumerate(prod.args):
+                if not isinstance(inner, sp.Add):
+                    continue
+                for term in inner.args:
+                    coeff, rest = term.as_coeff_Mul()
+                    if not isinstance(coeff, sp.Float) or coeff == 0:
+                        continue
+                    monic = sp.Add(*(rest if t is term else t / coeff for t in inner.args))
+                    others = prod.args[:k] + prod.args[k + 1:]
+                    trial = best.xreplace({prod: sp.Mul(coeff, monic, *others)})
+                    if node_count(trial) < size:
+                        best, size, improved = trial, node_count(trial), True
+                        break
+                if improved:
+                    break
+            if improved:
+                break
+    return best
 
 
 def round_floats(expr: sp.Expr, digits: int = 4) -> sp.Expr:
@@ -81,6 +112,56 @@ def evaluate(expr: sp.Expr, Z: np.ndarray) -> np.ndarray:
     with np.errstate(all="ignore"):
         out = np.asarray(fn(*Z.T), float)
     return np.broadcast_to(out, (Z.shape[0],)).astype(float)
+
+
+def _sse(expr: sp.Expr, Z: np.ndarray, y: np.ndarray) -> float:
+    r = evaluate(expr, Z) - y
+    return float(np.sum(r * r)) if np.all(np.isfinite(r)) else np.inf
+
+
+def _neutral_values(expr: sp.Expr) -> list:
+    """(float, value) pairs that drop it: 1 for a factor of a product, 0 for a term of a sum."""
+    out = []
+    for node in sp.preorder_traversal(expr):
+        neutral = sp.Integer(1) if isinstance(node, sp.Mul) else sp.Integer(0) if isinstance(node, sp.Add) else None
+        if neutral is not None:
+            out += [(a, neutral) for a in node.args if isinstance(a, sp.Float) and (a, neutral) not in out]
+    return out
+
+
+def prune(expr: sp.Expr, Z: np.ndarray, y: np.ndarray, rtol: float = 1e-4, max_rows: int = 1000,
+          max_nfev: int = 1000) -> sp.Expr:
+    """Drop the constants the others can absorb, keeping the fit.
+
+    A search returns trees such as ``0.999*(42.8*x3 + 100.5)*(...)**2``
+    whose constants are redundant (a scale can move into a neighbouring
+    factor). Each float factor of a product is tried at 1 and each float
+    term of a sum at 0; the rest are refitted (`polish`) and the change is kept when
+    the squared error grows by at most ``rtol`` (relative) and the tree
+    shrinks. Repeats until nothing more can go. The trials use at most
+    ``max_rows`` evenly spaced rows; the result is refitted on all of them.
+    """
+    Z = np.asarray(Z, float)
+    y = np.asarray(y, float)
+    rows = np.unique(np.linspace(0, y.size - 1, min(y.size, max_rows)).astype(int))
+    Zs, ys = Z[rows], y[rows]
+    best, best_sse = expr, _sse(expr, Zs, ys)
+    if not np.isfinite(best_sse):
+        return expr
+    changed = True
+    while changed:
+        changed = False
+        size = node_count(best)
+        for c, value in _neutral_values(best):
+            trial = best.xreplace({c: value})
+            if trial.is_number or node_count(trial) >= size:
+                continue
+            trial = polish(trial, Zs, ys, max_nfev=max_nfev)
+            sse = _sse(trial, Zs, ys)
+            if sse <= best_sse * (1.0 + rtol) + 1e-300:
+                best, best_sse, changed = trial, min(best_sse, sse), True
+                break
+    return expr if best is expr else polish(best, Z, y, max_nfev=max_nfev)
 
 
 def polish(expr: sp.Expr, Z: np.ndarray, y: np.ndarray, max_nfev: int = 200) -> sp.Expr:

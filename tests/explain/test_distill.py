@@ -7,7 +7,7 @@ import sympy as sp
 from satmd.errors import SatmdError
 from satmd.explain import distill, node_count, paper_complexity
 from satmd.explain.distill import pareto_front
-from satmd.explain.symbolic import compact, parse, polish
+from satmd.explain.symbolic import compact, parse, polish, prune
 
 
 def test_node_count_rule():
@@ -15,7 +15,9 @@ def test_node_count_rule():
     assert node_count(x0) == 1
     assert node_count(x0 * x1 + 2) == 5  # Add(Mul(x0, x1), 2)
     assert node_count(x0 / x1) == 5  # Mul(x0, Pow(x1, -1))
-    assert paper_complexity() == 21
+    # the paper's printed form, 1.69 + 0.02*(x3 - x1 - 2.77 - 0.28*x2)*((x1 - 3.14)**2 + x0):
+    # Add(1.69, Mul(0.02, Add(x3, -x1, -2.77, -0.28*x2), Add(Pow(Add(x1, -3.14), 2), x0)))
+    assert paper_complexity() == 20
 
 
 def test_compact_and_polish():
@@ -26,6 +28,31 @@ def test_compact_and_polish():
     p = polish(parse("1.0*x0**2 + 0.1", 1), Z, y)
     consts = sorted(float(c) for c in p.atoms(sp.Float))
     np.testing.assert_allclose(consts, [0.5, 3.0], atol=1e-6)
+
+
+def test_compact_pulls_a_coefficient_out_of_a_sum_in_a_product():
+    e = parse("(0.5*x1 + 0.25)*exp(x0) + x1", 2)  # sympy keeps the sum expanded
+    c = compact(e)
+    assert node_count(c) == node_count(e) - 1
+    assert sp.simplify(c - e) == 0
+    x0, x1 = sp.symbols("x0 x1", real=True)
+    assert c.has(sp.Add(x1, sp.Float(0.5)))  # 0.5*(x1 + 0.5)*exp(x0)
+
+
+def test_prune_drops_absorbable_constants_and_keeps_the_fit():
+    rng = np.random.default_rng(2)
+    Z = rng.uniform(-1, 1, (400, 2))
+    y = (Z[:, 1] + 2.0) * (Z[:, 0] - 1.0) ** 2
+    # an over-parameterised tree of the same function: 0.5*(2*x1 + 4)*(1.0*x0 - 1.0)**2 + 0*x0
+    e = parse("0.5*(2.0*x1 + 4.0)*(1.0*x0 - 1.0)**2 + 0.3*x0", 2)
+    e = polish(e, Z, y)
+    p = prune(e, Z, y)
+    assert node_count(p) < node_count(e)
+    assert not p.has(sp.Symbol("x0", real=True) * sp.Float(0.3))
+    np.testing.assert_allclose(sp.lambdify(sp.symbols("x0 x1", real=True), p)(*Z.T), y, atol=1e-6)
+    # a constant that matters stays
+    q = prune(parse("2.5*x0 + 1.0", 1), Z[:, :1], 2.5 * Z[:, 0] + 1.0)
+    assert sorted(float(c) for c in q.atoms(sp.Float)) == pytest.approx([1.0, 2.5])
 
 
 def test_operon_recovers_a_simple_law():

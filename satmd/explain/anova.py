@@ -1,0 +1,127 @@
+"""How much of a descriptor small formulas can explain, read off a full-factorial grid.
+
+On a full-factorial grid the functional ANOVA (Sobol') decomposition is exact
+and cheap: y = y0 + Σ f_i(x_i) + Σ f_ij(x_i, x_j) + ..., each term a
+difference of cell means. Its variance shares say what structure any
+formula must have: with main effects alone (an additive formula) R² cannot
+exceed ``main``; ``grid_ceiling`` bounds any function of a subset of inputs.
+
+>>> from satmd.explain import xi_dataset
+>>> from satmd.explain.anova import grid_anova
+>>> data = xi_dataset()                                  # doctest: +SKIP
+>>> print(grid_anova(data.X, data.targets["xi"], data.names).report())   # doctest: +SKIP
+"""
+from __future__ import annotations
+
+import itertools
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..errors import DataError
+
+
+@dataclass(frozen=True)
+class GridAnova:
+    """Variance shares of the ANOVA terms (fractions of the total variance).
+
+    ``main[name]`` is the share of f_i; ``pairs[(a, b)]`` of f_ab; ``r2_main``
+    and ``r2_pairs`` the R² of the additive model and of the model with every
+    two-way term (the most an additive / pairwise formula can reach);
+    ``r2_greedy`` the R² as the largest terms are added one at a time.
+    """
+
+    names: tuple
+    main: dict
+    pairs: dict
+    r2_main: float
+    r2_pairs: float
+    r2_greedy: tuple  # ((label, cumulative R²), ...)
+
+    def report(self) -> str:
+        mains = ", ".join(f"{n} {s:.3f}" for n, s in self.main.items())
+        pairs = ", ".join(f"{a}×{b} {s:.3f}" for (a, b), s in sorted(self.pairs.items(), key=lambda kv: -kv[1]))
+        steps = " → ".join(f"{lab} {r2:.3f}" for lab, r2 in self.r2_greedy)
+        return (f"ANOVA shares: main {mains}; pairs {pairs}\n"
+                f"  additive R² ≤ {self.r2_main:.3f}, with every pair ≤ {self.r2_pairs:.3f}; adding terms: {steps}")
+
+    def to_dict(self) -> dict:
+        return {"names": list(self.names), "main": dict(self.main),
+                "pairs": {f"{a}x{b}": s for (a, b), s in self.pairs.items()}, "r2_main": self.r2_main,
+                "r2_pairs": self.r2_pairs, "r2_greedy": [list(step) for step in self.r2_greedy]}
+
+
+def _cube(X, y):
+    """y as an array over the grid's axes (one axis per input); raises unless X is a full factorial."""
+    X = np.asarray(X, float)
+    y = np.asarray(y, float).ravel()
+    if X.ndim != 2 or X.shape[0] != y.size:
+        raise DataError(f"X must be (n, d) and y (n,); got {X.shape} and {y.shape}")
+    if not np.all(np.isfinite(y)):
+        raise DataError(f"grid_anova needs a finite target at every grid point ({np.sum(~np.isfinite(y))} are not)")
+    levels, index = [], []
+    for j in range(X.shape[1]):
+        lv, inv = np.unique(X[:, j], return_inverse=True)
+        levels.append(lv.size)
+        index.append(inv.ravel())
+    if int(np.prod(levels)) != y.size:
+        raise DataError(f"X is not a full-factorial grid: {'x'.join(map(str, levels))} levels "
+                        f"but {y.size} samples")
+    cube = np.full(levels, np.nan)
+    cube[tuple(index)] = y
+    if np.isnan(cube).any():
+        raise DataError("X is not a full-factorial grid: some level combinations repeat")
+    return cube
+
+
+def _term(cube, keep):
+    """The ANOVA term over the axes in ``keep`` (by inclusion-exclusion of cell means)."""
+    d = cube.ndim
+    out = 0.0
+    for k in range(len(keep) + 1):
+        for sub in itertools.combinations(keep, k):
+            other = tuple(a for a in range(d) if a not in sub)
+            out = out + (-1) ** (len(keep) - k) * cube.mean(axis=other, keepdims=True)
+    return out
+
+
+def grid_anova(X, y, names=None) -> GridAnova:
+    """Main-effect and two-way ANOVA shares of ``y`` over the full-factorial grid ``X`` (n, d)."""
+    cube = _cube(X, y)
+    d = cube.ndim
+    names = tuple(names) if names is not None else tuple(f"x{i}" for i in range(d))
+    total = np.mean((cube - cube.mean()) ** 2)
+    if total == 0:
+        raise DataError("the target is constant over the grid: nothing to decompose")
+    terms = {(i,): _term(cube, (i,)) for i in range(d)}
+    terms.update({p: _term(cube, p) for p in itertools.combinations(range(d), 2)})
+    share = {k: float(np.mean(np.broadcast_to(t, cube.shape) ** 2) / total) for k, t in terms.items()}
+
+    def r2(keys):
+        fit = cube.mean() + sum((terms[k] for k in keys), np.zeros(cube.shape))
+        return float(1.0 - np.mean((cube - fit) ** 2) / total)
+
+    mains = [(i,) for i in range(d)]
+    pairs = [k for k in terms if len(k) == 2]
+    greedy, chosen = [], list(mains)
+    greedy.append(("main effects", r2(chosen)))
+    for k in sorted(pairs, key=lambda k: -share[k]):
+        chosen.append(k)
+        greedy.append((f"+{names[k[0]]}×{names[k[1]]}", r2(chosen)))
+    return GridAnova(names, {names[i]: share[(i,)] for i in range(d)},
+                     {(names[a], names[b]): share[(a, b)] for a, b in pairs}, r2(mains), r2(mains + pairs),
+                     tuple(greedy))
+
+
+def grid_ceiling(X, y, columns) -> float:
+    """R² of the per-cell means of y over the distinct value combinations of
+    ``X[:, columns]``: on grid data, the most any function of only those
+    inputs can explain."""
+    X = np.asarray(X, float)
+    y = np.asarray(y, float).ravel()
+    keep = np.isfinite(y)
+    X, y = X[keep], y[keep]
+    _, cell = np.unique(X[:, list(columns)], axis=0, return_inverse=True)
+    cell = cell.ravel()
+    means = np.bincount(cell, y) / np.bincount(cell)
+    return float(1.0 - np.sum((y - means[cell]) ** 2) / np.sum((y - y.mean()) ** 2))
