@@ -73,7 +73,7 @@ def _one(job):
     rep = discover(sc.data)
     dt = time.perf_counter() - t0
     return {"seed": seed, "truth": sc.truth_names, "found": rep.effect_names,
-            "equivalent": [e["equivalent"] for e in rep.effects], "detectable": sc.detectable,
+            "equivalent": [e.equivalent for e in rep.effects], "detectable": sc.detectable,
             "correct": bool(judge(rep, sc)), "flagged": bool(rep.significant_mismatch), "time_s": dt,
             "chi2_before": rep.fit_before["chi2_reduced"], "chi2_after": rep.fit_after["chi2_reduced"]}
 

@@ -24,7 +24,7 @@ import time
 from pathlib import Path
 
 from satmd.explain import distill, paper_complexity, paper_formula_result, xi_dataset
-from satmd.explain._backends import OPERON_SYMBOLS
+from satmd.explain.backends import OPERON_SYMBOLS
 from satmd.explain.anova import grid_anova
 from satmd.explain.run import COMPLEXITY_CAP, XI_OPERON
 from satmd.explain.symbolic import PAPER_METRICS

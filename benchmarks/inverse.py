@@ -16,7 +16,13 @@ In one run:
 
 Writes benchmarks/results/inverse.json (+ inverse.md, the tables) and prints
 one line of figures.
-Usage: python benchmarks/inverse.py [--quick] [--threads N] [--noises 0,0.01] [--presets paper]
+
+``--training`` times only the default paper-preset physics training
+(`InverseModel(kind="physics", preset="paper").fit()`, issue 14) with its
+Table 2 MAE and the MAE on the 246 blind FRFs, and appends the figures with
+the device, torch version and thread count to
+benchmarks/results/inverse_training.json.
+Usage: python benchmarks/inverse.py [--quick] [--threads N] [--noises 0,0.01] [--presets paper] [--training]
 """
 from __future__ import annotations
 
@@ -39,7 +45,12 @@ def main(argv=None):
     ap.add_argument("--presets", default="paper,box")
     ap.add_argument("--out", default=str(RESULTS / "inverse.json"))
     ap.add_argument("--render", action="store_true", help="only rewrite inverse.md from an existing inverse.json")
+    ap.add_argument("--training", action="store_true", help="only time the paper-preset physics training")
+    ap.add_argument("--device", default=None, help="training device for --training (default: CUDA when present)")
+    ap.add_argument("--label", default="", help="a note stored with the --training figures")
     args = ap.parse_args(argv)
+    if args.training:
+        return time_training(args.threads, args.device, args.label)
     out = Path(args.out)
     if args.render:
         res = json.loads(out.read_text(encoding="utf-8"))
@@ -61,6 +72,39 @@ def main(argv=None):
     out.parent.mkdir(parents=True, exist_ok=True)
     out.write_text(json.dumps(res, indent=1, default=float), encoding="utf-8")
     write_markdown(res, out)
+
+
+def time_training(threads: int, device=None, label: str = "") -> dict:
+    """Wall and CPU seconds of the default paper-preset physics fit, with its accuracy (see the docstring)."""
+    import os
+    import platform
+
+    import torch
+
+    from satmd.inverse import BLIND_PAIRS, InverseModel, evaluate, pairs_dataset
+
+    torch.set_num_threads(threads)
+    model = InverseModel("physics", "paper", verbose=False, threads=threads, device=device)
+    t0, c0 = time.perf_counter(), time.process_time()
+    model.fit()
+    wall, cpu = time.perf_counter() - t0, time.process_time() - c0
+    t2 = evaluate(model)
+    blind = evaluate(model, pairs_dataset(BLIND_PAIRS, per_pair=40, seed=1000))
+    dev = model.fit_info_["device"]
+    rec = {"date": time.strftime("%Y-%m-%d %H:%M:%S"), "label": label, "train_s": wall, "train_cpu_s": cpu,
+           "table2_mae_R": t2["mae_R"], "table2_mae_L": t2["mae_L"], "blind_mae_R": blind["mae_R"],
+           "blind_mae_L": blind["mae_L"], "blind_coverage": blind["coverage"],
+           "device": torch.cuda.get_device_name(0) if dev.startswith("cuda") else f"cpu ({os.cpu_count()} cores)",
+           "torch": torch.__version__, "torch_threads": threads, "platform": platform.platform(),
+           "load_average": os.getloadavg(), "config": model.fit_info_["config"]}
+    path = RESULTS / "inverse_training.json"
+    runs = json.loads(path.read_text(encoding="utf-8")) if path.is_file() else []
+    runs.append(rec)
+    path.write_text(json.dumps(runs, indent=1), encoding="utf-8")
+    print(f"inverse training: {wall:.1f} s wall, {cpu:.1f} s CPU on {rec['device']} ({threads} thread(s), load "
+          f"{rec['load_average'][0]:.1f}); Table 2 MAE R {t2['mae_R']:.4f} Ω, L {t2['mae_L']:.3g} H; blind set MAE "
+          f"R {blind['mae_R']:.4f} Ω, L {blind['mae_L']:.3g} H")
+    return rec
 
 
 def write_markdown(res, out: Path):

@@ -21,7 +21,7 @@ from pathlib import Path
 
 import torch
 
-from satmd.explain.run import explain_model
+from satmd.report.explain_text import explain_model
 from satmd.inverse import InverseModel
 from satmd.plots import save
 

@@ -21,9 +21,10 @@ from .physics import (
 )
 from .simulate import simulate
 from .identify import FitResult, identify, identify_many  # noqa: E402  (binds the functions over the subpackages)
-from .discover import DiscoveryReport, discover  # noqa: E402
+from .discover import DiscoveryReport, discover, discover_many  # noqa: E402
+from .tune import TuneResult, retune, tune  # noqa: E402  (light: scipy.optimize loads on first use)
 
-__version__ = "0.1.0"
+from .version import __version__  # noqa: E402
 
 
 def __getattr__(name):
@@ -38,5 +39,5 @@ __all__ = [
     "Rig", "frf", "effect", "Effect", "FRFData", "load_frf", "save_frf", "simulate", "PAPER_GRID_HZ",
     "SensorGain", "TimeDelay", "StructuralDamping", "DielectricLoss", "ShuntCapacitance", "ExtraMode",
     "ParameterOffset", "SatmdError", "DataError", "FormatError", "identify", "identify_many", "FitResult",
-    "discover", "DiscoveryReport", "InverseModel",
+    "discover", "discover_many", "DiscoveryReport", "InverseModel", "tune", "TuneResult", "retune",
 ]

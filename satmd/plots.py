@@ -11,7 +11,14 @@ from .io.frfdata import UNITS
 LABELS = {"a1": "A1 (primary)", "a2": "A2 (absorber)", "u1": "U1", "u2": "U2", "q": "Q (charge)"}
 
 
-def _plt():
+def pyplot():
+    """matplotlib.pyplot on the Agg backend, imported on first use (it is slow to import).
+
+    Returns
+    -------
+    module
+        ``matplotlib.pyplot``.
+    """
     import matplotlib
 
     matplotlib.use("Agg", force=True)
@@ -21,10 +28,15 @@ def _plt():
 
 
 def save(fig, path) -> Path:
+    from .io.atomic import atomic_write
+
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(path, dpi=120, bbox_inches="tight")
-    _plt().close(fig)
+    try:
+        with atomic_write(path) as fh:  # a file object: the format comes from the suffix, not the temp name
+            fig.savefig(fh, format=path.suffix.lstrip(".").lower() or None, dpi=120, bbox_inches="tight")
+    finally:
+        pyplot().close(fig)
     return path
 
 
@@ -34,7 +46,7 @@ def frf_figure(curves: Sequence[tuple], channels: Sequence[str], title: str = ""
     ``curves`` are (label, freq_hz, {channel: complex array}, style dict).
     ``bands`` are (lo, hi) frequency ranges to shade.
     """
-    plt = _plt()
+    plt = pyplot()
     rows = 2 if phase else 1
     fig, axes = plt.subplots(rows, len(channels), figsize=(4.2 * len(channels), 3.0 * rows), squeeze=False,
                              sharex=True)
@@ -63,7 +75,7 @@ def frf_figure(curves: Sequence[tuple], channels: Sequence[str], title: str = ""
 
 def plot_frfdata(data, path, title="", others: Sequence[tuple] = ()):
     """Plot an FRFData (with ±2σ band when std is given) and optional model curves."""
-    plt = _plt()
+    plt = pyplot()
     channels = list(data.channels)
     curves = [("data", data.freq_hz, data.channels, {"color": "k", "marker": ".", "ms": 3, "lw": 0.6})]
     curves += [(lbl, f, d, st) for lbl, f, d, st in others]
@@ -83,7 +95,7 @@ def fit_figure(data, curves: Sequence[tuple], residuals: Sequence[tuple] = (), b
     ``curves``: (label, {channel: complex array}, style) on the data grid.
     ``residuals``: (label, {channel: complex standardised residual}, style).
     """
-    plt = _plt()
+    plt = pyplot()
     channels = [c for c in data.channels if any(c in d for _, d, _ in curves)] or list(data.channels)
     rows = 3 if residuals else 2
     fig, axes = plt.subplots(rows, len(channels), figsize=(4.6 * len(channels), 2.6 * rows), squeeze=False,

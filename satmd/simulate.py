@@ -34,7 +34,23 @@ def simulate(
 ) -> FRFData:
     """FRFData from the model, optionally with noise (std columns then included).
 
-    ``noise`` is REL or (REL, FLOOR) as in ``satmd simulate --noise REL[:FLOOR]``.
+    Parameters
+    ----------
+    freq_hz : frequencies [Hz] (default: the paper's 60-point grid).
+    rig : Rig
+        Parameter values (default: the paper's rig); one rig, not a batch.
+    effects : sequence of Effect
+        Missing physics included in the simulated data.
+    channels : channels to simulate, from a1 a2 u1 u2 q.
+    noise : REL or (REL, FLOOR)
+        Gaussian noise on each of Re and Im with std REL |A| + FLOOR max|A|
+        per channel (the SPEC noise model); None: noise-free, no std columns.
+    seed : seed of the noise.
+    meta : extra header entries for the data's metadata.
+
+    Returns
+    -------
+    FRFData
     """
     rig = Rig() if rig is None else rig
     if rig.batch_shape != ():

@@ -22,13 +22,20 @@ def _command_modules():
     return [n for n in _ORDER if n in found] + sorted(n for n in found if n not in _ORDER)
 
 
+class _Parser(argparse.ArgumentParser):
+    """Usage errors as one line, like every other refusal (subcommand parsers inherit the class)."""
+
+    def error(self, message):
+        self.exit(2, f"{self.prog}: error: {' '.join(message.split())} (see {self.prog} --help)\n")
+
+
 def build_parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(
+    parser = _Parser(
         prog="satmd",
         description="Identification, inversion, explanation and missing-physics discovery for "
                     "semi-active shunted piezoelectric tuned mass dampers.",
     )
-    from .. import __version__
+    from ..version import __version__
 
     parser.add_argument("--version", action="version", version=f"satmd {__version__}")
     sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
@@ -37,26 +44,58 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+# optional dependencies: their absence is the user's setup, not a bug in satmd
+_EXTRAS = {"torch", "tqdm", "matplotlib", "sympy", "pyoperon", "pysr", "pysindy", "juliacall", "h5py"}
+
+
 def main(argv=None) -> int:
+    """Run one command; returns the exit status (0 ok, 2 refused input, 130 interrupted).
+
+    Only user errors are caught: `SatmdError`, `OSError` (said in words) and a
+    missing optional dependency. Anything else is a bug and keeps its traceback.
+    """
     parser = build_parser()
-    args = parser.parse_args(argv)
     try:
-        return args.func(args) or 0
+        args = parser.parse_args(argv)
+    except SystemExit as exc:  # --help, --version or a usage error, already printed by argparse
+        return exc.code if isinstance(exc.code, int) else 2
+    from ._common import one_line_warnings
+
+    try:
+        with one_line_warnings(args.command):  # library warnings as one line each, whatever raised them
+            return args.func(args) or 0
     except BrokenPipeError:  # e.g. `satmd ... | head`: the reader left, nothing to report
         import os
 
         os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
         return 0
-    except (SatmdError, ValueError, OSError) as exc:
-        message = " ".join(str(exc).split()) or type(exc).__name__
-        print(f"satmd {args.command}: error: {message}", file=sys.stderr)
-        return 2
+    except SatmdError as exc:
+        return _refuse(args.command, str(exc))
+    except OSError as exc:
+        return _refuse(args.command, os_message(exc))
     except ImportError as exc:
-        print(f"satmd {args.command}: error: {exc}", file=sys.stderr)
-        return 2
+        missing = exc if isinstance(exc, ModuleNotFoundError) else exc.__cause__
+        if not (isinstance(missing, ModuleNotFoundError) and (missing.name or "").split(".")[0] in _EXTRAS):
+            raise
+        return _refuse(args.command, str(exc))
     except KeyboardInterrupt:
         print("satmd: interrupted", file=sys.stderr)
         return 130
+
+
+def _refuse(command, message) -> int:
+    from ._common import cli_text
+
+    message = cli_text(message) or "failed"
+    print(f"satmd {command}: error: {message}", file=sys.stderr)
+    return 2
+
+
+def os_message(exc: OSError) -> str:
+    """'out.csv: permission denied' rather than "[Errno 13] Permission denied: 'out.csv'"."""
+    what = (exc.strerror or type(exc).__name__).rstrip(".")
+    what = what[:1].lower() + what[1:]
+    return f"{exc.filename}: {what}" if exc.filename else f"{what}"
 
 
 if __name__ == "__main__":  # pragma: no cover

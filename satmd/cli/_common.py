@@ -3,13 +3,172 @@ from __future__ import annotations
 
 import argparse
 import contextlib
+import json
+import math
+import os
 import sys
+import time
 import warnings
+from pathlib import Path
 
 import numpy as np
 
-from ..errors import SatmdError
+from ..errors import FormatError, SatmdError
 from ..physics import Rig, effect
+
+
+# Upper bounds that keep memory bounded; refused up front with the number that was asked for.
+MAX_FREQ_POINTS = 1_000_000
+MAX_SAMPLES = 2 ** 24  # time samples per channel (3 channels of float64: 400 MB)
+
+
+# --- option types: argparse names the option in its message ---------------------
+def real(lo=None, hi=None, *, lo_open=False, hi_open=False):
+    """An argparse ``type``: a finite float within [lo, hi] (open ends with lo_open / hi_open)."""
+    def parse(text):
+        try:
+            x = float(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"{text!r} is not a number") from None
+        if not math.isfinite(x):
+            raise argparse.ArgumentTypeError(f"{text!r} is not a finite number")
+        if lo is not None and (x < lo or (lo_open and x == lo)):
+            raise argparse.ArgumentTypeError(f"{text} must be {'>' if lo_open else '>='} {lo:g}")
+        if hi is not None and (x > hi or (hi_open and x == hi)):
+            raise argparse.ArgumentTypeError(f"{text} must be {'<' if hi_open else '<='} {hi:g}")
+        return x
+
+    parse.__name__ = "number"
+    return parse
+
+
+def integer(lo=None, hi=None):
+    """An argparse ``type``: an integer within [lo, hi]."""
+    def parse(text):
+        try:
+            x = int(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"{text!r} is not an integer") from None
+        if (lo is not None and x < lo) or (hi is not None and x > hi):
+            span = f"{lo}..{hi}" if lo is not None and hi is not None else f">= {lo}" if lo is not None else f"<= {hi}"
+            raise argparse.ArgumentTypeError(f"{text} must be {span}")
+        return x
+
+    parse.__name__ = "integer"
+    return parse
+
+
+SEED = integer(0, 2 ** 32 - 1)  # numpy and torch take non-negative seeds
+
+
+def refuse_unused(args, parser_defaults: dict, when: str):
+    """Refuse options that do not apply in this mode (instead of ignoring them silently).
+
+    ``parser_defaults`` maps dest -> (flag, default); an option counts as given
+    when its value differs from the default. ``when`` completes "X applies ...".
+    """
+    given = [flag for dest, (flag, default) in parser_defaults.items() if getattr(args, dest, default) != default]
+    if given:
+        raise SatmdError(f"{', '.join(given)} {'applies' if len(given) == 1 else 'apply'} {when}")
+
+
+def option_defaults(group) -> dict:
+    """dest -> (flag, default) of every option in an argparse group (for `refuse_unused`)."""
+    return {a.dest: (a.option_strings[0], a.default) for a in group._group_actions if a.option_strings}
+
+
+# --- outputs: checked before any work ---------------------------------------------
+def plot_suffixes() -> tuple[str, ...]:
+    """Figure formats matplotlib's Agg backend writes (raw buffers aside)."""
+    from ..plots import pyplot
+
+    pyplot()
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+
+    return tuple(sorted("." + s for s in FigureCanvasAgg.get_supported_filetypes() if s not in ("raw", "rgba")))
+
+
+def check_outputs(outputs, inputs=()):
+    """Refuse unusable outputs before any work is done.
+
+    ``outputs``: (flag, path, allowed suffixes or None for a folder) for each
+    output given; ``inputs``: paths read by the command. An output must not be
+    an input, another output, or (for a file) an existing folder; its folder
+    must exist and be writable; a file needs a suffix from ``allowed``.
+    """
+    seen = {}
+    real_inputs = {os.path.realpath(p): str(p) for p in inputs if p}
+    for flag, path, allowed in outputs:
+        if path is None:
+            continue
+        path = Path(path)
+        where = f"{flag} {path}"
+        key = os.path.realpath(path)
+        if key in real_inputs:
+            raise SatmdError(f"{where}: is also the input {real_inputs[key]}; choose another output name")
+        if key in seen:
+            raise SatmdError(f"{where}: also given as {seen[key]}; choose different names")
+        seen[key] = flag
+        if allowed is None:  # a folder, created when missing
+            parent = path
+            while not parent.exists() and parent != parent.parent:  # the folders up to it are created
+                parent = parent.parent
+            if not parent.is_dir():
+                raise SatmdError(f"{where}: {parent} exists and is not a folder")
+        else:
+            if path.is_dir():
+                raise SatmdError(f"{where}: is a folder; give a file name")
+            if path.suffix.lower() not in allowed:
+                raise SatmdError(f"{where}: cannot write {path.suffix or 'files without a suffix'!r} "
+                                 f"(use {', '.join(allowed)})")
+            parent = path.parent
+            if not parent.is_dir():
+                raise SatmdError(f"{where}: folder {parent} does not exist")
+        if parent.exists() and not os.access(parent, os.W_OK | os.X_OK):
+            raise SatmdError(f"{where}: folder {parent} is not writable")
+
+
+# --- JSON: never NaN or Infinity ---------------------------------------------------
+def dumps_json(obj, command: str, **kw) -> str:
+    """JSON text with non-finite numbers written as null (standard JSON has no NaN); a note names them."""
+    nulled = []
+
+    def clean(x, where):
+        if isinstance(x, dict):
+            return {k: clean(v, f"{where}.{k}" if where else str(k)) for k, v in x.items()}
+        if isinstance(x, (list, tuple)):
+            return [clean(v, f"{where}[{i}]") for i, v in enumerate(x)]
+        if hasattr(x, "tolist") and not isinstance(x, (str, bytes)):  # numpy scalars and arrays
+            return clean(x.tolist(), where)
+        if isinstance(x, float) and not math.isfinite(x):
+            nulled.append(where)
+            return None
+        return x
+
+    text = json.dumps(clean(obj, ""), allow_nan=False, **kw)
+    if nulled:
+        shown = ", ".join(nulled[:6]) + (f" and {len(nulled) - 6} more" if len(nulled) > 6 else "")
+        print(f"satmd {command}: note: not finite, written as null: {shown}", file=sys.stderr)
+    return text
+
+
+# --- progress on stderr --------------------------------------------------------------
+class Progress:
+    """Stage lines for long work on stderr, at most one every ``every`` seconds unless forced.
+
+    ``satmd explain`` and friends call ``step(text)``; ``quiet`` silences it.
+    """
+
+    def __init__(self, command: str, quiet: bool = False, every: float = 5.0):
+        self.command, self.quiet, self.every = command, quiet, every
+        self.t0 = self.last = time.perf_counter()
+
+    def step(self, text: str, force: bool = False):
+        now = time.perf_counter()
+        if self.quiet or (not force and now - self.last < self.every):
+            return
+        self.last = now
+        print(f"satmd {self.command}: [{now - self.t0:5.0f} s] {text}", file=sys.stderr, flush=True)
 
 
 def parse_number(text: str, what: str) -> float:
@@ -34,6 +193,8 @@ def parse_freq(text: str) -> np.ndarray:
         raise SatmdError(f"--freq {text!r}: N must be an integer") from None
     if not (0 < lo < hi) or n < 2:
         raise SatmdError(f"--freq {text!r}: need 0 < LO < HI and N >= 2")
+    if n > MAX_FREQ_POINTS:
+        raise SatmdError(f"--freq {text!r}: {n} points is more than the {MAX_FREQ_POINTS} satmd computes at once")
     return np.linspace(lo, hi, n)
 
 
@@ -82,10 +243,17 @@ def parse_list(text: str | None) -> tuple[str, ...] | None:
     return tuple(s.strip() for s in text.split(",") if s.strip()) or None
 
 
+def name_list(text: str) -> str:
+    """An argparse ``type``: a comma-separated list that is not empty ('--free ""' is a mistake, not the default)."""
+    if not parse_list(text):
+        raise argparse.ArgumentTypeError(f"{text!r} names nothing; give comma-separated names")
+    return text
+
+
 def add_model_options(parser: argparse.ArgumentParser, free_help: str):
     """--free and --channels, shared by the commands that fit the model."""
-    parser.add_argument("--free", default="m2,kp,R,L", help=free_help)
-    parser.add_argument("--channels", default=None, help="channels to fit (default a1,a2 when present)")
+    parser.add_argument("--free", type=name_list, default="m2,kp,R,L", help=free_help)
+    parser.add_argument("--channels", type=name_list, default=None, help="channels to fit (default a1,a2 when present)")
 
 
 def parse_names(text: str, allowed, what: str) -> tuple[str, ...]:
@@ -98,7 +266,7 @@ def parse_names(text: str, allowed, what: str) -> tuple[str, ...]:
 
 def add_rig_options(parser: argparse.ArgumentParser, names=("m2", "kp", "R", "L")):
     for n in names:
-        parser.add_argument(f"--{n}", type=float, default=None, help=f"{n} (default {getattr(Rig(), n):g})")
+        parser.add_argument(f"--{n}", type=real(), default=None, help=f"{n} (default {getattr(Rig(), n):g})")
 
 
 def rig_from_args(args, names=("m2", "kp", "R", "L")) -> Rig:
@@ -118,6 +286,23 @@ def add_data_options(parser: argparse.ArgumentParser):
                         help="frequency axis in Hz for .txt files of complex values (one per line)")
 
 
+# the library names its parameters; the command line calls them by their flags
+_FLAGS = (("channel_map", "--map"), ("freq_axis", "--freq-axis"),
+          ("calibrate with scale (", "calibrate with --scale ("))
+
+
+def with_flags(text: str) -> str:
+    """Library parameter names in ``text`` replaced by the CLI's flags."""
+    for name, flag in _FLAGS:
+        text = text.replace(name, flag)
+    return text
+
+
+def cli_text(message) -> str:
+    """A library message on one line, in the CLI's words."""
+    return with_flags(" ".join(str(message).split()))
+
+
 @contextlib.contextmanager
 def one_line_warnings(command: str):
     """Show warnings raised while loading data as one line each on stderr (no source lines)."""
@@ -130,7 +315,7 @@ def one_line_warnings(command: str):
         finally:
             seen = set()
             for w in caught:
-                text = " ".join(str(w.message).split())
+                text = cli_text(w.message)
                 if text not in seen:
                     seen.add(text)
                     print(f"satmd {command}: warning: {text}", file=sys.stderr)
@@ -145,15 +330,20 @@ def load_data(args):
     from ..io import estimate_frf, is_recording, load_frf, load_recording
 
     command = getattr(args, "command", None) or "satmd"
+    if getattr(args, "plot", None):  # every output is checked before the first piece of work
+        check_outputs([("--plot", args.plot, plot_suffixes())], inputs=[args.data])
     lo, hi = parse_band(getattr(args, "band", None))
     with one_line_warnings(command):
         if is_recording(args.data):
             rec = load_recording(args.data, channel_map=getattr(args, "map", None))
             data = estimate_frf(rec, band=(lo, hi))
-            m = data.meta
-            print(f"satmd {command}: note: {args.data} is a time recording: FRFs estimated with {m['estimator']}, "
-                  f"nperseg={m['nperseg']} ({m['resolution_hz']} Hz), {m['segments']} averages "
-                  f"(use `satmd estimate-frf` for control)", file=sys.stderr)
+            from ..io.estimate import describe_estimate
+
+            print(f"satmd {command}: note: {args.data} is a time recording: FRFs estimated by "
+                  f"{describe_estimate(data)} (use `satmd estimate-frf` for control)", file=sys.stderr)
+            for finding in data.estimator.get("measurement", []):
+                print(f"satmd {command}: measurement: {finding['explanation']}; remedy: {finding['remedy']}",
+                      file=sys.stderr)
             return data
         options = {}
         if getattr(args, "map", None):
@@ -161,4 +351,9 @@ def load_data(args):
         if getattr(args, "freq_axis", None):
             options["freq_axis"] = args.freq_axis
         data = load_frf(args.data, **options)
+    for ch, s in data.std.items():  # every data command weights by the std: a zero is unusable
+        if np.any(s == 0):
+            k = int(np.argmax(s == 0))
+            raise FormatError(args.data, f"{ch}_std is 0 in data row {k + 1} ({data.freq_hz[k]:.6g} Hz): a point "
+                                         f"without noise cannot be weighted; drop the std columns or fix the row")
     return data.band(lo, hi) if (lo is not None or hi is not None) else data

@@ -1,30 +1,38 @@
 """satmd estimate-frf: FRFs (or transmissibilities) with coherence and std from a time recording."""
 from __future__ import annotations
 
+import sys
 from pathlib import Path
 
 import numpy as np
 
 from ..errors import SatmdError
-from ._common import add_rig_options, one_line_warnings, parse_band, parse_kv, rig_from_args
+from ..io.atomic import all_or_none
+from ._common import (add_rig_options, check_outputs, integer, one_line_warnings, parse_band, parse_kv, plot_suffixes,
+                      rig_from_args)
 
 
 def register(sub):
     p = sub.add_parser("estimate-frf", help="FRFs with coherence and std from a force/acceleration recording",
-                       description="Welch-averaged H1/H2 FRFs A1 = acc1/force, A2 = acc2/force with coherence and "
-                                   "the coherence-based std of Bendat & Piersol (written as std columns). A "
-                                   "recording without force (output-only) gives the transmissibility A2/A1.")
+                       description="FRFs A1 = acc1/force, A2 = acc2/force with std columns and coherence. By "
+                                   "default the local polynomial method on the full record (no window, full "
+                                   "resolution, leakage and transient removed, independent points, std from the "
+                                   "local residual) over the band the force excites; Welch H1/H2 on request. A "
+                                   "recording without force (output-only) gives the transmissibility A2/A1 (Welch).")
     p.add_argument("recording", metavar="REC", help="time recording (.csv time_s,force,acc1,acc2; .uff; .wav; "
                                                     ".npz; .mat)")
     p.add_argument("-o", "--out", required=True, metavar="FRF.csv",
                    help="output: FRFs as .csv, .uff, .npz or .mat (coherence kept except in .csv); "
                         "a transmissibility as .csv")
-    p.add_argument("--nperseg", type=int, default=None, metavar="N",
-                   help="samples per segment (default: ≈0.5 Hz resolution, at least 16 averages)")
-    p.add_argument("--window", default="hann", help="window (any scipy.signal.get_window name; default hann)")
-    p.add_argument("--overlap", type=float, default=0.5, help="segment overlap fraction (default 0.5)")
-    p.add_argument("--estimator", default="H1", choices=("H1", "H2"), help="H1: noise on the responses (default); "
-                                                                          "H2: noise on the force")
+    p.add_argument("--estimator", default=None, choices=("lpm", "H1", "H2"),
+                   help="lpm: local polynomial method (default); Welch H1: noise on the responses; Welch H2: "
+                        "noise on the force")
+    p.add_argument("--width", type=float, default=None, metavar="HZ",
+                   help="lpm: width of each local window in Hz (default 0.3, narrower for sharper resonances)")
+    p.add_argument("--nperseg", type=integer(8), default=None, metavar="N",
+                   help="Welch: samples per segment (default: ≈0.5 Hz resolution, at least 16 averages)")
+    p.add_argument("--window", default=None, help="Welch: window (any scipy.signal.get_window name; default hann)")
+    p.add_argument("--overlap", type=float, default=None, help="Welch: segment overlap fraction (default 0.5)")
     p.add_argument("--band", default=None, metavar="LO:HI", help="keep only LO <= f <= HI Hz")
     p.add_argument("--map", default=None, metavar="force=#1,a1=NODE:DIR,a2=#3",
                    help="which UFF records / WAV channels are force, a1 and a2")
@@ -37,17 +45,26 @@ def register(sub):
 
 
 def run(args):
-    from ..io import estimate_frf, load_recording, save_frf, save_transmissibility, transmissibility
+    from ..io import WRITERS
+
+    check_outputs([("-o", args.out, tuple(sorted(WRITERS))), ("--plot", args.plot, args.plot and plot_suffixes())],
+                  inputs=[args.recording])
+    with all_or_none():  # the data file and the figure appear together or not at all
+        return _run(args)
+
+
+def _run(args):
+    from ..io import FRFData, estimate_frf, load_recording, save_frf, save_transmissibility, transmissibility
+    from ..io.estimate import describe_estimate
 
     scale = parse_kv(args.scale, "--scale") if args.scale else None
     band = parse_band(args.band)
     out = Path(args.out)
     with one_line_warnings("estimate-frf"):
         rec = load_recording(args.recording, channel_map=args.map, scale=scale)
-        options = dict(nperseg=args.nperseg, window=args.window, overlap=args.overlap,
-                       estimator=args.estimator, band=band)
+        options = dict(nperseg=args.nperseg, window=args.window, overlap=args.overlap, band=band)
         if rec.has_force:
-            data = estimate_frf(rec, **options)
+            data = estimate_frf(rec, estimator=args.estimator, width_hz=args.width, **options)
             save_frf(data, out)
             kind = f"FRFs {', '.join(data.channels)}"
             freq, coh = data.freq_hz, data.coherence
@@ -59,15 +76,25 @@ def run(args):
                                  f"--map a1=#N,a2=#M")
             if out.suffix.lower() != ".csv":
                 raise SatmdError(f"{out}: a transmissibility is written as .csv")
-            t = transmissibility(rec, **options)
+            if args.estimator == "lpm":
+                raise SatmdError(f"{args.recording}: an output-only recording gives a transmissibility, "
+                                 f"estimated by Welch H1/H2, not lpm")
+            t = transmissibility(rec, estimator=args.estimator or "H1",
+                                 **{k: v for k, v in options.items() if v is not None})
             save_transmissibility(t, out)
             kind = "transmissibility A2/A1 (output-only recording)"
             freq, coh = t.freq_hz, {"T": t.coherence}
             curves = {"T": (t.value, t.std, t.model(rig_from_args(args)))}
             data = t
     m = data.meta
-    print(f"wrote {out}: {kind}, {len(freq)} points {freq[0]:.6g}..{freq[-1]:.6g} Hz, {m['estimator']}, "
-          f"nperseg={m['nperseg']} ({m['resolution_hz']} Hz), {m['segments']} averages, "
+    if isinstance(data, FRFData):
+        how = describe_estimate(data)
+        for finding in data.estimator.get("measurement", []):
+            print(f"satmd estimate-frf: measurement: {finding['explanation']}; remedy: {finding['remedy']}",
+                  file=sys.stderr)
+    else:
+        how = f"Welch {m['estimator']}, nperseg={m['nperseg']} ({m['resolution_hz']} Hz), {m['segments']} averages"
+    print(f"wrote {out}: {kind}, {len(freq)} points {freq[0]:.6g}..{freq[-1]:.6g} Hz, {how}, "
           f"median coherence {np.median(np.concatenate(list(coh.values()))):.3f}")
     if args.plot:
         plot_estimate(freq, curves, coh, args.plot, title=f"{Path(args.recording).name}: {kind}")
@@ -80,9 +107,9 @@ LABELS = {"a1": "A1 = acc1/force", "a2": "A2 = acc2/force", "T": "T = A2/A1"}
 
 def plot_estimate(freq, curves, coherence, path, title=""):
     """|H| with ±2σ, phase and coherence for each curve; a model overlay where given."""
-    from ..plots import _plt, save
+    from ..plots import pyplot, save
 
-    plt = _plt()
+    plt = pyplot()
     names = list(curves)
     fig, axes = plt.subplots(3, len(names), figsize=(4.4 * len(names), 7.5), squeeze=False, sharex=True)
     for j, name in enumerate(names):

@@ -1,10 +1,10 @@
 """satmd explain: use case III for a trained inverse model (figures + markdown summary)."""
 from __future__ import annotations
 
-import json
 from pathlib import Path
 
 from ..errors import SatmdError
+from ._common import Progress, check_outputs, dumps_json, integer
 
 BACKENDS = ("operon", "pysr", "sindy")
 
@@ -20,9 +20,11 @@ def register(sub):
     p.add_argument("--out", default=None, metavar="DIR", help="output folder (default MODELDIR/explain)")
     p.add_argument("--backend", default="operon", choices=BACKENDS,
                    help="symbolic-regression backend (default operon; pysr needs a Julia runtime)")
-    p.add_argument("--threads", type=int, default=1, metavar="N", help="threads for the symbolic search (default 1)")
+    p.add_argument("--threads", type=integer(1), default=1, metavar="N",
+                   help="threads for the symbolic search (default 1)")
     p.add_argument("--quick", action="store_true", help="smaller latent set and shorter symbolic searches")
     p.add_argument("--no-distill", action="store_true", help="skip the symbolic distillation")
+    p.add_argument("--quiet", action="store_true", help="no progress lines on stderr")
     p.set_defaults(func=run)
 
 
@@ -35,39 +37,48 @@ def load_model(path):
 
 
 def run(args):
-    if args.threads < 1:
-        raise SatmdError("--threads must be >= 1")
     model_dir = Path(args.model)
     if not model_dir.is_dir():
         raise SatmdError(f"{model_dir}: no such model folder")
+    out = Path(args.out) if args.out else model_dir / "explain"
+    check_outputs([("--out", out, None)])
     if args.backend == "pysr":
-        from ..explain._backends import julia_runtime
+        from ..explain.backends import julia_runtime
 
         if julia_runtime() is None:  # refuse before any work is done
             raise SatmdError("the pysr backend needs a Julia runtime (julia not found on PATH); use --backend operon")
     model = load_model(model_dir)
-    from ..explain._model import check_net_model
+    from ..explain.contract import check_net_model
 
     check_net_model(model)
-    from ..explain.run import explain_model
+    from ..report.explain_text import explain_model
+    from ..io.atomic import all_or_none, atomic_write
     from ..plots import save
 
-    out = Path(args.out) if args.out else model_dir / "explain"
     fig_dir = out / "figures"
     written = []
+    progress = Progress("explain", quiet=args.quiet)
+    progress.step(f"attribution, latent and sensitivity of {model_dir}"
+                  + ("" if args.no_distill else f", then symbolic distillation ({args.backend})")
+                  + ("" if args.quick else "; about a minute or more (--quick for less)"), force=True)
 
     def figure(fig, name):
         written.append(save(fig, fig_dir / name))
+        progress.step(f"{len(written)} figure(s) drawn, last {name}", force=True)
         return f"![{name}](figures/{name})"
 
-    md, results = explain_model(model, figure, backend=args.backend, quick=args.quick,
-                                symbolic=not args.no_distill, n_threads=args.threads)
-    out.mkdir(parents=True, exist_ok=True)
-    head = [f"# satmd explain: {model_dir}", "",
-            f"Model kind `{model.kind}`, {len(model.networks_)} network(s), grid of {len(model.freq_hz)} "
-            f"frequencies.", ""]
-    (out / "summary.md").write_text("\n".join(head) + md + "\n", encoding="utf-8")
-    (out / "explain.json").write_text(json.dumps(results, indent=1, default=_json_default), encoding="utf-8")
+    with all_or_none():  # figures, summary and JSON appear together or not at all
+        md, results = explain_model(model, figure, backend=args.backend, quick=args.quick,
+                                    symbolic=not args.no_distill, n_threads=args.threads)
+        out.mkdir(parents=True, exist_ok=True)
+        head = [f"# satmd explain: {model_dir}", "",
+                f"Model kind `{model.kind}`, {len(model.networks_)} network(s), grid of {len(model.freq_hz)} "
+                f"frequencies.", ""]
+        with atomic_write(out / "summary.md", "w") as fh:
+            fh.write("\n".join(head) + md + "\n")
+        with atomic_write(out / "explain.json", "w") as fh:
+            fh.write(dumps_json(results, "explain", indent=1, default=_json_default))
+
     def peaks(t):
         return "/".join(f"{p:.0f}" for p in sorted(t["R"]["peaks_hz"]))
 

@@ -1,9 +1,8 @@
 """satmd identify: grey-box fit of m2, kp, R, L (or any free parameters) to an FRF file."""
 from __future__ import annotations
 
-import json
-
-from ._common import add_data_options, add_model_options, load_data, parse_list, parse_effect, parse_kv
+from ._common import (add_data_options, add_model_options, dumps_json, load_data, one_line_warnings, parse_effect,
+                      parse_kv, parse_list, real)
 
 
 def register(sub):
@@ -15,7 +14,7 @@ def register(sub):
     p.add_argument("--init", default=None, metavar="m2=0.3,...", help="start values (also the nominal values)")
     p.add_argument("--effect", action="append", default=[], metavar="NAME:key=value,...",
                    help="include a known effect in the model (repeatable)")
-    p.add_argument("--reg", type=float, default=0.0, help="λ_reg of paper eq. 13 (default 0: unbiased)")
+    p.add_argument("--reg", type=real(0), default=0.0, help="λ_reg of paper eq. 13 (default 0: unbiased)")
     p.add_argument("--local", action="store_true", help="skip the global search (start from --init only)")
     p.add_argument("--ci", action="store_true", help="also compute 95 %% profile-likelihood intervals")
     p.add_argument("--json", action="store_true", help="print the result as JSON only")
@@ -25,14 +24,16 @@ def register(sub):
 
 def run(args):
     from ..identify import identify
+    from ..identify.intervals import describe_interval, intervals_to_dict
 
     data = load_data(args)
     free = parse_list(args.free) or ("m2", "kp", "R", "L")
     channels = parse_list(args.channels)
     effects = [parse_effect(e) for e in args.effect]
     start = parse_kv(args.init, "--init") if args.init else None
-    fit = identify(data, free=free, channels=channels, effects=effects, start=start, reg=args.reg,
-                   global_search=not args.local)
+    with one_line_warnings("identify"):  # poor fit / pinned: on stderr with --json (the report lists them)
+        fit = identify(data, free=free, channels=channels, effects=effects, start=start, reg=args.reg,
+                       global_search=not args.local, warn=bool(args.json))
     if args.plot:
         from ..plots import fit_figure, save
 
@@ -44,12 +45,18 @@ def run(args):
     if args.json:
         out = fit.to_dict()
         if args.ci:
-            out["confidence_intervals_95"] = {k: list(v) for k, v in fit.confidence_intervals().items()}
-        print(json.dumps(out, indent=2))
+            ci = intervals_to_dict(fit.confidence_intervals())
+            out["confidence_intervals_95"] = ci["intervals"]  # null: that side is open (see _open)
+            out["confidence_intervals_95_open"] = ci["open"]
+        if data.estimator:  # FRFs estimated from a recording: say how, and what the chain did (SPEC §9)
+            out["estimator"] = {k: v for k, v in data.estimator.items() if k != "measurement"}
+            out["measurement"] = [{k: m[k] for k in ("name", "explanation", "remedy")}
+                                  for m in data.estimator.get("measurement", [])]
+        print(dumps_json(out, "identify", indent=2))
         return 0
     print(fit.report())
     if args.ci:
         print("[[95 % profile-likelihood intervals]]")
         for name, (lo, hi) in fit.confidence_intervals().items():
-            print(f"    {name:<10} [{lo:.8g}, {hi:.8g}]")
+            print(f"    {name:<10} {describe_interval(lo, hi)}")
     return 0

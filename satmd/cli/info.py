@@ -114,7 +114,9 @@ def _uff(path, channel_map) -> list[str]:
 
 def _tail(exc) -> str:
     """The message without the leading file name (the header line names the file)."""
-    text = str(exc)
+    from ._common import with_flags
+
+    text = with_flags(str(exc))
     return text.split(": ", 1)[1] if ": " in text else text
 
 

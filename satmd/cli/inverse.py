@@ -1,9 +1,8 @@
 """satmd inverse: train, apply and evaluate the amortized inverse (use case II)."""
 from __future__ import annotations
 
-import json
-
 from ..errors import SatmdError
+from ._common import SEED, check_outputs, dumps_json, integer, real
 
 KINDS = ("physics", "supervised", "hybrid", "optimization")
 
@@ -22,17 +21,18 @@ def register(sub):
                         "net + least-squares refinement) or optimization (nothing to train)")
     t.add_argument("--preset", default="paper", choices=("paper", "box"),
                    help="paper: the 30 reference pairs with jitter; box: R, L independent (default paper)")
-    t.add_argument("--noise", type=float, default=0.0, metavar="REL",
+    t.add_argument("--noise", type=real(0, 1, hi_open=True), default=0.0, metavar="REL",
                    help="relative input noise during training, e.g. 0.01 (default 0)")
-    t.add_argument("--epochs", type=int, default=None, help="training epochs (default per preset)")
-    t.add_argument("--warm-start", type=int, default=None, metavar="N",
-                   help="supervised warm-start epochs before the physics loss (default per preset)")
-    t.add_argument("--samples-per-pair", type=int, default=None, help="paper preset: samples per pair (default 150)")
-    t.add_argument("--samples", type=int, default=None, help="box preset: number of samples (default 6000)")
-    t.add_argument("--members", type=int, default=5, help="ensemble members (default 5)")
-    t.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
+    t.add_argument("--epochs", type=integer(1), default=None, help="training epochs (default 90)")
+    t.add_argument("--warm-start", type=integer(0), default=None, metavar="N",
+                   help="supervised warm-start epochs before the physics loss (default 50)")
+    t.add_argument("--samples-per-pair", type=integer(1), default=None,
+                   help="paper preset: samples per pair (default 150)")
+    t.add_argument("--samples", type=integer(1), default=None, help="box preset: number of samples (default 6000)")
+    t.add_argument("--members", type=integer(1, 256), default=5, help="ensemble members (default 5)")
+    t.add_argument("--seed", type=SEED, default=0, help="random seed (default 0)")
     t.add_argument("--device", default=None, help="cpu or cuda (default: cuda when present)")
-    t.add_argument("--threads", type=int, default=None,
+    t.add_argument("--threads", type=integer(1), default=None,
                    help="torch CPU threads for training (default 1: the fastest for this small net)")
     t.add_argument("--quiet", action="store_true", help="no progress bar")
     t.add_argument("--out", required=True, metavar="DIR", help="folder for the saved model")
@@ -40,7 +40,9 @@ def register(sub):
 
     q = isub.add_parser("predict", help="predict R and L of one FRF file",
                         description="Predict the shunt R and L (with standard deviations) of a measured FRF file "
-                                    "with channels a1, a2 on the model's frequency grid.")
+                                    "(channels a1, a2) or time recording. Data on another grid are brought onto the "
+                                    "model's (spline inside the data's span, the least-squares forward model outside "
+                                    "it, with a warning), and the prediction is checked through the forward model.")
     q.add_argument("model", metavar="DIR", help="saved model folder")
     from ._common import add_data_options
 
@@ -51,10 +53,23 @@ def register(sub):
     e = isub.add_parser("evaluate", help="the six blind pairs of the paper's Table 2",
                         description="Evaluate a saved model on the six blind (R, L) pairs of SPEC §5.")
     e.add_argument("model", metavar="DIR", help="saved model folder")
-    e.add_argument("--noise", type=float, default=0.0, metavar="REL", help="input noise on the blind FRFs (default 0)")
-    e.add_argument("--seed", type=int, default=0, help="noise seed")
+    e.add_argument("--noise", type=real(0, 1, hi_open=True), default=0.0, metavar="REL",
+                   help="input noise on the blind FRFs (default 0)")
+    e.add_argument("--seed", type=SEED, default=0, help="noise seed")
     e.add_argument("--json", action="store_true", help="print JSON")
     e.set_defaults(func=run_evaluate)
+
+
+def check_device(device):
+    """The library's device check (`satmd.inverse.training.check_device`), naming the option."""
+    if device is None or device == "cpu":
+        return
+    from ..inverse.training import check_device as check
+
+    try:
+        check(device)
+    except SatmdError as exc:
+        raise SatmdError(f"--{exc}") from None
 
 
 def _load(path):
@@ -66,21 +81,24 @@ def _load(path):
 def run_train(args):
     from ..inverse import InverseModel
 
-    if args.noise < 0 or args.noise >= 1:
-        raise SatmdError(f"--noise {args.noise}: must be a relative level in [0, 1)")
-    for name in ("epochs", "samples_per_pair", "samples", "members"):
-        v = getattr(args, name)
-        if v is not None and v < 1:
-            raise SatmdError(f"--{name.replace('_', '-')} must be >= 1")
-    if args.warm_start is not None and args.warm_start < 0:
-        raise SatmdError("--warm-start must be >= 0")
-    if args.threads is not None and args.threads < 1:
-        raise SatmdError("--threads must be >= 1")
-    model = InverseModel(kind=args.kind, preset=args.preset, noise=args.noise, epochs=args.epochs,
-                         warm_start_epochs=args.warm_start, samples_per_pair=args.samples_per_pair,
-                         n_samples=args.samples, n_members=args.members, seed=args.seed, device=args.device,
-                         threads=args.threads or 1,
-                         verbose=not args.quiet)
+    # a size option of the other preset would be ignored: refuse it
+    other = {"paper": ("samples", "--samples"), "box": ("samples_per_pair", "--samples-per-pair")}[args.preset]
+    if getattr(args, other[0]) is not None:
+        raise SatmdError(f"{other[1]} does not apply to --preset {args.preset}")
+    from ..inverse.strategies import STRATEGIES
+
+    if not STRATEGIES[args.kind].has_net:
+        for flag, value in (("--epochs", args.epochs), ("--warm-start", args.warm_start)):
+            if value is not None:
+                raise SatmdError(f"{flag} does not apply to --kind {args.kind} (nothing is trained)")
+    check_device(args.device)
+    check_outputs([("--out", args.out, None)])
+    given = {"epochs": args.epochs, "warm_start_epochs": args.warm_start, "samples_per_pair": args.samples_per_pair,
+             "n_samples": args.samples, "threads": args.threads}
+    # options left out keep the model's defaults (one source: InverseModel's signature)
+    model = InverseModel(kind=args.kind, preset=args.preset, noise=args.noise, n_members=args.members, seed=args.seed,
+                         device=args.device, verbose=not args.quiet,
+                         **{k: v for k, v in given.items() if v is not None})
     model.fit()
     model.save(args.out)
     info = model.fit_info_
@@ -94,23 +112,36 @@ def run_train(args):
 
 
 def run_predict(args):
+    import sys
+    import warnings
+
+    from ..io import DataWarning
     from ._common import load_data
 
     model = _load(args.model)
     data = load_data(args)
-    p = model.predict_one(data)
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always", DataWarning)
+        p = model.predict_one(data)
+    notes = list(dict.fromkeys(" ".join(str(w.message).split()) for w in caught if w.category is DataWarning))
+    for w in caught:
+        if w.category is not DataWarning:
+            warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
+    for note in notes:
+        print(f"satmd inverse predict: warning: {note}", file=sys.stderr)
     if args.json:
-        print(json.dumps(p))
-    else:
-        print(f"R = {p['R']:.6g} ± {p['R_std']:.2g} Ω")
-        print(f"L = {p['L']:.6g} ± {p['L_std']:.2g} H")
+        print(dumps_json({**p, "warnings": notes}, "inverse predict"))
+        return
+    print(f"R = {p['R']:.6g} ± {p['R_std']:.2g} Ω")
+    print(f"L = {p['L']:.6g} ± {p['L_std']:.2g} H")
+    verdict = "explained" if p["explained"] else "NOT explained: do not trust R, L"
+    print(f"forward check: residual {p['residual']:.3g} = {p['residual_ratio']:.2g} x expected "
+          f"{p['residual_expected']:.2g} (limit 3): {verdict}")
 
 
 def run_evaluate(args):
     from ..inverse import PAPER_TABLE2, evaluate
 
-    if args.noise < 0 or args.noise >= 1:
-        raise SatmdError(f"--noise {args.noise}: must be a relative level in [0, 1)")
     model = _load(args.model)
     res = evaluate(model, noise=args.noise, seed=args.seed)
     rows = []
@@ -121,8 +152,8 @@ def run_evaluate(args):
                      "paper_R_pred": float(PAPER_TABLE2[i, 2]), "paper_L_pred": float(PAPER_TABLE2[i, 3])})
     summary = {k: res[k] for k in ("mae_R", "mae_L", "rel_R", "rel_L", "frf_error", "coverage", "infer_s_per_frf")}
     if args.json:
-        print(json.dumps({"kind": model.kind, "preset": model.preset, "noise": args.noise, "rows": rows,
-                          **summary, "paper": {"mae_R": 0.0823, "mae_L": 0.000572}}, indent=1))
+        print(dumps_json({"kind": model.kind, "preset": model.preset, "noise": args.noise, "rows": rows,
+                          **summary, "paper": {"mae_R": 0.0823, "mae_L": 0.000572}}, "inverse evaluate", indent=1))
         return
     print(f"{model.kind} model (preset {model.preset}), six blind pairs, input noise {args.noise:g}")
     print(f"{'R':>6} {'L':>6} {'R_pred':>10} {'±':>8} {'L_pred':>9} {'±':>9} {'|eR|':>8} {'|eL|':>9}")

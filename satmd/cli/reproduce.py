@@ -14,7 +14,9 @@ def register(sub):
 
 def run(args):
     from ..report import reproduce
+    from ._common import check_outputs
 
+    check_outputs([("--out", args.out, None)])
     only = [s.strip() for s in args.only.split(",")] if args.only else None
     index = reproduce(args.out, only=only, quick=args.quick)
     print(f"report written to {index} (and index.html)")

@@ -2,11 +2,20 @@
 from __future__ import annotations
 
 from ..errors import SatmdError
-from ..io import CHANNELS, save_frf
+from ..io import CHANNELS, WRITERS, save_frf
+from ..io.atomic import all_or_none
+from ..io.recording import RECORDING_WRITERS
 from ..physics import PAPER_GRID_HZ
 from ..simulate import simulate
 from ._common import (
+    MAX_SAMPLES,
+    SEED,
     add_rig_options,
+    check_outputs,
+    option_defaults,
+    plot_suffixes,
+    real,
+    refuse_unused,
     parse_band,
     parse_effect,
     parse_freq,
@@ -25,7 +34,7 @@ def register(sub):
                         "parameter_offset:k1:value=2e5 (repeatable)")
     p.add_argument("--noise", default=None, metavar="REL[:FLOOR]",
                    help="Gaussian noise with std = REL|A| + FLOOR max|A| on Re and Im; adds std columns")
-    p.add_argument("--seed", type=int, default=None, help="random seed for the noise")
+    p.add_argument("--seed", type=SEED, default=None, help="random seed for the noise")
     p.add_argument("--freq", default="40:130:60", metavar="LO:HI:N", help="frequency grid (default 40:130:60)")
     p.add_argument("--channels", default="a1,a2", help="channels to write, from a1,a2,u1,u2,q (default a1,a2)")
     p.add_argument("-o", "--out", required=True, metavar="OUT.csv",
@@ -34,13 +43,25 @@ def register(sub):
     t.add_argument("--time", action="store_true",
                    help="write a time recording (force, acc1, acc2) instead of FRFs: band-limited random force "
                         "through the linear model; --noise REL is then sensor noise relative to each channel's RMS")
-    t.add_argument("--duration", type=float, default=60.0, metavar="S", help="recording length in s (default 60)")
-    t.add_argument("--fs", type=float, default=1000.0, metavar="HZ", help="sample rate in Hz (default 1000)")
+    t.add_argument("--duration", type=real(0, lo_open=True), default=60.0, metavar="S",
+                   help="recording length in s (default 60)")
+    t.add_argument("--fs", type=real(0, lo_open=True), default=1000.0, metavar="HZ",
+                   help="sample rate in Hz (default 1000)")
     t.add_argument("--force-band", default="20:200", metavar="LO:HI",
                    help="excitation band in Hz (default 20:200)")
     t.add_argument("--force-rms", type=float, default=1.0, metavar="N", help="RMS force in N (default 1)")
+    t.add_argument("--excitation", default="random", choices=("random", "sweep", "multisine"),
+                   help="random: band-limited non-periodic noise, rig at rest at t = 0 (default, as on a rig); "
+                        "sweep: one log sine sweep; multisine: periodic, exact steady state (the ideal case)")
+    t.add_argument("--force-noise", type=float, default=None, metavar="REL",
+                   help="force-sensor noise relative to the force RMS (default: half of --noise)")
+    t.add_argument("--burn-in", type=float, default=0.0, metavar="S",
+                   help="seconds of excitation before the record starts (default 0: starts at rest)")
     p.add_argument("--plot", default=None, metavar="OUT.png", help="also plot the FRFs")
-    p.set_defaults(func=run)
+    # options of one mode given in the other are refused, not ignored
+    p.set_defaults(func=run, time_only=option_defaults(t),
+                   frf_only={a.dest: (a.option_strings[0], a.default) for a in p._actions
+                             if a.dest in ("freq", "channels")})
 
 
 def parse_noise(text):
@@ -54,18 +75,24 @@ def parse_noise(text):
 
 
 def run(args):
+    if args.time:
+        refuse_unused(args, args.frf_only, "only without --time (a recording's grid follows from --fs, --duration)")
+    else:
+        refuse_unused(args, args.time_only, "only with --time")
     rig = rig_from_args(args)
     effects = [parse_effect(e) for e in args.effect]
     if args.time:
         return run_time(args, rig, effects)
     freq = parse_freq(args.freq) if args.freq else PAPER_GRID_HZ
     channels = parse_names(args.channels, CHANNELS, "--channels")
+    check_outputs([("-o", args.out, tuple(sorted(WRITERS))), ("--plot", args.plot, args.plot and plot_suffixes())])
     data = simulate(freq, rig, effects, channels, noise=parse_noise(args.noise), seed=args.seed)
-    save_frf(data, args.out)
-    if args.plot:
-        from ..plots import plot_frfdata
+    with all_or_none():
+        save_frf(data, args.out)
+        if args.plot:
+            from ..plots import plot_frfdata
 
-        plot_frfdata(data, args.plot, title=f"simulated: {', '.join(e.name for e in effects) or 'nominal model'}")
+            plot_frfdata(data, args.plot, title=f"simulated: {', '.join(e.name for e in effects) or 'nominal model'}")
     print(f"wrote {args.out} ({len(data)} points, channels {', '.join(channels)})")
 
 
@@ -81,8 +108,14 @@ def run_time(args, rig, effects):
     lo, hi = parse_band(args.force_band)
     if lo is None or hi is None:
         raise SatmdError(f"--force-band {args.force_band!r}: expected LO:HI in Hz")
+    n = args.duration * args.fs
+    if n > MAX_SAMPLES:
+        raise SatmdError(f"--duration {args.duration:g} s at --fs {args.fs:g} Hz is {n:.3g} samples per channel; "
+                         f"at most {MAX_SAMPLES} (e.g. --duration {MAX_SAMPLES // args.fs:g})")
+    check_outputs([("-o", args.out, tuple(sorted(RECORDING_WRITERS)))])
     rec = simulate_recording(args.duration, args.fs, rig, effects, band_hz=(lo, hi), force_rms=args.force_rms,
-                             noise=noise[0] if noise else 0.0, seed=args.seed)
+                             noise=noise[0] if noise else 0.0, seed=args.seed, excitation=args.excitation,
+                             force_noise=args.force_noise, burn_in_s=args.burn_in)
     save_recording(rec, args.out)
     print(f"wrote {args.out} ({rec.n_samples} samples at {rec.fs_hz:g} Hz = {rec.duration_s:g} s, "
           f"channels {', '.join(rec.channels)})")

@@ -9,32 +9,114 @@ Steps (each module says how):
 1. fit the nominal model globally (`satmd.identify`);
 2. noise from the std columns, or estimated (`noise.py`);
 3. locate and decide with calibrated χ² tests (`locate.py`);
-4. explain: candidates from the SPEC §8 vocabulary, BIC model selection
-   with backward elimination, swaps and equivalents (`select.py`);
+4. explain: every registered effect is a candidate, started where its own
+   declarations say (`candidates.py`); BIC model selection with backward
+   elimination, swaps and equivalents (`select.py`). No effect is named here:
+   what an effect is, how to search for it and how to say it in words lives
+   in its class (`satmd.physics.effects`);
 5. when the vocabulary cannot explain a significant mismatch: `unexplained`,
    with a smooth data-driven correction showing how much of it is structured
    (`discrepancy.py`);
-6. report (`report.py`).
+6. typed findings (`findings.py`), formatted by the report (`report.py`).
 """
 from __future__ import annotations
 
 import time
+from functools import partial
 from typing import Sequence
 
+from .._fleet import fleet_map
 from ..identify import identify
 from ..io.frfdata import FRFData
 from ..physics import Rig
 from .candidates import default_candidates
 from .discrepancy import fit_discrepancy
+from .findings import UNEXPLAINED, EffectFinding, UnexplainedFinding
 from .locate import test_mismatch
 from .noise import estimate_std
-from .report import SCHEMA, DiscoveryReport, explain
+from .report import SCHEMA, DiscoveryReport, describe_effect, describe_unexplained
 from .select import Model, Search, equivalents, select
 
-__all__ = ["discover", "DiscoveryReport", "SCHEMA"]
+__all__ = ["discover", "discover_many", "discover_frf", "DiscoveryReport", "EffectFinding", "UnexplainedFinding",
+           "SCHEMA"]
 
 
 def discover(
+    data,
+    rig: Rig | None = None,
+    free: Sequence[str] = ("m2", "kp", "R", "L"),
+    candidates: Sequence[str] | None = None,
+    channels: Sequence[str] | None = None,
+    alpha: float = 1e-3,
+    max_effects: int = 3,
+) -> DiscoveryReport:
+    """Find what physics the nominal model leaves out of ``data``.
+
+    Parameters
+    ----------
+    data : FRFData or Recording
+        Measured FRFs, or a force/acceleration recording: its FRFs are then
+        estimated by `satmd.io.estimate_frf` (local polynomial method, std from
+        the recording's own noise). For FRFs estimated from a recording the
+        report adds ``estimator`` and the ``measurement`` findings of the chain,
+        kept apart from physics.
+    rig : values of the fixed parameters (default: the paper's rig).
+    free : parameters fitted in every model (default m2, kp, R, L).
+    candidates : effect names to consider (default: every registered effect).
+    channels : channels to fit (default a1, a2 when present, else all).
+    alpha : level of the mismatch test (global and band-wise together).
+    max_effects : most effects a model may hold.
+
+    Returns
+    -------
+    DiscoveryReport
+    """
+    from dataclasses import replace
+
+    from ..io.recording import Recording
+
+    if isinstance(data, Recording):
+        from ..io.estimate import estimate_frf
+
+        data = estimate_frf(data)
+    report = discover_frf(data, rig, free, candidates, channels, alpha, max_effects)
+    if not data.estimator:
+        return report
+    return replace(report, estimator=dict(data.estimator), measurement=list(data.estimator.get("measurement", [])))
+
+
+def _discover_one(data, kwargs):
+    return discover(data, **kwargs)
+
+
+def discover_many(datas: Sequence, executor=None, progress: bool = False, chunksize: int = 1,
+                  **kwargs) -> list[DiscoveryReport]:
+    """Run `discover` on every dataset in ``datas`` (same keyword arguments).
+
+    Parameters
+    ----------
+    datas : sequence of FRFData or Recording
+        One discovery each.
+    executor : concurrent.futures.Executor or None
+        A ProcessPoolExecutor spreads the fleet over cores, a Dask
+        ``distributed.Client(address).get_executor()`` over machines; None runs
+        in this process. The reports are the serial ones bit for bit (apart
+        from their ``wall_time``).
+    progress : show progress on stderr.
+    chunksize : datasets sent to a worker as one task.
+    **kwargs :
+        Passed to `discover` (rig, free, candidates, channels, alpha, max_effects).
+
+    Returns
+    -------
+    list of DiscoveryReport
+        In input order.
+    """
+    return fleet_map(partial(_discover_one, kwargs=kwargs), datas, executor, chunksize, progress, "discover",
+                     "dataset")
+
+
+def discover_frf(
     data: FRFData,
     rig: Rig | None = None,
     free: Sequence[str] = ("m2", "kp", "R", "L"),
@@ -51,9 +133,15 @@ def discover(
     rig : values of the fixed parameters (default: the paper's rig).
     free : parameters fitted in every model (default m2, kp, R, L; their true
         values may be anywhere in the SPEC §9 ranges).
-    candidates : effect names to consider (default: the whole vocabulary).
+    candidates : effect names to consider (default: every registered effect,
+        `satmd.physics.effects.registered_names`).
+    channels : channels to fit (default a1, a2 when present, else all).
     alpha : level of the mismatch test (global and band-wise together).
     max_effects : most effects a model may hold.
+
+    Returns
+    -------
+    DiscoveryReport
     """
     t0 = time.perf_counter()
     rig = Rig() if rig is None else rig
@@ -64,6 +152,8 @@ def discover(
 
     nominal_fit = identify(data, rig, free, channels)
     noise, noise_dof = "given", None
+    if str(data.estimator.get("method", "")).startswith("welch"):
+        noise_dof = data.estimator.get("noise_dof")  # a Welch std rests on a few dozen averages: F tests
     if not data.has_std:
         noise = "estimated"
         data = data.with_std(estimate_std(data, nominal_fit))
@@ -73,9 +163,10 @@ def discover(
     before = _fit_summary(nominal_fit)
     p_values = {"global": test0.p_global, "band": test0.p_band}
     if not test0.significant:
-        return DiscoveryReport(False, noise, test0.bands_hz, [], dict(nominal_fit.values), before, before,
-                               nominal_fit, nominal_fit, None, p_values, test0.whiteness,
-                               time.perf_counter() - t0)
+        return DiscoveryReport(significant_mismatch=False, noise=noise, mismatch_bands_hz=test0.bands_hz,
+                               effects=[], parameters=dict(nominal_fit.values), fit_before=before, fit_after=before,
+                               nominal_fit=nominal_fit, final_fit=nominal_fit, discrepancy=None, p_values=p_values,
+                               whiteness=test0.whiteness, wall_time=time.perf_counter() - t0)
 
     nominal = Model((), [], nominal_fit)
     search = Search(data, rig, free, channels, candidates)
@@ -91,12 +182,12 @@ def discover(
         dbic = {n: m.bic - final.bic for n, m in without.items()}
         for name in sorted(final.names, key=lambda n: -dbic[n]):
             eff = final.effects[final.names.index(name)]
-            params = {k: float(v) for k, v in eff.params.items()}
             # what accounting for this effect does to the free parameters (vs the model without it)
             ref = without[name].fit.values
             shifts = {k: final.fit.values[k] / ref[k] - 1 for k in free if ref[k]}
-            effects.append({"name": name, "parameters": params, "equivalent": equiv[name],
-                            "delta_bic": round(float(dbic[name]), 2), "explanation": explain(name, params, rig, shifts)})
+            effects.append(EffectFinding(name=name, parameters={k: float(v) for k, v in eff.params.items()},
+                                         equivalent=equiv[name], delta_bic=round(float(dbic[name]), 2),
+                                         explanation=describe_effect(eff, rig, shifts), shifts=shifts))
     after = _fit_summary(final.fit)
     test1 = test_mismatch(final.fit, alpha, noise_dof)
     disc = None
@@ -105,19 +196,17 @@ def discover(
         structured = disc.structured_fraction
         dof = max(final.fit.dof - disc.n_parameters, 1)
         after = {"chi2_reduced": disc.chi2_after / dof, "rel_error": _rel_error(final.fit, disc)}
-        bands = ", ".join(f"{a:.1f}–{b:.1f} Hz" for a, b in test1.bands_hz) or "the whole band"
-        effects.append({"name": "unexplained", "parameters": {}, "equivalent": [],
-                        "delta_bic": round(float(final.fit.chi2 - disc.chi2_after
-                                                 - disc.n_parameters * _log_n(final.fit)), 2),
-                        "explanation": (f"significant mismatch remains at {bands} that no vocabulary effect "
-                                        f"explains; a smooth data-driven correction removes "
-                                        f"{100 * structured:.0f} % of the remaining χ² "
-                                        f"({sum(disc.terms.values())} Chebyshev terms), so the missing "
-                                        f"physics is {'mostly structured' if structured > 0.5 else 'mostly sharp or noise-like'}")})
+        n_terms = sum(disc.terms.values())
+        effects.append(UnexplainedFinding(
+            name=UNEXPLAINED, parameters={}, equivalent=[],
+            delta_bic=round(float(final.fit.chi2 - disc.chi2_after - disc.n_parameters * _log_n(final.fit)), 2),
+            explanation=describe_unexplained(test1.bands_hz, structured, n_terms),
+            bands_hz=test1.bands_hz, structured_fraction=structured, n_terms=n_terms))
     p_values.update({"global_after": test1.p_global, "band_after": test1.p_band})
-    return DiscoveryReport(True, noise, test0.bands_hz, effects, {k: final.fit.values[k] for k in free}, before,
-                           after, nominal_fit, final.fit, disc, p_values, test0.whiteness,
-                           time.perf_counter() - t0)
+    return DiscoveryReport(significant_mismatch=True, noise=noise, mismatch_bands_hz=test0.bands_hz, effects=effects,
+                           parameters={k: final.fit.values[k] for k in free}, fit_before=before, fit_after=after,
+                           nominal_fit=nominal_fit, final_fit=final.fit, discrepancy=disc, p_values=p_values,
+                           whiteness=test0.whiteness, wall_time=time.perf_counter() - t0)
 
 
 def _fit_summary(fit) -> dict:
@@ -131,16 +220,14 @@ def _log_n(fit):
 
 
 def _unexplained(fit):
-    p = fit._problem
-    pred = p.prediction(fit.theta)
-    residual = {c: p.target[k] - pred[k] for k, c in enumerate(p.channels)}
-    sigma = {c: p.sigma[k] for k, c in enumerate(p.channels)}
-    return fit_discrepancy(p.omega_hz, residual, sigma)
+    residual = {c: -r for c, r in fit.residuals().items()}  # data - model
+    return fit_discrepancy(fit.freq_hz, residual, fit.sigma)
 
 
 def _rel_error(fit, disc):
     import numpy as np
 
-    p = fit._problem
-    pred = p.prediction(fit.theta) + np.stack([disc.correction[c] for c in p.channels])
-    return float(np.linalg.norm(pred - p.target) / np.linalg.norm(p.target))
+    model = fit.prediction()
+    pred = np.stack([model[c] + disc.correction[c] for c in fit.channels])
+    target = np.stack([fit.data[c] for c in fit.channels])
+    return float(np.linalg.norm(pred - target) / np.linalg.norm(target))

@@ -1,54 +1,57 @@
 """Candidate effects and where to start fitting them.
 
-Each vocabulary effect gets a few starting values; effects with a location
-(``extra_mode``) are scanned over the measured band. All starts of one
-candidate are screened in one batched model call with the other parameters
-held at the current fit, and only the best few are refined.
+Every registered effect is a candidate (`satmd.physics.effects`). Its own
+declarations say where a fit starts: the grid of its parameters' declared
+starts, or, for an effect with a location (a `MatchedFilter` scan), a
+matched-filter scan over the measured band. All starts of one candidate are
+screened in one batched model call with the other parameters held at the
+current fit, and only the best few are refined.
 """
 from __future__ import annotations
 
 import numpy as np
 
-from ..physics.effects import OFFSET_PARAMETERS, VOCABULARY_NAMES, effect
+from ..physics import frf
+from ..physics.effects import registered_names
+
+GRID_REFINE = 2  # distinct best grid starts refined by least squares
 
 
 def default_candidates() -> tuple[str, ...]:
-    return VOCABULARY_NAMES
+    """Every effect name the vocabulary knows (SPEC §8 plus registered ones)."""
+    return registered_names()
 
 
-def start_grid(name: str, rig, freq_hz) -> list[dict]:
-    """Starting values of the effect's own parameters."""
-    if name == "sensor_gain":
-        return [{"gain_a1": g1, "gain_a2": g2} for g1 in (0.93, 1.0, 1.07) for g2 in (0.93, 1.0, 1.07)]
-    if name == "time_delay":
-        return [{"tau_s": t} for t in (-2e-4, 0.0, 1e-4, 3e-4, 6e-4)]
-    if name == "structural_damping":
-        return [{"eta": x} for x in (0.003, 0.01, 0.03, 0.1)]
-    if name == "dielectric_loss":
-        return [{"tan_delta": x} for x in (0.003, 0.01, 0.03, 0.1)]
-    if name == "shunt_capacitance":
-        return [{"Cs": x} for x in (2e-7, 1e-6, 3e-6, 1e-5, 3e-5)]
-    if name == "extra_mode":
-        lo, hi = float(freq_hz[0]), float(freq_hz[-1])
-        # resolve peaks of ζ ~ 0.3 %: geometric steps of 0.25 %
-        n = int(np.ceil(np.log(hi / lo) / np.log(1.0025))) + 1
-        fs = np.geomspace(lo, hi, n)
-        return [{"f_hz": f, "zeta": z, "mass_ratio": m}
-                for f in fs for z in (0.003, 0.01, 0.03) for m in (0.003, 0.01, 0.03)]
-    if name.startswith("parameter_offset:"):
-        p = name.split(":", 1)[1]
-        nominal = float(getattr(rig, p))
-        factors = (0.3, 0.6, 0.85, 1.2, 1.6, 2.5) if p in ("c1", "cp") else (0.75, 0.9, 0.97, 1.03, 1.1, 1.3)
-        return [{"value": nominal * f} for f in factors]
-    raise ValueError(f"no start grid for effect {name!r}")
+def candidate_starts(new, fit, rig) -> tuple[list[dict], int]:
+    """Starting values of ``new``'s own parameters when it joins the model of ``fit``,
+    and how many distinct best of them to refine."""
+    if new.scan is None:
+        return new.starts(rig), GRID_REFINE
+    return matched_filter(new, fit), new.scan.refine
 
 
-def neutral_effect(name: str, rig):
-    """The effect at a harmless placeholder value (parameters are set by the fit)."""
-    if name == "extra_mode":
-        return effect(name, f_hz=100.0, zeta=0.01, mass_ratio=0.0)
-    if name.startswith("parameter_offset:"):
-        p = name.split(":", 1)[1]
-        assert p in OFFSET_PARAMETERS
-        return effect(name, value=float(getattr(rig, p)))
-    return effect(name)
+def matched_filter(new, fit) -> list[dict]:
+    """Scan ``new`` over the band as its `MatchedFilter` declares: for every location and
+    shape the amplitude enters linearly near its neutral value, so the best amplitude and the
+    χ² it removes follow in closed form from one batched Jacobian at the neutral amplitude."""
+    scan = new.scan
+    freq = fit.freq_hz
+    lo, hi = float(freq[0]), float(freq[-1])
+    grid = [np.geomspace(lo, hi, int(np.ceil(np.log(hi / lo) / np.log(1 + scan.step))) + 1)]
+    grid += [np.asarray(v) for v in scan.shapes.values()]
+    mesh = [g.ravel() for g in np.meshgrid(*grid, indexing="ij")]
+    names = [scan.location, *scan.shapes]
+    base = new.neutral[scan.amplitude]
+    trial = new.replace(**dict(zip(names, mesh)), **{scan.amplitude: base})
+    r = frf(freq, fit.rig, list(fit.effects) + [trial], wrt=[trial.qualified(scan.amplitude)], outputs=fit.channels)
+    resid, sigma = fit.residuals(), fit.sigma
+    num = np.zeros(mesh[0].size)
+    den = np.zeros(mesh[0].size)
+    for c in fit.channels:
+        J = r.jac[c][..., 0] / sigma[c]  # (N, F)
+        num += np.real(np.sum(np.conj(J) * (-resid[c] / sigma[c]), axis=-1))  # against data - model
+        den += np.sum(np.abs(J) ** 2, axis=-1)
+    amp = np.clip(base + num / np.maximum(den, 1e-300), *scan.amplitude_range)
+    gain = np.where(num > 0, num**2 / np.maximum(den, 1e-300), 0.0)
+    order = np.argsort(-gain)[: scan.keep]
+    return [{**{n: float(m[i]) for n, m in zip(names, mesh)}, scan.amplitude: float(amp[i])} for i in order]

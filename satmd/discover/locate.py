@@ -14,7 +14,6 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from scipy import stats
 
 WIDTHS = (1, 3, 7, 15)
 
@@ -39,8 +38,10 @@ def test_mismatch(fit, alpha: float = 1e-3, noise_dof: float | None = None) -> M
     ``noise_dof``: degrees of freedom behind an estimated σ; the global test
     is then an F test, which accounts for the uncertainty of the estimate.
     """
+    from scipy import stats  # heavy: imported where used, not at `import satmd`
+
     z = standardized(fit)
-    freq = fit._problem.omega_hz
+    freq = fit.freq_hz
     per_point = sum(np.abs(v) ** 2 for v in z.values())  # ~ χ²_{2C}
     C = len(z)
     if noise_dof:

@@ -15,7 +15,6 @@ few sharp features (an unmodelled light mode) do not inflate the estimate.
 from __future__ import annotations
 
 import numpy as np
-from scipy.optimize import minimize
 
 
 def second_difference(r: np.ndarray) -> np.ndarray:
@@ -24,6 +23,8 @@ def second_difference(r: np.ndarray) -> np.ndarray:
 
 def estimate_channel_std(residual: np.ndarray, magnitude: np.ndarray, nu: float = 4.0) -> np.ndarray:
     """σ per point (on each of Re and Im) for one channel."""
+    from scipy.optimize import minimize  # heavy: imported where used, not at `import satmd`
+
     d = second_difference(residual)
     # variance seen by each difference: the (1, 4, 1)/6 average of σ² over its stencil
     peak = magnitude.max()

@@ -4,9 +4,8 @@ from __future__ import annotations
 import json
 from dataclasses import dataclass, field
 
-import numpy as np
-
-from ..physics.rig import PARAMETER_INFO
+from .findings import UNEXPLAINED
+from .select import MIN_DELTA_BIC
 
 SCHEMA = "satmd-discovery/1"
 
@@ -16,7 +15,7 @@ class DiscoveryReport:
     significant_mismatch: bool
     noise: str  # "given" or "estimated"
     mismatch_bands_hz: list
-    effects: list  # dicts: name, parameters, equivalent, delta_bic, explanation
+    effects: list  # EffectFinding, most important first
     parameters: dict
     fit_before: dict
     fit_after: dict
@@ -27,32 +26,47 @@ class DiscoveryReport:
     p_values: dict = field(default_factory=dict, repr=False, compare=False)
     whiteness: dict = field(default_factory=dict, repr=False, compare=False)
     wall_time: float = 0.0
+    # --- from recordings: how the FRFs were estimated, and what the chain did (SPEC §9) ---
+    estimator: dict = field(default_factory=dict)
+    measurement: list = field(default_factory=list)  # dicts: name, explanation, remedy, corrected
 
     def to_dict(self) -> dict:
+        chain = {}
+        if self.estimator:
+            chain = {"estimator": {k: v for k, v in self.estimator.items() if k != "measurement"},
+                     "measurement": [{k: m[k] for k in ("name", "explanation", "remedy")} for m in self.measurement]}
         return {
             "schema": SCHEMA,
             "significant_mismatch": bool(self.significant_mismatch),
             "noise": self.noise,
             "mismatch_bands_hz": [[round(a, 4), round(b, 4)] for a, b in self.mismatch_bands_hz],
-            "effects": [{k: e[k] for k in ("name", "parameters", "equivalent", "delta_bic", "explanation")}
-                        for e in self.effects],
+            "effects": [e.to_dict() for e in self.effects],
             "parameters": dict(self.parameters),
             "fit_before": dict(self.fit_before),
             "fit_after": dict(self.fit_after),
-        }
+        } | chain
 
     def to_json(self, **kw) -> str:
         return json.dumps(self.to_dict(), **kw)
 
     @property
     def effect_names(self) -> list:
-        return [e["name"] for e in self.effects]
+        return [e.name for e in self.effects]
 
     def report(self) -> str:
         noise = ("the std columns of the file" if self.noise == "given"
                  else "an estimate from the residual's roughness (no std in the file)")
-        lines = ["[[Missing-physics discovery]]",
-                 f"    noise model: {noise}",
+        if self.estimator:
+            from ..io.estimate import describe_estimate
+
+            noise = "the std of the FRF estimate (from the recording's own noise)"
+            lines = ["[[Missing-physics discovery]]",
+                     f"    from a recording: {describe_estimate(self)}"]
+            lines += [f"    measurement: {m['name']}: {m['explanation']} (remedy: {m['remedy']})"
+                      for m in self.measurement]
+        else:
+            lines = ["[[Missing-physics discovery]]"]
+        lines += [f"    noise model: {noise}",
                  f"    nominal fit: χ²_red = {self.fit_before['chi2_reduced']:.3g}, "
                  f"relative error {self.fit_before['rel_error']:.3g} "
                  f"(p = {self.p_values.get('global', float('nan')):.2g} globally, "
@@ -63,9 +77,9 @@ class DiscoveryReport:
         bands = ", ".join(f"{a:.1f}–{b:.1f} Hz" for a, b in self.mismatch_bands_hz) or "spread over the band"
         lines.append(f"    significant mismatch located at: {bands}")
         for i, e in enumerate(self.effects, 1):
-            lines.append(f"  {i}. {e['name']}: {e['explanation']}")
-            if e.get("equivalent"):
-                lines.append(f"     equally good explanations (|ΔBIC| < 10): {', '.join(e['equivalent'])} "
+            lines.append(f"  {i}. {e.name}: {e.explanation}")
+            if e.equivalent:
+                lines.append(f"     equally good explanations (|ΔBIC| < {MIN_DELTA_BIC:g}): {', '.join(e.equivalent)} "
                              "— these FRFs cannot tell them apart")
         lines.append(f"    after: χ²_red = {self.fit_after['chi2_reduced']:.3g}, "
                      f"relative error {self.fit_after['rel_error']:.3g}")
@@ -79,18 +93,18 @@ class DiscoveryReport:
         """Measured vs nominal vs augmented FRFs and standardised residuals, bands shaded."""
         from ..plots import fit_figure
 
-        data = self.nominal_fit._problem.data
+        data = self.nominal_fit.data
         curves = [("nominal model", self.nominal_fit.prediction().channels, {"color": "tab:orange", "lw": 1.0})]
         resid = [("nominal", self.nominal_fit.standardized_residuals(), {"color": "tab:orange", "lw": 0.8})]
         if self.final_fit is not None and self.final_fit is not self.nominal_fit:
             pred = dict(self.final_fit.prediction().channels)
             z = dict(self.final_fit.standardized_residuals())
-            label = " + ".join(n for n in self.effect_names if n != "unexplained") or "model"
+            label = " + ".join(n for n in self.effect_names if n != UNEXPLAINED) or "model"
             if self.discrepancy is not None:
-                sig = self.final_fit._problem.sigma
-                for k, c in enumerate(self.final_fit.channels):
+                sig = self.final_fit.sigma
+                for c in self.final_fit.channels:
                     pred[c] = pred[c] + self.discrepancy.correction[c]
-                    z[c] = z[c] + self.discrepancy.correction[c] / sig[k]
+                    z[c] = z[c] + self.discrepancy.correction[c] / sig[c]
                 label += " + smooth discrepancy"
             curves.append((f"with {label}", pred, {"color": "tab:blue", "lw": 1.2}))
             resid.append(("augmented", z, {"color": "tab:blue", "lw": 0.8}))
@@ -104,40 +118,19 @@ class DiscoveryReport:
         return save(self.figure(), path)
 
 
-def explain(name: str, params: dict, rig, shifts: dict) -> str:
-    """One or two sentences of plain engineering language for a found effect."""
-    if name == "sensor_gain":
-        parts = []
-        for ch, label in (("gain_a1", "accelerometer 1 (primary)"), ("gain_a2", "accelerometer 2 (absorber)")):
-            g = params[ch]
-            word = "high" if g > 1 else "low"
-            parts.append(f"{label} reads {abs(g - 1) * 100:.1f} % {word}")
-        text = "; ".join(parts) + " (calibration error)"
-    elif name == "time_delay":
-        tau = params["tau_s"]
-        text = (f"the acquisition {'lags' if tau > 0 else 'leads'} by {abs(tau) * 1e3:.3g} ms on both channels "
-                f"(a phase error of {np.degrees(2 * np.pi * 100 * abs(tau)):.2g}° at 100 Hz)")
-    elif name == "structural_damping":
-        eta = params["eta"]
-        text = (f"the host structure has hysteretic loss η = {eta:.3g} (loss factor), "
-                f"as much damping at resonance as c = {eta * float(rig.k1) / (2 * np.pi * 50):.3g} N·s/m at 50 Hz")
-    elif name == "dielectric_loss":
-        text = f"the piezo's dielectric is lossy: tan δ = {params['tan_delta']:.3g}"
-    elif name == "shunt_capacitance":
-        cs = params["Cs"]
-        text = f"a stray capacitance of {cs * 1e6:.3g} µF ({100 * cs / float(rig.Cp):.2g} % of Cp) sits across the shunt"
-    elif name == "extra_mode":
-        text = (f"an unmodelled host mode at {params['f_hz']:.1f} Hz with {100 * params['mass_ratio']:.2g} % of the "
-                f"primary mass (ζ = {params['zeta']:.2g})")
-    elif name.startswith("parameter_offset:"):
-        p = name.split(":", 1)[1]
-        v, nominal = params["value"], float(getattr(rig, p))
-        unit = PARAMETER_INFO[p][0]
-        text = (f"the fixed parameter {p} is {v:.4g} {unit}, {100 * (v / nominal - 1):+.1f} % from its nominal "
-                f"{nominal:.4g} {unit}")
-    else:
-        text = name
+def describe_effect(effect, rig, shifts: dict) -> str:
+    """A found effect in plain words: what the effect says of itself, then what it moves."""
+    text = effect.explain(rig)
     moved = [f"{k} {100 * s:+.2g} %" for k, s in shifts.items() if abs(s) > 1e-3]
     if moved:
         text += "; accounting for it moves " + ", ".join(moved)
     return text
+
+
+def describe_unexplained(bands_hz, structured_fraction: float, n_terms: int) -> str:
+    """The ``unexplained`` verdict in plain words, from the numbers of the finding."""
+    bands = ", ".join(f"{a:.1f}–{b:.1f} Hz" for a, b in bands_hz) or "the whole band"
+    kind = "mostly structured" if structured_fraction > 0.5 else "mostly sharp or noise-like"
+    return (f"significant mismatch remains at {bands} that no vocabulary effect explains; a smooth data-driven "
+            f"correction removes {100 * structured_fraction:.0f} % of the remaining χ² ({n_terms} Chebyshev "
+            f"terms), so the missing physics is {kind}")

@@ -145,10 +145,10 @@ def judge(report, scenario: Scenario) -> bool:
     if len(found) != len(truth):
         return False
     for e in scenario.effects:
-        match = [r for r in found if r["name"] == e.name or e.name in r["equivalent"]]
+        match = [r for r in found if r.name == e.name or e.name in r.equivalent]
         if not match:
             return False
-        if e.name == "extra_mode" and match[0]["name"] == "extra_mode":
-            if abs(match[0]["parameters"]["f_hz"] - e.params["f_hz"]) > 0.05 * e.params["f_hz"]:
+        if e.name == "extra_mode" and match[0].name == "extra_mode":
+            if abs(match[0].parameters["f_hz"] - e.params["f_hz"]) > 0.05 * e.params["f_hz"]:
                 return False
     return report.noise != "given" or report.fit_after["chi2_reduced"] <= 1.5

@@ -18,7 +18,8 @@ import numpy as np
 
 from ..identify import identify
 from ..identify.problem import Problem
-from .candidates import neutral_effect, start_grid
+from ..physics.effects import at_rest
+from .candidates import candidate_starts
 
 MIN_DELTA_BIC = 10.0
 
@@ -59,19 +60,16 @@ class Search:
         if tried in self.tried:
             return self.cache[key]
         self.tried.add(tried)
-        new = neutral_effect(name, self.rig)
+        new = at_rest(name, self.rig)
         effects = list(model.effects) + [new]
         problem = Problem(self.data, self.rig, self.free_names(effects), self.channels, effects)
         base = dict(model.fit.values)
-        if name == "extra_mode":
-            grid = mode_scan(model, self.data.freq_hz)
-        else:
-            grid = start_grid(name, self.rig, self.data.freq_hz)
+        grid, n_refine = candidate_starts(new, model.fit, self.rig)
         thetas = np.array([[{**base, **{new.qualified(k): v for k, v in g.items()}}.get(n, np.nan)
                             for n in problem.names] for g in grid])
         thetas = np.clip(thetas, problem.lower, problem.upper)
         cost = problem.batch_cost(thetas)
-        keep = _distinct_best(thetas, cost, problem.names, new, 3 if name == "extra_mode" else 2)
+        keep = _distinct_best(thetas, cost, problem.names, new, n_refine)
         starts = [dict(zip(problem.names, thetas[k])) for k in keep]
         fit = self.fit(effects, starts)
         fitted = [_with_values(e, fit.values) for e in effects]
@@ -95,34 +93,6 @@ class Search:
         if old is None or model.bic < old.bic:
             self.cache[key] = model
         return self.cache[key]
-
-
-def mode_scan(model: Model, freq_hz, zetas=(0.002, 0.005, 0.01, 0.02, 0.05)) -> list[dict]:
-    """Matched-filter scan for an unmodelled mode: for every (f3, ζ) the mode
-    mass enters linearly near zero, so the best mass and the χ² it removes
-    follow in closed form from one batched Jacobian at μ = 0."""
-    from ..physics import frf
-    from ..physics.effects import effect
-
-    fit = model.fit
-    p = fit._problem
-    rig, effects = p.apply(fit.theta)
-    lo, hi = float(freq_hz[0]), float(freq_hz[-1])
-    f3 = np.geomspace(lo, hi, int(np.ceil(np.log(hi / lo) / np.log(1.002))) + 1)
-    F, Z = np.meshgrid(f3, np.asarray(zetas), indexing="ij")
-    mode = effect("extra_mode", f_hz=F.ravel(), zeta=Z.ravel(), mass_ratio=0.0)
-    r = frf(p.omega_hz, rig, list(effects) + [mode], wrt=["extra_mode.mass_ratio"], outputs=p.channels)
-    resid = p.target - p.prediction(fit.theta)  # data - model, (C, F)
-    num = np.zeros(F.size)
-    den = np.zeros(F.size)
-    for k, c in enumerate(p.channels):
-        J = r.jac[c][..., 0] / p.sigma[k]  # (N, F)
-        num += np.real(np.sum(np.conj(J) * (resid[k] / p.sigma[k]), axis=-1))
-        den += np.sum(np.abs(J) ** 2, axis=-1)
-    mu = np.clip(num / np.maximum(den, 1e-300), 1e-5, 0.2)
-    gain = np.where(num > 0, num**2 / np.maximum(den, 1e-300), 0.0)
-    order = np.argsort(-gain)[:40]
-    return [{"f_hz": float(F.ravel()[i]), "zeta": float(Z.ravel()[i]), "mass_ratio": float(mu[i])} for i in order]
 
 
 def _with_values(effect, values):

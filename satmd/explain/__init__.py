@@ -20,12 +20,17 @@ Physics (NumPy only):
 - `grid_anova(X, y)`: main-effect and two-way shares of a descriptor over a
   full-factorial grid, i.e. what additive or pairwise formulas can reach.
 
+The contract a model must follow is `ExplainableModel` (a typing.Protocol;
+`satmd.inverse.InverseModel` follows it). `satmd.explain.run` computes the
+whole use case as typed results; `satmd.report.explain_text` formats them.
+
 Symbolic distillation: `distill(X, y, backend="operon"|"pysr"|"sindy")`
 (needs sympy; its names are imported on first use, so ``import
 satmd.explain`` works with NumPy/SciPy alone).
 """
 from .anova import GridAnova, grid_anova
 from .attribution import BLIND_CASES, PAPER_TABLE3, Attribution, attribution, peak_frequencies, table3_stats
+from .contract import ExplainableModel
 from .descriptors import NOMINAL, XI_GRID, DescriptorData, modal_descriptors, xi_dataset, xi_frf
 from .distill import DistillResult, distill, paper_formula_result
 from .latent import LatentMap, latent_map
@@ -47,5 +52,5 @@ __all__ = [
     "latent_map", "LatentMap", "attribution", "Attribution", "table3_stats", "peak_frequencies", "PAPER_TABLE3",
     "BLIND_CASES", "physical_sensitivity", "PhysicalSensitivity", "agreement", "chain_rule_check", "xi_frf",
     "xi_dataset", "modal_descriptors", "DescriptorData", "NOMINAL", "XI_GRID", "distill", "DistillResult",
-    "paper_formula_result", "grid_anova", "GridAnova", "node_count", "paper_complexity", "PAPER_FORMULA", "PAPER_METRICS",
+    "paper_formula_result", "grid_anova", "GridAnova", "ExplainableModel", "node_count", "paper_complexity", "PAPER_FORMULA", "PAPER_METRICS",
 ]

@@ -86,7 +86,18 @@ def _term(cube, keep):
 
 
 def grid_anova(X, y, names=None) -> GridAnova:
-    """Main-effect and two-way ANOVA shares of ``y`` over the full-factorial grid ``X`` (n, d)."""
+    """Main-effect and two-way ANOVA shares of ``y`` over a full-factorial grid.
+
+    Parameters
+    ----------
+    X : (n, d) inputs on a full-factorial grid.
+    y : (n,) target.
+    names : names of the d inputs (default x0..).
+
+    Returns
+    -------
+    GridAnova
+    """
     cube = _cube(X, y)
     d = cube.ndim
     names = tuple(names) if names is not None else tuple(f"x{i}" for i in range(d))

@@ -22,7 +22,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from . import _model
+from ..errors import DataError
+from . import contract
 
 OUTPUTS = ("R", "L")
 #: The six blind (R [Ω], L [H]) pairs of the paper (SPEC §5), the cases of Figures 5-8.
@@ -96,20 +97,24 @@ def attribution(model, frfs, labels=None, space: str = "raw") -> Attribution:
     Parameters
     ----------
     model : a trained `satmd.inverse.InverseModel` (net kind) or an object
-        following the same contract (see `satmd.explain._model`)
+        following the same contract (`satmd.explain.contract.ExplainableModel`)
     frfs : FRFData or a list of them, a dataset, complex (n, 2, F) or raw
         features (n, 4F) on the model's grid
     labels : optional case names
     space : "raw" (default: ∂/∂X of the raw features, see the module
         docstring) or "scaled" (∂/∂ of the standardised network inputs)
+
+    Returns
+    -------
+    Attribution
     """
     if space not in ("raw", "scaled"):
-        raise ValueError(f"space must be 'raw' or 'scaled', got {space!r}")
-    torch = _model.torch_module()
-    _model.check_net_model(model)
-    raw = _model.raw_features(model, frfs)
+        raise DataError(f"space must be 'raw' or 'scaled', got {space!r}")
+    torch = contract.torch_module()
+    contract.check_net_model(model)
+    raw = contract.raw_features(model, frfs)
     X = torch.tensor(raw, dtype=torch.float64, requires_grad=True)
-    out = _model.normalised_outputs_raw(model, X)  # (n, 2)
+    out = contract.normalised_outputs_raw(model, X)  # (n, 2)
     grads = []
     for k in range(out.shape[1]):
         (g,) = torch.autograd.grad(out[:, k].sum(), X, retain_graph=k + 1 < out.shape[1])
@@ -119,7 +124,7 @@ def attribution(model, frfs, labels=None, space: str = "raw") -> Attribution:
     g = gradients if space == "raw" else gradients * np.asarray(model.scaler_.scale, float)
     curves = normalise_max(per_frequency(g, n_freq))
     lo = np.array([model.bounds["R"][0], model.bounds["L"][0]])
-    prediction = lo + out.detach().double().numpy() * _model.bounds_span(model)
+    prediction = lo + out.detach().double().numpy() * contract.bounds_span(model)
     labels = tuple(labels) if labels is not None else tuple(f"case {i + 1}" for i in range(len(raw)))
     return Attribution(np.asarray(model.freq_hz, float), curves, gradients, prediction, labels, space)
 
@@ -132,6 +137,16 @@ def table3_stats(curves: np.ndarray, freq_hz: np.ndarray) -> dict:
     - ``mean_case_std`` / ``max_case_std``: mean and maximum over frequency of
       the across-case standard deviation (population std, ddof = 0);
     - ``peaks_hz``: the two main peaks of the mean curve (`peak_frequencies`).
+
+    Parameters
+    ----------
+    curves : (n_cases, F) normalised curves.
+    freq_hz : (F,) frequencies [Hz].
+
+    Returns
+    -------
+    dict
+        The statistics above.
     """
     c = np.asarray(curves, float)
     mean_curve = normalise_max(c.mean(axis=0))
@@ -146,8 +161,20 @@ def table3_stats(curves: np.ndarray, freq_hz: np.ndarray) -> dict:
 
 
 def peak_frequencies(curve: np.ndarray, freq_hz: np.ndarray, n: int = 2, min_separation_hz: float = 15.0) -> list:
-    """Frequencies of the ``n`` highest local maxima of ``curve``, at least
-    ``min_separation_hz`` apart, highest first (ends of the grid count as maxima)."""
+    """Frequencies of the highest local maxima of a curve (ends of the grid count as maxima).
+
+    Parameters
+    ----------
+    curve : (F,) values.
+    freq_hz : (F,) frequencies [Hz].
+    n : how many maxima.
+    min_separation_hz : least distance between two reported maxima.
+
+    Returns
+    -------
+    list of float
+        Highest first.
+    """
     y = np.asarray(curve, float)
     f = np.asarray(freq_hz, float)
     padded = np.concatenate([[-np.inf], y, [-np.inf]])

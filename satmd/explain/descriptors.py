@@ -45,7 +45,21 @@ _HOST_ALONE_M2 = 1e-12  # kg: the absorber decouples as m2 -> 0
 
 
 def xi_frf(rig: Rig | None = None, freq=PAPER_GRID_HZ, nominal: dict | None = None, channel: str = "u1"):
-    """ξ_FRF of each rig in the batch (eq. 27); shape = the rig's batch shape."""
+    """ξ_FRF of each rig in the batch (eq. 27).
+
+    Parameters
+    ----------
+    rig : Rig
+        Fields may be arrays (a batch); default: the paper's rig.
+    freq : frequencies [Hz] (default: the paper grid).
+    nominal : rig values of the reference Y_nom (default: SPEC §6).
+    channel : response channel (default u1).
+
+    Returns
+    -------
+    ndarray
+        ξ with the rig's batch shape.
+    """
     rig = Rig() if rig is None else rig
     # the reference keeps the rig's other (fixed) parameters; they must be scalars
     base = Rig(**{n: _scalar(getattr(rig, n)) for n in Rig.names()})
@@ -77,7 +91,18 @@ class DescriptorData:
 
 
 def xi_dataset(grid: dict | None = None, freq=PAPER_GRID_HZ, modal: bool = False) -> DescriptorData:
-    """The SPEC §6 dataset: ξ (and optionally the modal descriptors) over the grid."""
+    """The SPEC §6 dataset: ξ (and optionally the modal descriptors) over the grid.
+
+    Parameters
+    ----------
+    grid : {R, L, m2, kp: values} of the full-factorial grid (default: SPEC §6).
+    freq : frequencies [Hz] of ξ (default: the paper grid).
+    modal : add the modal descriptors.
+
+    Returns
+    -------
+    DescriptorData
+    """
     rig, X = grid_rig(grid)
     targets = {"xi": xi_frf(rig, freq)}
     if modal:
@@ -101,8 +126,16 @@ def _parabolic(logm: np.ndarray, idx: np.ndarray, freq: np.ndarray):
 def modal_descriptors(rig: Rig | None = None, freq=FINE_GRID_HZ) -> dict:
     """Resonances, splitting, anti-resonance and peak attenuation of |U1| (module doc).
 
-    Returns a dict of arrays with the rig's batch shape; NaN where fewer than
-    two peaks lie inside the band. ``freq`` must be uniform.
+    Parameters
+    ----------
+    rig : Rig
+        Fields may be arrays (a batch); default: the paper's rig.
+    freq : uniform frequency grid [Hz], fine enough to resolve the peaks.
+
+    Returns
+    -------
+    dict
+        Arrays with the rig's batch shape; NaN where fewer than two peaks lie inside the band.
     """
     rig = Rig() if rig is None else rig
     freq = np.asarray(freq, float)

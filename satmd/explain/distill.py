@@ -26,7 +26,7 @@ from sklearn.metrics import mean_absolute_error, r2_score
 from sklearn.model_selection import train_test_split
 
 from ..errors import DataError, SatmdError
-from ._backends import BACKENDS
+from .backends import BACKENDS
 from .anova import grid_ceiling  # noqa: F401 - re-exported: it bounds what distill can reach
 
 
@@ -144,21 +144,28 @@ def distill(X, y, backend: str = "operon", names=None, *, max_complexity: int | 
 
     Parameters
     ----------
-    X : (n, d) physical inputs; y : (n,) target (non-finite rows are dropped)
+    X : (n, d) physical inputs
+    y : (n,) target (non-finite rows are dropped)
     backend : "operon" (default), "pysr" or "sindy"
     names : names of the d inputs (default x0..)
-    seed : seed of the train/test split (SPEC §6: 42); ``search_seed``: of the
-        back end's search (default: ``seed``)
     max_complexity : return the most accurate (training R²) candidate with at
         most this many nodes; None: the back end's own choice (operon: MDL;
         sindy: best training R²)
-    n_threads, time_limit : resources of the search (time_limit in s, a cap)
+    test_size : share of the test split
+    seed : seed of the train/test split (SPEC §6: 42)
+    search_seed : seed of the back end's search (default: ``seed``)
     zscore : standardise the inputs first (the paper's x_i); False: x_i are the raw inputs
+    n_threads, time_limit : resources of the search (time_limit in s, a cap)
     polish : refit each candidate's constants on the training data (default:
         yes, except for SINDy's polynomial library whose fit is already least squares)
     prune : drop the constants the others can absorb (`symbolic.prune`: the
         squared error may grow by 1e-4 relative); default: when polishing
-    options : passed to the back end (e.g. max_length, generations, degree, rational)
+    digits : significant digits the constants are rounded to (metrics use the rounded formula)
+    **options : passed to the back end (e.g. max_length, generations, degree, rational)
+
+    Returns
+    -------
+    DistillResult
     """
     if backend not in BACKENDS:
         raise SatmdError(f"unknown backend {backend!r}; choose from {', '.join(BACKENDS)}")
@@ -208,7 +215,20 @@ def distill(X, y, backend: str = "operon", names=None, *, max_complexity: int | 
 
 
 def paper_formula_result(X, y, test_size: float = 0.2, seed: int = 42) -> dict:
-    """The paper's formula evaluated on our data and split: complexity and metrics."""
+    """The paper's formula evaluated on our data and split: complexity and metrics.
+
+    Parameters
+    ----------
+    X : (n, d) physical inputs.
+    y : (n,) target.
+    test_size : share of the test split.
+    seed : seed of the split (SPEC §6: 42).
+
+    Returns
+    -------
+    dict
+        ``expression``, ``complexity`` and the train/test metrics.
+    """
     symbolic = _symbolic()
     Ztr, Zte, ytr, yte, _, _ = split(X, y, test_size, seed)
     expr = symbolic.compact(symbolic.parse(symbolic.PAPER_FORMULA, Ztr.shape[1]))

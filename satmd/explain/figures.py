@@ -3,7 +3,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..plots import _plt
+from ..plots import pyplot
 from .attribution import OUTPUTS, PAPER_PEAK_BANDS_HZ
 
 _UNITS = {"R": "Ω", "L": "H"}
@@ -16,7 +16,7 @@ def _bands(ax):
 
 def latent_figure(lm, title: str = "Latent PCA (64-d penultimate layer)"):
     """Figure 4: the same PCA points coloured by R and by L, with the R/L sweeps of the disentanglement test."""
-    plt = _plt()
+    plt = pyplot()
     fig, axes = plt.subplots(1, 2, figsize=(11, 4.4))
     for ax, name, c in zip(axes, OUTPUTS, (lm.R, lm.L)):
         sc = ax.scatter(lm.pcs[:, 0], lm.pcs[:, 1], c=c, s=8, cmap="viridis")
@@ -35,7 +35,7 @@ def latent_figure(lm, title: str = "Latent PCA (64-d penultimate layer)"):
 
 def attribution_curves(att, k: int):
     """Figures 5 / 7: normalised sensitivity curves per case, their mean, the paper's peak bands shaded."""
-    plt = _plt()
+    plt = pyplot()
     name = OUTPUTS[k]
     fig, ax = plt.subplots(figsize=(8, 3.8))
     _bands(ax)
@@ -54,7 +54,7 @@ def attribution_curves(att, k: int):
 
 def attribution_heatmap(att, k: int):
     """Figures 6 / 8: cases x frequency heatmap of the normalised sensitivity."""
-    plt = _plt()
+    plt = pyplot()
     name = OUTPUTS[k]
     fig, ax = plt.subplots(figsize=(8, 0.45 * len(att.labels) + 1.6))
     f = att.freq_hz
@@ -70,7 +70,7 @@ def attribution_heatmap(att, k: int):
 
 def agreement_figure(att, phys_curves: np.ndarray, rows: list, title: str = ""):
     """Neural attribution against physical sensitivity |∂A/∂θ|, every blind case on one figure."""
-    plt = _plt()
+    plt = pyplot()
     n = len(att.labels)
     fig, axes = plt.subplots(2, n, figsize=(2.6 * n, 5.2), sharex=True, sharey=True, squeeze=False)
     for k, name in enumerate(OUTPUTS):
@@ -94,7 +94,7 @@ def distill_figure(res, X, y, title: str = "ξ_FRF"):
     """Figure 9 (predicted vs true on the test split) and the accuracy-complexity Pareto front."""
     from .distill import split
 
-    plt = _plt()
+    plt = pyplot()
     _, Zte, _, yte, _, _ = split(X, y)
     from .symbolic import evaluate
 

@@ -21,8 +21,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import DataError
+from ..inverse.dataset import complex_to_features
 from ..physics import frf
-from . import _model
+from . import contract
 
 #: Half-widths of the sweeps around each anchor.
 SWEEP_HALF_WIDTH = {"R": 5.0, "L": 0.02}
@@ -104,10 +105,10 @@ def sweep(model, anchor, n: int = 11, half_width=None) -> dict:
     Ls = np.linspace(lo_L, L0 + half["L"], n)
     R = np.concatenate([Rs, np.full(n, R0)])
     L = np.concatenate([np.full(n, L0), Ls])
-    rig = _model.model_rig(model).replace(R=R, L=L)
+    rig = contract.model_rig(model).replace(R=R, L=L)
     r = frf(model.freq_hz, rig, outputs=("a1", "a2"))
-    Z = _model.latent(model, _model.complex_to_raw(np.stack([r.a1, r.a2], axis=1)))
-    span = _model.bounds_span(model)
+    Z = contract.latent(model, complex_to_features(np.stack([r.a1, r.a2], axis=1)))
+    span = contract.bounds_span(model)
     dR = _direction(Z[:n], Rs / span[0])
     dL = _direction(Z[n:], Ls / span[1])
     return {"anchor": [R0, L0], "angle_deg": angle_deg(dR, dL), "R": Rs, "L": Ls, "latent_R": Z[:n],
@@ -121,18 +122,26 @@ def latent_map(model, data, labels=None, anchors=None, n_sweep: int = 11, folds:
     ----------
     model : a trained net-kind `InverseModel` (or an object following its contract)
     data : labelled FRFs: an `InverseDataset`, or FRFs with ``labels=(R, L)``
+    labels : (R, L) arrays when ``data`` carries no labels
     anchors : (R, L) points for the sweeps (default: the six blind pairs of SPEC §5)
+    n_sweep : points of each R or L sweep
+    folds : folds of the cross-validated linear probe
+    seed : seed of the folds
+
+    Returns
+    -------
+    LatentMap
     """
     from sklearn.decomposition import PCA
 
     from .attribution import BLIND_CASES
 
-    _model.check_net_model(model)
+    contract.check_net_model(model)
     R, L = _labels(data, labels)
-    raw = _model.raw_features(model, data)
+    raw = contract.raw_features(model, data)
     if raw.shape[0] != R.size:
         raise DataError(f"{raw.shape[0]} FRFs but {R.size} labels")
-    Z = _model.latent(model, raw)
+    Z = contract.latent(model, raw)
     pca = PCA(n_components=2, random_state=seed).fit(Z)
     groups = getattr(data, "group", None)
     probe = {"R": linear_probe(Z, R, groups, folds, seed), "L": linear_probe(Z, L, groups, folds, seed)}

@@ -49,12 +49,22 @@ def physical_sensitivity(rig: Rig | None = None, freq=PAPER_GRID_HZ, params=OUTP
                          feature_scale=None) -> PhysicalSensitivity:
     """Per-frequency |∂A/∂θ| from the analytic Jacobian, normalised as the attribution.
 
-    ``rig`` fields may be arrays (e.g. the six blind R, L): one batched call.
-    ``feature_scale`` (4F,), e.g. a model's ``scaler_.scale``: express the
-    derivatives in standardised feature units, ∂(X_c / s_c)/∂θ, before the
-    per-frequency reduction -- the dual of the attribution with
-    ``space="scaled"`` (G s and J / s multiply to the same G J).
-    ``jacobian`` always holds the raw derivatives.
+    Parameters
+    ----------
+    rig : Rig
+        Fields may be arrays (e.g. the six blind R, L): one batched call.
+    freq : frequencies [Hz] (default: the paper grid).
+    params : parameters θ to differentiate by (default R, L).
+    effects : effects included in the model.
+    feature_scale : (4F,), e.g. a model's ``scaler_.scale``
+        Express the derivatives in standardised feature units, ∂(X_c / s_c)/∂θ,
+        before the per-frequency reduction -- the dual of the attribution with
+        ``space="scaled"`` (G s and J / s multiply to the same G J).
+
+    Returns
+    -------
+    PhysicalSensitivity
+        ``jacobian`` always holds the raw derivatives.
     """
     rig = Rig() if rig is None else rig
     freq = np.asarray(freq, float)
@@ -78,8 +88,19 @@ def spearman(a: np.ndarray, b: np.ndarray) -> float:
 
 
 def agreement(neural: np.ndarray, physical: np.ndarray, labels=None) -> list:
-    """Per case and output, cosine similarity and Spearman correlation of two
-    sets of normalised curves (n, 2, F). Returns a list of dicts."""
+    """Per case and output, cosine similarity and Spearman correlation of two sets of normalised curves.
+
+    Parameters
+    ----------
+    neural : (n, 2, F) attribution curves (S_R, S_L per case).
+    physical : (n, 2, F) physical sensitivities, same layout.
+    labels : case names (default: case indices).
+
+    Returns
+    -------
+    list of dict
+        One per case: its label and, per output, ``cosine`` and ``spearman``.
+    """
     neural = np.asarray(neural, float)
     physical = np.asarray(physical, float).reshape(neural.shape)
     rows = []
@@ -93,12 +114,18 @@ def agreement(neural: np.ndarray, physical: np.ndarray, labels=None) -> list:
 
 
 def chain_rule_check(gradients: np.ndarray, jacobian: np.ndarray, span) -> np.ndarray:
-    """(n, 2, 2) matrices G J diag(span): ∂(R̂, L̂)/∂(R, L) through the data.
+    """∂(R̂, L̂)/∂(R, L) through the data: G J diag(span); a locally consistent inverse gives the identity.
 
-    ``gradients`` (n, 2, 4F) of normalised outputs w.r.t. raw features,
-    ``jacobian`` (n, 4F, 2) of raw features w.r.t. (R, L), ``span`` the output
-    ranges (R_max - R_min, L_max - L_min). A locally consistent inverse gives
-    the identity.
+    Parameters
+    ----------
+    gradients : (n, 2, 4F) gradients G of the normalised outputs w.r.t. the raw features.
+    jacobian : (n, 4F, 2) Jacobian J of the raw features w.r.t. (R, L).
+    span : output ranges (R_max - R_min, L_max - L_min).
+
+    Returns
+    -------
+    ndarray
+        (n, 2, 2) matrices.
     """
     g = np.asarray(gradients, float) * np.asarray(span, float)[None, :, None]
     return np.einsum("nkd,ndp->nkp", g, np.asarray(jacobian, float))

@@ -39,7 +39,16 @@ def parse(text: str, n_vars: int) -> sp.Expr:
 
 
 def node_count(expr) -> int:
-    """Nodes of the sympy expression tree (see the module docstring)."""
+    """Nodes of the sympy expression tree (see the module docstring).
+
+    Parameters
+    ----------
+    expr : sympy expression or a string sympy can parse.
+
+    Returns
+    -------
+    int
+    """
     return sum(1 for _ in sp.preorder_traversal(sp.sympify(expr)))
 
 
@@ -101,6 +110,12 @@ def round_floats(expr: sp.Expr, digits: int = 4) -> sp.Expr:
 
 
 def paper_complexity() -> int:
+    """Node count of the paper's formula in its most compact form.
+
+    Returns
+    -------
+    int
+    """
     return node_count(compact(parse(PAPER_FORMULA, 4)))
 
 

@@ -1,19 +1,24 @@
 """Grey-box identification: global search + scipy least squares with the analytic Jacobian."""
 from __future__ import annotations
 
+import sys
 import time
 from typing import Sequence
 
 import numpy as np
-from scipy.optimize import least_squares
-from scipy.stats import qmc
 
 from ..errors import DataError
 from ..io.frfdata import FRFData
 from ..physics import Rig
 from ..physics.effects import Effect
 from .problem import SEARCH_RANGES, Problem
-from .result import FitResult, build_result
+from .result import FitResult
+from .statistics import build_result, emit_warnings
+
+# The global search and the multi-start fits run on at most this many frequencies (chosen by
+# Problem.thinned); only the best start is then refined on all points. Keeps a 16k-point FRF
+# within seconds; data with fewer points are used whole, so small fits are unchanged.
+SEARCH_POINTS = 512
 
 
 def identify(
@@ -32,6 +37,7 @@ def identify(
     max_nfev: int | None = None,
     tol: float = 1e-12,
     seed: int = 0,
+    warn: bool | None = None,
 ) -> FitResult:
     """Fit free model parameters to measured FRFs.
 
@@ -55,29 +61,79 @@ def identify(
         (over m2, kp, R, L when free; SPEC §9 ranges) in one batched call
         and refine the best ``n_refine`` with least squares. The true values
         may lie anywhere in those ranges: no good start is needed.
+    n_search : size of the Sobol design (rounded up to a power of 2).
+    n_refine : distinct best design points refined by least squares.
     bounds : {name: (lo, hi)} overriding the default hard bounds.
     scale : without std in the data, residuals are divided by s = max|x*|
         per channel ("channel", default) or over all fitted channels
         together ("global", paper eq. 13 as the paper's code has it).
+    max_nfev : most function evaluations of each least-squares run (None: SciPy's default).
+    tol : ftol, xtol and gtol of least squares.
+    seed : seed of the scrambled Sobol design.
+    warn : also emit the result's poor-fit warnings (model cannot represent
+        the data, parameters pinned at a bound) as `satmd.io.DataWarning`.
+        They are always in ``FitResult.warnings``. None (default): emit when
+        called from user code or the CLI, not from satmd's own packages,
+        which fit wrong models on purpose (discovery's model selection).
 
     Returns
     -------
     FitResult
+
+    Raises
+    ------
+    DataError
+        For inputs that cannot give a meaningful fit: no more frequency
+        points than free parameters, non-physical magnitudes, ``reg < 0``,
+        start values outside the bounds, invalid search settings.
     """
     t0 = time.perf_counter()
+    _check_settings(reg, n_search, n_refine, max_nfev, tol)
+    n_search, n_refine = int(n_search), int(n_refine)
+    max_nfev = None if max_nfev is None else int(max_nfev)
     problem = Problem(data, rig, free, channels, effects, bounds, scale)
     starts = _starts(problem, start)
     nominal = starts[0]
+    coarse = problem.thinned(SEARCH_POINTS)  # memory and time O(points), not O(points × starts)
     if global_search:
-        starts = starts + _search(problem, n_search, n_refine, seed, starts)
+        starts = starts + _search(coarse, n_search, n_refine, seed, starts)
     best, nfev = None, 0
     for s in starts:
-        fit = _local_fit(problem, s, nominal, reg, max_nfev, tol)
+        fit = _local_fit(coarse, s, nominal, reg, max_nfev, tol)
         nfev += fit.nfev
         if best is None or fit.cost < best.cost:
             best = fit
+    if coarse is not problem:  # polish the best start on every point
+        best = _local_fit(problem, coarse.values_from_x(best.x, nominal), nominal, reg, max_nfev, tol)
+        nfev += best.nfev
     theta = problem.values_from_x(best.x, nominal)
-    return build_result(problem, theta, nominal, nfev, time.perf_counter() - t0, best, reg)
+    result = build_result(problem, theta, nominal, nfev, time.perf_counter() - t0, best, reg)
+    if warn is None:
+        caller = sys._getframe(1).f_globals.get("__name__", "")
+        warn = not caller.startswith("satmd.") or caller.startswith("satmd.cli")
+    if warn:
+        emit_warnings(result)
+    return result
+
+
+def _check_settings(reg, n_search, n_refine, max_nfev, tol):
+    """Refuse settings that would give NaN or a silent no-op instead of a fit."""
+    def bad(name, value, need):
+        raise DataError(f"{name} must be {need}, got {value!r}")
+
+    if not (isinstance(reg, (int, float, np.number)) and np.isfinite(reg) and reg >= 0):
+        bad("reg", reg, "a finite number >= 0")
+    if not (isinstance(tol, (int, float, np.number)) and np.isfinite(tol) and 0 < tol < 1):
+        bad("tol", tol, "in (0, 1)")
+
+    def whole(v):
+        return isinstance(v, (int, float, np.number)) and np.isfinite(v) and float(v).is_integer()
+
+    for name, value in (("n_search", n_search), ("n_refine", n_refine)):
+        if not (whole(value) and 1 <= value <= 1 << 20):
+            bad(name, value, "an integer in 1..1048576")
+    if max_nfev is not None and not (whole(max_nfev) and max_nfev >= 1):
+        bad("max_nfev", max_nfev, "None or an integer >= 1")
 
 
 def _starts(problem: Problem, start) -> list[np.ndarray]:
@@ -94,6 +150,11 @@ def _starts(problem: Problem, start) -> list[np.ndarray]:
         if unknown:
             raise DataError(f"start names {sorted(unknown)} are not free parameters ({', '.join(problem.names)})")
         theta = np.array([float(s.get(n, b)) for n, b in zip(problem.names, base)])
+        # a given start outside the bounds is refused (clipping would silently fit from elsewhere);
+        # defaults taken from the rig or effect are only brought inside
+        for n, v, p in zip(problem.names, theta, problem.params):
+            if n in s and not p.lower <= v <= p.upper:
+                raise DataError(f"start {n}={v:g} is outside the bounds [{p.lower:g}, {p.upper:g}] of {n}")
         out.append(np.clip(theta, problem.lower, problem.upper))
     return out
 
@@ -106,6 +167,8 @@ def _search(problem: Problem, n_search, n_refine, seed, starts) -> list[np.ndarr
     lo = np.log([SEARCH_RANGES[problem.names[i]][0] for i in idx])
     hi = np.log([SEARCH_RANGES[problem.names[i]][1] for i in idx])
     m = int(np.ceil(np.log2(max(n_search, 2))))
+    from scipy.stats import qmc  # imported here: scipy.stats costs 0.3 s at `import satmd`
+
     u = qmc.Sobol(len(idx), scramble=True, seed=seed).random_base2(m)
     thetas = np.repeat(starts[0][None, :], u.shape[0], axis=0)
     thetas[:, idx] = np.exp(lo + u * (hi - lo))
@@ -140,6 +203,8 @@ def _local_fit(problem: Problem, theta0, nominal, reg, max_nfev, tol):
             r = np.concatenate([r, sqrt_reg * x])
             J = np.vstack([J, sqrt_reg * np.eye(x.size)])
         return r, J
+
+    from scipy.optimize import least_squares  # imported where used: keeps `import satmd` fast
 
     fun, jac = _split(fun_jac)
     return least_squares(fun, x0, jac=jac, bounds=(lo, hi), method="trf", x_scale="jac",

@@ -1,12 +1,15 @@
 """Repeated optimisation: one global fit per FRF, spread over any executor."""
 from __future__ import annotations
 
-from concurrent.futures import Executor
 from functools import partial
-from typing import Sequence
+from typing import TYPE_CHECKING, Sequence
 
+from .._fleet import fleet_map
 from ..io.frfdata import FRFData
 from .fit import identify
+
+if TYPE_CHECKING:  # only for the annotation: concurrent.futures would cost start-up time
+    from concurrent.futures import Executor
 
 
 def _fit_one(data, kwargs):
@@ -14,25 +17,26 @@ def _fit_one(data, kwargs):
 
 
 def identify_many(datas: Sequence[FRFData], executor: Executor | None = None, progress: bool = False,
-                  **kwargs) -> list:
+                  chunksize: int = 1, **kwargs) -> list:
     """Fit every FRF in ``datas`` (same keyword arguments as `identify`).
 
-    ``executor`` is any `concurrent.futures.Executor`: a ProcessPoolExecutor
-    spreads the fleet over cores, a Dask ``client.get_executor()`` over
-    machines; None runs in this process. Results come back in input order.
+    Parameters
+    ----------
+    datas : sequence of FRFData
+        The measurements, one fit each.
+    executor : concurrent.futures.Executor or None
+        A ProcessPoolExecutor spreads the fleet over cores, a Dask
+        ``distributed.Client(address).get_executor()`` over machines; None runs
+        in this process. The results are the serial ones bit for bit.
+    progress : show progress on stderr.
+    chunksize : FRFs sent to a worker as one task (more for quick fits).
+    **kwargs :
+        Passed to `identify`. Poor-fit warnings stay on each result unless
+        ``warn=True`` is passed.
+
+    Returns
+    -------
+    list of FitResult
+        In input order.
     """
-    fn = partial(_fit_one, kwargs=kwargs)
-    if executor is None:
-        it = map(fn, datas)
-        if progress:
-            it = _progress(it, len(datas))
-        return list(it)
-    return list(executor.map(fn, datas))
-
-
-def _progress(it, total):
-    try:
-        from tqdm import tqdm
-    except ImportError:  # tqdm comes with the nn extra; plain iteration without it
-        return it
-    return tqdm(it, total=total, desc="identify", unit="FRF")
+    return fleet_map(partial(_fit_one, kwargs=kwargs), datas, executor, chunksize, progress, "identify", "FRF")

@@ -7,7 +7,10 @@
 
 Kinds: ``physics`` (eq. 22 loss through the torch twin), ``supervised``
 (MSE on labels), ``optimization`` (repeated global least squares) and
-``hybrid`` (net + a few least-squares steps); see `satmd.inverse.model`.
+``hybrid`` (net + a few least-squares steps): strategy objects in
+`satmd.inverse.strategies`. Every prediction carries a forward check
+(``residual_ratio``, ``explained``), and FRFs on any grid are brought onto the
+net's (`satmd.inverse.inputs`).
 The NumPy parts (datasets, metadata) import without torch; the nets need it.
 """
 from .dataset import (
@@ -23,9 +26,11 @@ from .dataset import (
     pairs_dataset,
 )
 from .evaluation import evaluate
-from .model import KINDS, InverseModel, normalised_outputs
+from .model import InverseModel, normalised_outputs
+from .strategies import KINDS, NET_KINDS
 
 __all__ = [
-    "InverseModel", "normalised_outputs", "KINDS", "InverseDataset", "make_dataset", "pairs_dataset", "evaluate",
+    "InverseModel", "normalised_outputs", "KINDS", "NET_KINDS", "InverseDataset", "make_dataset", "pairs_dataset",
+    "evaluate",
     "BOUNDS", "BOX_RANGE", "PAPER_PAIRS", "BLIND_PAIRS", "OFF_CURVE_PAIRS", "PAPER_TABLE2", "PAPER_TABLE2_MAE",
 ]

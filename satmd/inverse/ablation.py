@@ -16,6 +16,7 @@ and carry its std, as a measured FRF would.
 """
 from __future__ import annotations
 
+import dataclasses
 import platform
 import time
 
@@ -59,17 +60,17 @@ def loop_speedup(preset: str = "paper", epochs: int = 3, loop_epochs: int = 2, n
 
     from .model import InverseModel
     from .nets import EnsembleNet
-    from .training import Scaler, TrainConfig, per_sample_epoch, train_ensemble
+    from .training import Scaler, per_sample_epoch, train_ensemble
 
     m = InverseModel("physics", preset)
     data = m.make_data()
     scaler = Scaler.fit(data.train.features())
-    cfg = TrainConfig(objective="physics", epochs=epochs, warm_start_epochs=0, n_members=m.n_members, seed=seed,
-                      batch_size=m.batch_size, device="cpu")
+    cfg = dataclasses.replace(m.train_config("physics"), epochs=epochs, warm_start_epochs=0, seed=seed, device="cpu")
     _, hist = train_ensemble(data.train, None, cfg, scaler, verbose=False)
     vec = float(np.mean(hist["epoch_s"]))
     net = EnsembleNet(m.n_members, generator=torch.Generator().manual_seed(seed))
-    runs = [per_sample_epoch(net, data.train, scaler, batch_size=m.batch_size, max_samples=n_loop)
+    runs = [per_sample_epoch(net, data.train, scaler, batch_size=m.batch_size, max_samples=n_loop,
+                             dtype=getattr(torch, m.twin_dtype))
             for _ in range(1 if n_loop else loop_epochs)]
     loop = float(np.mean(runs))
     return {"vectorised_epoch_s": vec, "per_sample_epoch_s": loop, "speedup": loop / vec, "n_train": len(data.train),

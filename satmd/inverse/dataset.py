@@ -179,8 +179,8 @@ def jitter_pairs(pairs, per_pair: int, rng, jitter_r=JITTER_R, jitter_l=JITTER_L
 
 def make_dataset(
     preset: str = "paper",
-    samples_per_pair: int = 200,
-    n_samples: int = 8000,
+    samples_per_pair: int | None = None,
+    n_samples: int | None = None,
     val_fraction: float = 0.2,
     seed: int = 0,
     freq_hz=PAPER_GRID_HZ,
@@ -191,15 +191,27 @@ def make_dataset(
     Parameters
     ----------
     preset : "paper" or "box"
-    samples_per_pair : samples around each of the 30 reference pairs (paper; the reference used 5)
-    n_samples : number of samples (box)
+    samples_per_pair : samples around each of the 30 reference pairs (paper; the reference used 5;
+        None: ``satmd.inverse.params.PRESET_SIZES``)
+    n_samples : number of samples (box; None: ``PRESET_SIZES``)
     val_fraction : share of reference pairs (paper) or of samples (box) in the validation set
     seed : everything random (jitter, split) derives from it
+    freq_hz : frequency grid
+    rig : fixed mechanical parameters (default: the paper's rig)
+
+    Returns
+    -------
+    InverseDataset
     """
     if preset not in PRESETS:
         raise SatmdError(f"unknown preset {preset!r}; choose from {', '.join(PRESETS)}")
     if not 0.0 <= val_fraction < 1.0:
         raise SatmdError(f"val_fraction must be in [0, 1), got {val_fraction}")
+    from .params import PRESET_SIZES
+
+    sizes = PRESET_SIZES[preset]
+    samples_per_pair = sizes.get("samples_per_pair") if samples_per_pair is None else samples_per_pair
+    n_samples = sizes.get("n_samples") if n_samples is None else n_samples
     rng = np.random.default_rng(seed)
     freq_hz = np.asarray(freq_hz, float)
     if preset == "paper":
@@ -235,7 +247,22 @@ def make_dataset(
 
 def pairs_dataset(pairs, per_pair: int = 0, seed: int = 0, jitter_r=JITTER_R / 2, jitter_l=JITTER_L / 2,
                   freq_hz=PAPER_GRID_HZ, rig: Rig | None = None, preset: str = "test") -> InverseDataset:
-    """The given pairs exactly, plus ``per_pair`` jittered neighbours of each (test sets)."""
+    """The given pairs exactly, plus ``per_pair`` jittered neighbours of each (test sets).
+
+    Parameters
+    ----------
+    pairs : (k, 2) array of (R, L)
+    per_pair : jittered neighbours per pair
+    seed : jitter seed
+    jitter_r, jitter_l : half-widths of the uniform jitter of R [Ω] and L [H]
+    freq_hz : frequency grid
+    rig : fixed mechanical parameters (default: the paper's rig)
+    preset : label stored in the dataset
+
+    Returns
+    -------
+    InverseDataset
+    """
     rng = np.random.default_rng(seed)
     R, L, group = jitter_pairs(pairs, per_pair, rng, jitter_r, jitter_l, include_centre=True)
     a1, a2 = simulate_pairs(R, L, freq_hz, rig)

@@ -1,26 +1,35 @@
-"""Saving and loading an `InverseModel` without pickle.
+"""`InverseModel.to_dict` / `from_dict` / `save` / `load` without pickle.
 
 A saved model is a folder:
 
 - ``model.json``: schema ``satmd-inverse/1``, hyperparameters, kind, preset,
-  bounds, frequency grid, rig, input scaling, std calibration, seeds,
-  training summary and the versions of satmd / torch / numpy;
+  bounds, frequency grid, rig, input scaling, std calibration, training
+  summary, the versions of satmd / torch / numpy, and a sha256 of all that
+  (a hand-edited file is noticed);
 - ``weights.pt``: the ensemble's ``state_dict`` (tensors only, written with
   ``torch.save`` and read back with ``torch.load(weights_only=True)``);
   absent for the ``optimization`` kind.
+
+Both files are written together or not at all. This module takes the model
+class as an argument and never imports `satmd.inverse.model`.
 """
 from __future__ import annotations
 
+import hashlib
 import json
 from pathlib import Path
 
 import numpy as np
 
 from ..errors import DataError, SatmdError
+from .dataset import BOUNDS
+from .strategies import KINDS, STRATEGIES
 
 SCHEMA = "satmd-inverse/1"
 META = "model.json"
 WEIGHTS = "weights.pt"
+CHECKSUM = "sha256"
+_NOT_PARAMS = ("rig", "freq_hz")  # stored resolved, at the top level
 
 
 def _jsonable(x):
@@ -35,44 +44,141 @@ def _jsonable(x):
     return x
 
 
-def save_model(model, path) -> Path:
-    from .. import __version__
+def _checksum(meta: dict) -> str:
+    body = {k: v for k, v in meta.items() if k != CHECKSUM}
+    return hashlib.sha256(json.dumps(body, sort_keys=True).encode()).hexdigest()
 
-    path = Path(path)
-    path.mkdir(parents=True, exist_ok=True)
+
+def model_meta(model) -> dict:
+    """The JSON-ready description of a fitted model (`InverseModel.to_dict`)."""
+    from ..version import __version__
+
     versions = {"satmd": __version__, "numpy": np.__version__}
-    history = {k: v for k, v in model.history_.items() if k in ("loss", "val_mae", "phase", "train_s", "device")}
+    history = {k: v for k, v in getattr(model, "history_", {}).items()
+               if k in ("loss", "val_mae", "val_epoch", "phase", "train_s", "device")}
     meta = {
         "schema": SCHEMA,
-        "params": model.get_params(),
+        "params": {k: v for k, v in model.get_params().items() if k not in _NOT_PARAMS},
         "kind": model.kind,
         "preset": model.preset,
         "bounds": {k: list(v) for k, v in model.bounds.items()},
-        "freq_hz": model.freq_hz.tolist(),
-        "rig": {k: float(v) for k, v in model.rig.as_dict().items()},
+        "freq_hz": np.asarray(model.freq_hz, float).tolist(),
+        "rig": {k: float(v) for k, v in model._rig.as_dict().items()},
         "feature_order": "[Re A1, Re A2, Im A1, Im A2] over freq_hz (satmd.physics.torch.features)",
-        "scaler": model.scaler_.to_dict() if model.scaler_ is not None else None,
-        "std_scale": list(map(float, model.std_scale_)),
+        "scaler": model.scaler_.to_dict() if getattr(model, "scaler_", None) is not None else None,
+        "std_scale": list(map(float, getattr(model, "std_scale_", np.ones(2)))),
         "fit_info": model.fit_info_,
         "history": history,
         "versions": versions,
     }
-    if model.ensemble_ is not None:
+    if getattr(model, "ensemble_", None) is not None:
         import torch
 
         versions["torch"] = torch.__version__
         meta["network"] = {"class": "EnsembleNet", "n_members": model.ensemble_.n_members,
                            "sizes": list(model.ensemble_.sizes)}
-        state = {k: v.detach().cpu().contiguous() for k, v in model.ensemble_.state_dict().items()}
-        torch.save(state, path / WEIGHTS)
-    (path / META).write_text(json.dumps(_jsonable(meta), indent=1), encoding="utf-8")
+    meta = _jsonable(meta)
+    meta[CHECKSUM] = _checksum(meta)
+    return meta
+
+
+def model_from_meta(cls, meta: dict, state: dict | None = None):
+    """The model `model_meta` described, with weights ``state`` (net kinds); `SatmdError` for anything else."""
+    from ..physics import Rig
+
+    if not isinstance(meta, dict) or meta.get("schema") != SCHEMA:
+        got = meta.get("schema") if isinstance(meta, dict) else type(meta).__name__
+        raise DataError(f"schema {got!r}, expected {SCHEMA!r}")
+    if CHECKSUM in meta and meta[CHECKSUM] != _checksum(meta):  # models saved before the checksum have none
+        raise DataError("contents differ from what was saved (checksum mismatch); edited by hand?")
+    for key, kind in (("params", dict), ("rig", dict), ("bounds", dict), ("freq_hz", list), ("std_scale", list)):
+        if not isinstance(meta.get(key), kind):
+            raise DataError(f"{key!r} missing or not a {kind.__name__}")
+    kind = meta.get("kind")
+    if kind not in KINDS:
+        raise DataError(f"unknown kind {kind!r} (known: {', '.join(KINDS)})")
+    strategy = STRATEGIES[kind]
+    info = meta.get("fit_info") or {}
+    objective = info.get("objective") if isinstance(info, dict) else None
+    if meta["params"].get("kind") != kind or not isinstance(info, dict) or info.get("kind", kind) != kind or (
+            objective is not None and objective != strategy.objective):
+        raise DataError(f"kind {kind!r} differs from the kind it was trained as")
+    if strategy.has_net != ("network" in meta) or (strategy.has_net and not isinstance(meta.get("scaler"), dict)):
+        raise DataError(f"kind {kind!r} " + ("needs a network and its input scaler" if strategy.has_net
+                                             else "has no network"))
+    names = set(cls._param_names()) - set(_NOT_PARAMS)
+    # a None where None is not allowed stands for "the default" in models saved by earlier versions
+    params = {k: v for k, v in meta["params"].items()
+              if k in names and (v is not None or None in cls._parameter_constraints.get(k, ()))}
+    params["verbose"] = False
+    try:
+        if {k: tuple(map(float, v)) for k, v in meta["bounds"].items()} != {k: tuple(v) for k, v in BOUNDS.items()}:
+            raise DataError(f"bounds {meta['bounds']} differ from eq. 20's {dict(BOUNDS)}")
+        model = cls(**params, rig=Rig(**meta["rig"]).validate(), freq_hz=np.array(meta["freq_hz"], float))
+        model._validate_params()
+        model.std_scale_ = np.array(meta["std_scale"], float).reshape(2)
+        if strategy.has_net:
+            from .training import Scaler
+
+            model.scaler_ = Scaler.from_dict(meta["scaler"])
+            n_features = (4 * model.freq_hz.size,)
+            if model.scaler_.mean.shape != n_features or model.scaler_.scale.shape != n_features:
+                raise DataError("input scaler does not fit the frequency grid")
+    except (KeyError, TypeError, ValueError) as exc:
+        if isinstance(exc, SatmdError):
+            raise
+        raise DataError(f"damaged model description ({' '.join(str(exc).split())})") from None
+    model.fit_info_ = info or {"loaded": True}
+    model.history_ = meta.get("history") or {}
+    if strategy.has_net:
+        if state is None:
+            raise DataError("a network model needs its weights")
+        model._set_ensemble(_ensemble(meta["network"], state, model.freq_hz.size))
+    return model
+
+
+def _ensemble(net: dict, state: dict, n_freq: int):
+    import torch
+
+    from .nets import EnsembleNet
+
+    try:
+        members, sizes = int(net["n_members"]), [int(s) for s in net["sizes"]]
+    except (KeyError, TypeError, ValueError):
+        raise DataError("damaged network description") from None
+    # bounds on what a file may ask us to allocate (the SPEC net is 240-256-128-64-2)
+    if not (1 <= members <= 256 and len(sizes) >= 2 and sizes[0] == 4 * n_freq and sizes[-1] == 2
+            and all(1 <= s <= 8192 for s in sizes)):
+        raise DataError(f"network {members} x {sizes} does not fit a {n_freq}-point grid")
+    ensemble = EnsembleNet(members, sizes)
+    try:
+        ensemble.load_state_dict(state)
+    except (RuntimeError, TypeError, AttributeError, KeyError):
+        raise DataError(f"the weights do not match the network {members} x {sizes}") from None
+    if not all(bool(torch.isfinite(v).all()) for v in state.values()):
+        raise DataError("weights contain NaN or infinite values (a damaged file)")
+    return ensemble
+
+
+def write_folder(path, meta: dict, state: dict | None) -> Path:
+    """Write ``model.json`` and ``weights.pt`` (when ``state``) into ``path``, both or neither."""
+    from ..io.atomic import all_or_none, atomic_write
+
+    path = Path(path)
+    path.mkdir(parents=True, exist_ok=True)
+    with all_or_none():
+        if state is not None:
+            import torch
+
+            with atomic_write(path / WEIGHTS) as fh:
+                torch.save(state, fh)
+        with atomic_write(path / META, "w") as fh:
+            fh.write(json.dumps(meta, indent=1))
     return path
 
 
-def load_model(path):
-    from ..physics import Rig
-    from .model import InverseModel
-
+def read_folder(cls, path):
+    """The model saved in folder ``path``; a damaged or edited folder is refused with a one-line DataError."""
     path = Path(path)
     meta_file = path / META
     if not meta_file.is_file():
@@ -81,32 +187,30 @@ def load_model(path):
         meta = json.loads(meta_file.read_text(encoding="utf-8"))
     except json.JSONDecodeError as exc:
         raise DataError(f"{meta_file}: invalid JSON ({exc.msg}, line {exc.lineno})") from None
-    if meta.get("schema") != SCHEMA:
-        raise DataError(f"{meta_file}: schema {meta.get('schema')!r}, expected {SCHEMA!r}")
-    import inspect
+    except (OSError, UnicodeDecodeError) as exc:
+        raise DataError(f"{meta_file}: cannot read ({getattr(exc, 'strerror', None) or exc})") from None
+    state = None
+    if isinstance(meta, dict) and STRATEGIES.get(meta.get("kind")) is not None and "network" in meta:
+        state = _read_weights(path / WEIGHTS)
+    try:
+        return model_from_meta(cls, meta, state)
+    except SatmdError as exc:
+        where = path / WEIGHTS if str(exc).startswith(("the weights", "weights")) else meta_file
+        raise DataError(f"{where}: {exc}") from None
 
-    known = set(inspect.signature(InverseModel.__init__).parameters) - {"self", "rig", "freq_hz"}
-    params = {k: v for k, v in dict(meta["params"]).items() if k in known}
-    params["verbose"] = False
-    model = InverseModel(**params, rig=Rig(**meta["rig"]), freq_hz=np.array(meta["freq_hz"]))
-    model.bounds = {k: tuple(v) for k, v in meta["bounds"].items()}
-    model.std_scale_ = np.array(meta["std_scale"], float)
-    model.fit_info_ = meta.get("fit_info") or {"loaded": True}
-    model.history_ = meta.get("history", {})
-    if meta.get("scaler"):
-        from .training import Scaler
 
-        model.scaler_ = Scaler.from_dict(meta["scaler"])
-    if "network" in meta:
-        import torch
+def _read_weights(file: Path) -> dict:
+    import pickle
+    import zipfile
 
-        from .nets import EnsembleNet
+    import torch
 
-        weights = path / WEIGHTS
-        if not weights.is_file():
-            raise SatmdError(f"{path}: {WEIGHTS} is missing")
-        net = EnsembleNet(meta["network"]["n_members"], meta["network"]["sizes"])
-        state = torch.load(weights, map_location="cpu", weights_only=True)
-        net.load_state_dict(state)
-        model._set_ensemble(net)
-    return model
+    if not file.is_file():
+        raise DataError(f"{file}: missing (the model's weights)")
+    try:
+        state = torch.load(file, map_location="cpu", weights_only=True)
+    except (RuntimeError, EOFError, OSError, pickle.UnpicklingError, zipfile.BadZipFile, ValueError):
+        raise DataError(f"{file}: damaged or truncated (not a readable torch weights file)") from None
+    if not isinstance(state, dict) or not all(isinstance(v, torch.Tensor) for v in state.values()):
+        raise DataError(f"{file}: not a state_dict of tensors")
+    return state

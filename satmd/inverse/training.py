@@ -1,8 +1,10 @@
 """Vectorised, seeded training of the inverse nets (needs torch).
 
-One step pushes a whole mini-batch, for every ensemble member at once,
-through the network and (for the physics objective) through the torch twin
-``satmd.physics.torch.frf``: no Python loop over samples or members.
+One step pushes a whole mini-batch, for every ensemble member at once
+(stacked weights, `satmd.inverse.nets.EnsembleNet`), through the network
+and (for the physics objective) through the torch twin
+``satmd.physics.torch.frf``: no Python loop over samples or members. The
+data live on the training device for the whole run.
 
 Objectives
 ----------
@@ -12,16 +14,35 @@ Objectives
     accelerations are compared with the *noise-free* target FRFs:
     ``mean_n mean_j (|Â1 - A1|² + |Â2 - A2|²) / s_n²`` with
     ``s_n = max_{j, channel} |A_n|`` (|z|² = Re² + Im²); no labels in this phase.
-    Its gradient is back-propagated through the twin and, by default,
-    preconditioned per sample by the inverse 2x2 Gauss-Newton matrix of
-    eq. 22 before it enters the network (`physics_objective`): the FRFs are
-    far less sensitive to R than to L, and plain gradient steps leave R
-    loose. A warm start of ``warm_start_epochs`` supervised epochs puts the
-    nets near the solution first (the physics loss is flat far from it); it
-    is reported in the model's ``fit_info_``.
+    With ``precondition`` (default) every sample asks its outputs to move by
+    its Gauss-Newton step of eq. 22 (`gauss_newton_step`; at most
+    ``MAX_STEP``), because the FRFs are far less sensitive to R than to L and
+    plain gradient steps leave R loose. The Jacobian comes from one batched
+    twin call at (R, L) and two nudged points, so no graph is kept through the
+    twin. Without it the plain gradient of eq. 22 is back-propagated through
+    the twin. A warm start of ``warm_start_epochs`` supervised epochs puts the
+    nets near the solution first (the physics loss is flat far from it).
 ``supervised``
     Mean squared error on the normalised labels (the paper's "conventional
     supervised regressor" baseline).
+
+Speed
+-----
+What a step costs on a CPU: the twin (eq. 22 and its Jacobian: one batched
+call in complex64, no graph through it), the net's forward and backward (all
+members in one ``baddbmm`` per layer), and Adam (fused: unfused, the update
+cost as much as the net). Training is *step*-limited, not sample-limited:
+at equal epochs a batch of 256 took a quarter of the steps and gave a
+Table 2 MAE ten times worse at a third of the preset's data, and saved only
+~20 % per sample on a CPU, so the default batch stays 64. On a GPU, raise
+``batch_size`` together with ``epochs``.
+
+Learning rate
+-------------
+``lr`` and ``physics_lr`` are the peak rates at a batch of ``REFERENCE_BATCH``
+(64) samples; a batch of B samples uses ``lr * sqrt(B / 64)`` (the square-root
+rule for Adam). Within each phase the rate follows a cosine from the peak
+down to ``lr_final``.
 
 Noise (eq. 23) is drawn afresh for every batch and member, and added to the
 network inputs only; the physics target stays noise-free.
@@ -30,11 +51,12 @@ from __future__ import annotations
 
 import contextlib
 import math
-import sys
 import time
 from dataclasses import asdict, dataclass
 
 import numpy as np
+
+from ..errors import DataError
 
 try:
     import torch
@@ -46,25 +68,30 @@ from ..physics.torch import frf as torch_frf
 from .dataset import BOUNDS, InverseDataset
 from .nets import EnsembleNet
 
+REFERENCE_BATCH = 64  # the batch at which ``lr`` is quoted (sqrt rule above)
+MAX_STEP = 0.05  # largest Gauss-Newton step per output (normalised units)
+FD_STEP = {"complex128": 1e-6, "complex64": 1e-3}  # finite-difference step of the Jacobian, per twin precision
+N_VAL_POINTS = 20  # validation MAE is recorded this many times per run (cheap history, not every epoch)
 
-@dataclass
+
+@dataclass(frozen=True)
 class TrainConfig:
-    objective: str = "physics"
-    epochs: int = 90
-    warm_start_epochs: int = 50
-    batch_size: int = 64
-    lr: float = 1e-3
-    physics_lr: float | None = 3e-4  # peak lr of the physics phase (None: lr)
-    lr_final: float = 1e-5
-    weight_decay: float = 0.0
-    n_members: int = 5
-    noise: float = 0.0
-    seed: int = 0
-    device: str | None = None
-    twin_dtype: str = "complex128"
-    precondition: bool = True  # Gauss-Newton preconditioning of the eq. 22 gradient (physics phase)
-    max_step: float = 0.05  # largest Gauss-Newton step per output (normalised units)
-    threads: int | None = 1  # torch CPU threads while training (None: leave torch's setting)
+    """Resolved training settings. Build it with `InverseModel.train_config` (the defaults live there)."""
+
+    objective: str
+    epochs: int
+    warm_start_epochs: int
+    batch_size: int
+    lr: float
+    physics_lr: float
+    lr_final: float
+    n_members: int
+    noise: float
+    seed: int
+    device: str | None
+    precondition: bool
+    threads: int | None
+    twin_dtype: str
 
     def to_dict(self):
         return asdict(self)
@@ -75,6 +102,27 @@ def pick_device(device=None) -> torch.device:
     if device in (None, "auto"):
         return torch.device("cuda" if torch.cuda.is_available() else "cpu")
     return torch.device(device)
+
+
+def check_device(device) -> None:
+    """Refuse, before any work, a device other than "cpu", "cuda", "cuda:N" or None, or CUDA torch cannot see."""
+    from ..errors import SatmdError
+
+    if device is None or device == "cpu":
+        return
+    kind, _, index = str(device).partition(":")
+    if kind != "cuda" or (index and not index.isdigit()):
+        raise SatmdError(f"device {device!r}: use cpu, cuda or cuda:N")
+    count = torch.cuda.device_count() if torch.cuda.is_available() else 0
+    if count == 0:
+        raise SatmdError(f"device {device}: torch sees no CUDA device here; use cpu")
+    if index and int(index) >= count:
+        raise SatmdError(f"device {device}: torch sees {count} CUDA device(s), cuda:0..cuda:{count - 1}")
+
+
+def scaled_lr(lr: float, batch_size: int) -> float:
+    """Peak learning rate for ``batch_size`` from the rate quoted at `REFERENCE_BATCH`."""
+    return float(lr) * math.sqrt(int(batch_size) / REFERENCE_BATCH)
 
 
 class Scaler:
@@ -99,7 +147,11 @@ class Scaler:
 
     @classmethod
     def from_dict(cls, d):
-        return cls(np.array(d["mean"]), np.array(d["scale"]))
+        return cls(np.array(d["mean"], float), np.array(d["scale"], float))
+
+
+def _real(dtype):
+    return torch.float64 if dtype == torch.complex128 else torch.float32
 
 
 def _denormalised(out, bounds):
@@ -108,85 +160,69 @@ def _denormalised(out, bounds):
     return r_lo + out[..., 0] * (r_hi - r_lo), l_lo + out[..., 1] * (l_hi - l_lo)
 
 
-def physics_loss(norm_out, target, s_n, freq_t, rig: Rig, bounds=BOUNDS, dtype=torch.complex128):
-    """Eq. 22 for normalised outputs (..., n, 2) against complex targets (n, 2, F).
-
-    Returns the per-(member, sample) loss, shape (..., n).
-    """
-    real = torch.float64 if dtype == torch.complex128 else torch.float32
-    R, L = _denormalised(norm_out.to(real), bounds)
-    pred = torch_frf(freq_t, rig.replace(R=R, L=L), dtype=dtype, device=freq_t.device, outputs=("a1", "a2"))
-    d1 = pred["a1"] - target[:, 0]
-    d2 = pred["a2"] - target[:, 1]
-    err = (d1.real ** 2 + d1.imag ** 2 + d2.real ** 2 + d2.imag ** 2).mean(dim=-1)
-    return err / (s_n * s_n)
-
-
 def _residuals(norm_out, target, s_n, freq_t, rig, bounds, dtype):
-    """Scaled real residual vector of eq. 22, (..., n, 4F)."""
+    """Scaled real residual vector of eq. 22, (..., n, 4F): [Re d1, Re d2, Im d1, Im d2] / s_n."""
     R, L = _denormalised(norm_out, bounds)
     pred = torch_frf(freq_t, rig.replace(R=R, L=L), dtype=dtype, device=freq_t.device, outputs=("a1", "a2"))
-    d = torch.cat([pred["a1"] - target[:, 0], pred["a2"] - target[:, 1]], dim=-1) / s_n[:, None]
+    d = torch.cat([pred["a1"] - target[:, 0], pred["a2"] - target[:, 1]], dim=-1) * (1.0 / s_n)[:, None]
     return torch.cat([d.real, d.imag], dim=-1)
 
 
-def gauss_newton_matrix(norm_out, target, s_n, freq_t, rig, bounds=BOUNDS, dtype=torch.complex128,
-                        h: float = 1e-6, damping: float = 1e-3):
-    """Per-sample 2x2 Gauss-Newton matrix of eq. 22 w.r.t. the normalised outputs, (..., n, 2, 2).
+def physics_loss(norm_out, target, s_n, freq_t, rig: Rig, bounds=BOUNDS, dtype=torch.complex128):
+    """Eq. 22 for normalised outputs (..., n, 2) against complex targets (n, 2, F); per sample, shape (..., n)."""
+    r = _residuals(norm_out.to(_real(dtype)), target, s_n, freq_t, rig, bounds, dtype)
+    return (r * r).sum(dim=-1) / freq_t.numel()
 
-    J (d residual / d output) by forward differences of the twin (two extra
-    evaluations, no graph); H = (2/F) JᵀJ with Levenberg-Marquardt damping.
+
+def gauss_newton_step(norm_out, target, s_n, freq_t, rig, bounds=BOUNDS, dtype=torch.complex128,
+                      damping: float = 1e-3):
+    """Per-sample Gauss-Newton step of eq. 22 in the normalised outputs, and the loss.
+
+    Returns ``(step, loss)``, shapes (..., n, 2) and (..., n). The Jacobian
+    d residual / d output comes from forward differences, with the point and
+    its two nudges in *one* twin call; the 2x2 normal equations (with
+    Levenberg-Marquardt damping) are solved in closed form.
     """
-    real = torch.float64 if dtype == torch.complex128 else torch.float32
+    h = FD_STEP["complex128" if dtype == torch.complex128 else "complex64"]
     with torch.no_grad():
-        o = norm_out.detach().to(real)
-        r0 = _residuals(o, target, s_n, freq_t, rig, bounds, dtype)
-        cols = []
-        for k in range(2):
-            step = torch.zeros_like(o)
-            step[..., k] = h
-            cols.append((_residuals(o + step, target, s_n, freq_t, rig, bounds, dtype) - r0) / h)
-        J = torch.stack(cols, dim=-1)  # (..., n, 4F, 2)
-        H = (2.0 / freq_t.numel()) * J.transpose(-1, -2) @ J
-        diag = torch.diagonal(H, dim1=-2, dim2=-1)
-        H = H + torch.diag_embed(damping * diag + 1e-30)
-    return H
+        o = norm_out.detach().to(_real(dtype))
+        nudge = torch.eye(2, dtype=o.dtype, device=o.device) * h
+        r = _residuals(torch.stack([o, o + nudge[0], o + nudge[1]]), target, s_n, freq_t, rig, bounds, dtype)
+        # products, not divisions: a division costs several multiplications here
+        r0, jr, jl = r[0], (r[1] - r[0]) * (1.0 / h), (r[2] - r[0]) * (1.0 / h)
+        a = (jr * jr).sum(-1) * (1 + damping) + 1e-30
+        b = (jr * jl).sum(-1)
+        c = (jl * jl).sum(-1) * (1 + damping) + 1e-30
+        gr, gl = (jr * r0).sum(-1), (jl * r0).sum(-1)
+        det = a * c - b * b
+        step = torch.stack([(c * gr - b * gl) / det, (a * gl - b * gr) / det], dim=-1)
+    return step, (r0 * r0).sum(-1) / freq_t.numel()
 
 
 def physics_objective(out, target, s_n, freq_t, rig, bounds=BOUNDS, dtype=torch.complex128,
-                      precondition: bool = True, max_step: float = 0.05):
-    """Mean eq. 22 loss of the network outputs ``out`` (..., n, 2), ready for ``backward()``.
+                      precondition: bool = True):
+    """``(objective, loss)`` of the network outputs ``out`` (..., n, 2): ``objective.backward()`` trains.
 
-    The gradient of eq. 22 is back-propagated through the torch twin. With
-    ``precondition``, on its way into the network it is multiplied per sample
-    by the inverse 2x2 Gauss-Newton matrix of eq. 22 (so every sample asks
-    its outputs to move by its Gauss-Newton step, at most ``max_step``): the
-    objective and its minimiser are unchanged, but R, to which the FRFs are
-    far less sensitive than to L, converges as fast as L.
+    With ``precondition`` the objective is the surrogate ``sum(out * step) / n``
+    whose gradient is each sample's Gauss-Newton step (clipped at `MAX_STEP`):
+    the minimiser of eq. 22 is unchanged, but R converges as fast as L.
+    Otherwise it is eq. 22 itself, differentiated through the twin.
+    ``loss`` is the mean eq. 22 value (detached).
     """
-    real = torch.float64 if dtype == torch.complex128 else torch.float32
-    o = out.to(real)
-    if precondition and o.requires_grad:
-        H = gauss_newton_matrix(o, target, s_n, freq_t, rig, bounds, dtype)
-        n_terms = o[..., 0].numel()
-        cap = max_step / n_terms
-
-        def hook(g):
-            step = torch.linalg.solve(H, g.unsqueeze(-1)).squeeze(-1)
-            return step.clamp(-cap, cap)
-
-        o.register_hook(hook)
-    return physics_loss(o, target, s_n, freq_t, rig, bounds, dtype).mean()
+    if not precondition:
+        loss = physics_loss(out, target, s_n, freq_t, rig, bounds, dtype).mean()
+        return loss, loss.detach()
+    step, loss = gauss_newton_step(out, target, s_n, freq_t, rig, bounds, dtype)
+    step = step.clamp(-MAX_STEP, MAX_STEP).to(out.dtype) / out[..., 0].numel()
+    return (out * step).sum(), loss.mean()
 
 
 class _Batches:
-    """Tensors of one partition on the training device."""
+    """Tensors of one partition, resident on the training device."""
 
     def __init__(self, ds: InverseDataset, scaler: Scaler, bounds, device, dtype):
-        real = torch.float64 if dtype == torch.complex128 else torch.float32
-        feats = ds.features()
         self.n = len(ds)
-        self.x = torch.as_tensor(scaler.transform(feats), device=device)
+        self.x = torch.as_tensor(scaler.transform(ds.features()), device=device)
         # per-feature noise scale in standardised units: |A| / feature scale
         mag = np.abs(np.concatenate([ds.a1, ds.a2], axis=-1))
         self.noise_unit = torch.as_tensor(np.concatenate([mag, mag], axis=-1) / scaler.scale, dtype=torch.float32,
@@ -194,18 +230,29 @@ class _Batches:
         self.y = torch.as_tensor(ds.labels_normalised(bounds), dtype=torch.float32, device=device)
         target = np.stack([ds.a1, ds.a2], axis=1)
         self.target = torch.as_tensor(target, dtype=dtype, device=device)
-        self.s_n = torch.as_tensor(np.abs(target).max(axis=(1, 2)), dtype=real, device=device)
+        self.s_n = torch.as_tensor(np.abs(target).max(axis=(1, 2)), dtype=_real(dtype), device=device)
 
 
 def train_ensemble(train: InverseDataset, val: InverseDataset | None, config: TrainConfig, scaler: Scaler,
                    rig: Rig | None = None, bounds=BOUNDS, verbose: bool = True):
     """Train a deep ensemble; returns (EnsembleNet on CPU, history dict).
 
-    History holds per-epoch training loss and validation MAE of the ensemble
-    mean (normalised units) when ``val`` is given, plus timings.
+    Parameters
+    ----------
+    train, val : training data and optional validation data (its MAE is recorded in the history)
+    config : resolved settings (`InverseModel.train_config`)
+    scaler : input standardisation
+    rig : fixed mechanical parameters (default: the paper's rig)
+    bounds : output normalisation bounds (eq. 20)
+    verbose : progress on stderr
+
+    Returns
+    -------
+    (EnsembleNet, dict) : the nets and the history (loss per epoch, validation
+        MAE in normalised units, timings, device, warm-start epochs).
     """
     if config.objective not in ("physics", "supervised"):
-        raise ValueError(f"objective must be 'physics' or 'supervised', got {config.objective!r}")
+        raise DataError(f"objective must be 'physics' or 'supervised', got {config.objective!r}")
     rig = Rig() if rig is None else rig
     device = pick_device(config.device)
     dtype = getattr(torch, config.twin_dtype)
@@ -214,28 +261,27 @@ def train_ensemble(train: InverseDataset, val: InverseDataset | None, config: Tr
     net = EnsembleNet(config.n_members, generator=gen).to(device)
     tr = _Batches(train, scaler, bounds, device, dtype)
     va = _Batches(val, scaler, bounds, device, dtype) if val is not None and len(val) else None
-    freq_t = torch.as_tensor(train.freq_hz, dtype=torch.float64 if dtype == torch.complex128 else torch.float32,
-                             device=device)
+    freq_t = torch.as_tensor(train.freq_hz, dtype=_real(dtype), device=device)
 
-    epochs = int(config.epochs)
-    warm = int(config.warm_start_epochs) if config.objective == "physics" else 0
-    warm = min(warm, epochs)
-    steps_per_epoch = max(1, math.ceil(tr.n / config.batch_size))
-    opt = torch.optim.Adam(net.parameters(), lr=config.lr, weight_decay=config.weight_decay)
+    warm = min(int(config.warm_start_epochs), int(config.epochs)) if config.objective == "physics" else 0
+    phases = []  # (objective, epochs, peak lr at the reference batch)
+    if warm:
+        phases.append(("supervised", warm, config.lr))
+    main_epochs = int(config.epochs) - warm
+    main_lr = config.physics_lr if warm else config.lr
+    if main_epochs:
+        phases.append((config.objective, main_epochs, main_lr))
 
-    def lr_at(step, phase_start, phase_steps, peak):
-        # cosine from the peak to lr_final within each phase (warm start, then main)
-        t = min(1.0, (step - phase_start) / max(1, phase_steps))
-        return config.lr_final + 0.5 * (peak - config.lr_final) * (1 + math.cos(math.pi * t))
-
-    physics_lr = config.lr if config.physics_lr is None else config.physics_lr
-
-    history = {"loss": [], "val_mae": [], "epoch_s": [], "phase": []}
-    bar = _progress(epochs, verbose, f"train {config.objective}")
+    history = {"loss": [], "val_mae": [], "val_epoch": [], "epoch_s": [], "phase": []}
+    total_epochs = sum(p[1] for p in phases)
+    bar = _progress(total_epochs, verbose, f"train {config.objective}")
     t_start = time.perf_counter()
     with _cpu_threads(config.threads if device.type == "cpu" else None):
-        _epochs(net, opt, tr, va, freq_t, config, rig, bounds, dtype, device, gen, noise_gen, warm, epochs,
-                       steps_per_epoch, physics_lr, lr_at, history, bar)
+        for objective, n_epochs, peak in phases:
+            # a fresh Adam per phase: the moment estimates of the other loss do not carry over
+            opt = _adam(net, scaled_lr(peak, config.batch_size), device)
+            _run_phase(net, opt, tr, va, freq_t, config, rig, bounds, dtype, gen, noise_gen, objective, n_epochs,
+                       scaled_lr(peak, config.batch_size), total_epochs, history, bar)
     if bar is not None:
         bar.close()
     history["train_s"] = time.perf_counter() - t_start
@@ -244,10 +290,18 @@ def train_ensemble(train: InverseDataset, val: InverseDataset | None, config: Tr
     return net.cpu().eval(), history
 
 
+def _adam(net, lr, device):
+    """Adam, fused where torch has it (one kernel for all parameters: the unfused update costs as much as
+    the forward and backward passes of this small net on a CPU)."""
+    try:
+        return torch.optim.Adam(net.parameters(), lr=lr, fused=device.type in ("cpu", "cuda"))
+    except (RuntimeError, TypeError):  # pragma: no cover - older torch or another device
+        return torch.optim.Adam(net.parameters(), lr=lr)
+
+
 @contextlib.contextmanager
 def _cpu_threads(n):
-    """Torch CPU threads set to ``n`` for the block (the net is small: one thread is fastest,
-    more only spin, badly so on a busy machine)."""
+    """Torch CPU threads set to ``n`` for the block (on a small shared machine more threads only spin)."""
     before = torch.get_num_threads()
     if n:
         torch.set_num_threads(int(n))
@@ -257,50 +311,51 @@ def _cpu_threads(n):
         torch.set_num_threads(before)
 
 
-def _epochs(net, opt, tr, va, freq_t, config, rig, bounds, dtype, device, gen, noise_gen, warm, epochs,
-            steps_per_epoch, physics_lr, lr_at, history, bar):
-    """The training loop proper (mini-batches of all members at once)."""
+def _run_phase(net, opt, tr, va, freq_t, config, rig, bounds, dtype, gen, noise_gen, objective, n_epochs, peak,
+               total_epochs, history, bar):
+    """One phase of mini-batch epochs (all members at once), cosine learning rate from ``peak``."""
+    device = tr.x.device
+    batch = int(config.batch_size)
+    steps = n_epochs * max(1, math.ceil(tr.n / batch))
+    val_every = max(1, math.ceil(total_epochs / N_VAL_POINTS))
     step = 0
-    for epoch in range(epochs):
+    for _ in range(n_epochs):
         t0 = time.perf_counter()
-        phase = "supervised" if (config.objective == "supervised" or epoch < warm) else "physics"
-        if phase == "physics" and config.objective == "physics" and epoch == warm and warm:
-            opt = torch.optim.Adam(net.parameters(), lr=physics_lr, weight_decay=config.weight_decay)
-        peak = physics_lr if (phase == "physics" and warm) else config.lr
-        phase_start = 0 if epoch < warm or not warm else warm * steps_per_epoch
-        phase_steps = (warm if epoch < warm else epochs - warm) * steps_per_epoch
         perm = torch.randperm(tr.n, generator=gen).to(device)
-        total = 0.0
+        total = torch.zeros((), device=device)  # summed on the device: no host sync per step
         net.train()
-        for i in range(0, tr.n, config.batch_size):
-            idx = perm[i:i + config.batch_size]
+        for i in range(0, tr.n, batch):
+            idx = perm[i:i + batch]
             x = tr.x[idx]
             if config.noise:
-                eps = torch.randn((config.n_members,) + tuple(x.shape), generator=noise_gen, device=device)
+                eps = torch.randn((net.n_members,) + tuple(x.shape), generator=noise_gen, device=device)
                 x = x.unsqueeze(0) + config.noise * tr.noise_unit[idx].unsqueeze(0) * eps
+            t = min(1.0, step / max(1, steps))
             for g in opt.param_groups:
-                g["lr"] = lr_at(step, phase_start, phase_steps, peak)
+                g["lr"] = config.lr_final + 0.5 * (peak - config.lr_final) * (1 + math.cos(math.pi * t))
             out = net(x)
-            if phase == "physics":
-                loss = physics_objective(out, tr.target[idx], tr.s_n[idx], freq_t, rig, bounds, dtype,
-                                         config.precondition, config.max_step)
+            if objective == "physics":
+                obj, loss = physics_objective(out, tr.target[idx], tr.s_n[idx], freq_t, rig, bounds, dtype,
+                                              config.precondition)
             else:
-                loss = ((out - tr.y[idx]) ** 2).mean()
+                obj = loss = ((out - tr.y[idx]) ** 2).mean()
             opt.zero_grad(set_to_none=True)
-            loss.backward()
+            obj.backward()
             opt.step()
-            total += float(loss.detach()) * idx.numel()
+            total += loss.detach().to(total.dtype) * idx.numel()
             step += 1
-        history["loss"].append(total / tr.n)
-        history["phase"].append(phase)
-        if va is not None:
+        history["loss"].append(float(total) / tr.n)
+        history["phase"].append(objective)
+        epoch = len(history["loss"])
+        if va is not None and (epoch % val_every == 0 or epoch == total_epochs):
             net.eval()
             with torch.no_grad():
                 pred = net(va.x).mean(dim=0)
                 history["val_mae"].append((pred - va.y).abs().mean(dim=0).tolist())
+                history["val_epoch"].append(epoch)
         history["epoch_s"].append(time.perf_counter() - t0)
         if bar is not None:
-            post = {"loss": f"{history['loss'][-1]:.3g}", "phase": phase[:4]}
+            post = {"loss": f"{history['loss'][-1]:.3g}", "phase": objective[:4]}
             if history["val_mae"]:
                 post["val"] = f"{max(history['val_mae'][-1]):.2e}"
             bar.set_postfix(post, refresh=False)
@@ -308,13 +363,9 @@ def _epochs(net, opt, tr, va, freq_t, config, rig, bounds, dtype, device, gen, n
 
 
 def _progress(total, verbose, desc):
-    if not verbose or not sys.stderr.isatty():
-        return None
-    try:
-        from tqdm.auto import tqdm
-    except ImportError:  # pragma: no cover
-        return None
-    return tqdm(total=total, desc=desc, unit="epoch", leave=False)
+    from .._progress import progress  # a bar on a terminal, periodic lines otherwise
+
+    return progress(total, desc, "epoch", enabled=verbose)
 
 
 def per_sample_epoch(net: EnsembleNet, train: InverseDataset, scaler: Scaler, rig: Rig | None = None,
@@ -329,16 +380,16 @@ def per_sample_epoch(net: EnsembleNet, train: InverseDataset, scaler: Scaler, ri
     """
     rig = Rig() if rig is None else rig
     tr = _Batches(train, scaler, bounds, torch.device("cpu"), dtype)
-    freq_t = torch.as_tensor(train.freq_hz, dtype=torch.float64)
+    freq_t = torch.as_tensor(train.freq_hz, dtype=_real(dtype))
     opt = torch.optim.Adam(net.parameters(), lr=lr)
     n = tr.n if max_samples is None else min(tr.n, max_samples)
     t0 = time.perf_counter()
     opt.zero_grad()
     for i in range(n):
         out = net(tr.x[i:i + 1])
-        loss = physics_objective(out, tr.target[i:i + 1], tr.s_n[i:i + 1], freq_t, rig, bounds, dtype,
-                                 precondition) / batch_size
-        loss.backward()
+        obj, _ = physics_objective(out, tr.target[i:i + 1], tr.s_n[i:i + 1], freq_t, rig, bounds, dtype,
+                                   precondition)
+        (obj / batch_size).backward()
         if (i + 1) % batch_size == 0 or i == n - 1:
             opt.step()
             opt.zero_grad()

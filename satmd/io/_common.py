@@ -2,14 +2,14 @@
 from __future__ import annotations
 
 import math
-
-import numpy as np
-
 import re
 import warnings
 from pathlib import Path
 
+import numpy as np
+
 from ..errors import FormatError
+from .atomic import all_or_none, atomic_write  # noqa: F401 - io modules import them from here too
 
 G0 = 9.80665  # standard gravity, for accelerations in g
 
@@ -24,6 +24,11 @@ class DataWarning(UserWarning):
 
 def warn(path, message: str):
     warnings.warn(f"{path}: {message}", DataWarning, stacklevel=3)
+
+
+def short_error(exc) -> str:
+    """An exception from a third-party reader as a short one-line text (for `FormatError` messages)."""
+    return " ".join(str(exc).split())[:120] or type(exc).__name__
 
 
 def read_bytes(path) -> bytes:
@@ -155,6 +160,14 @@ def parse_channel_map(spec, allowed, aliases=None) -> dict:
     if not out:
         raise ValueError("channel map is empty")
     return out
+
+
+def channel_map_of(path, spec, allowed, aliases=None) -> dict:
+    """`parse_channel_map` for a reader: a malformed map is a `FormatError` naming the file."""
+    try:
+        return parse_channel_map(spec, allowed, aliases)
+    except ValueError as exc:
+        raise FormatError(path, str(exc)) from None
 
 
 def split_csv(path, text: str, magic: str):

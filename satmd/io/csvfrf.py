@@ -1,23 +1,29 @@
 """The `satmd-frf v1` CSV format (SPEC §7): strict reader, exact writer."""
 from __future__ import annotations
 
-import os
+import json
 from pathlib import Path
 
 import numpy as np
 
 from ..errors import FormatError
 from ._common import decode_text, numeric_table, read_bytes, split_csv
+from .atomic import atomic_write
 from .frfdata import CHANNELS, FRFData
 
 MAGIC = "# satmd-frf v1"
 _SUFFIXES = ("re", "im", "std")
+ESTIMATOR_KEY = "satmd estimator"  # comment line holding FRFData.estimator as JSON
 
 
 def read_csv(path) -> FRFData:
     """Read a SPEC §7 file; any malformation raises FormatError (file, line, column)."""
     path = Path(path)
     text = decode_text(path, read_bytes(path))
+    if text.lstrip().lower().startswith("# satmd-transmissibility"):  # say what the file is, not "unknown channel"
+        raise FormatError(path, "holds a transmissibility A2/A1 (written by estimate-frf from an output-only "
+                                "recording), not FRFs per unit force; FRFs need a recording with a force channel",
+                          line=1)
     header, header_line, rows, meta = split_csv(path, text, "satmd-frf")
     if header is None:
         raise FormatError(path, "no column header (expected freq_hz,a1_re,a1_im,...)")
@@ -47,7 +53,15 @@ def read_csv(path) -> FRFData:
                                   column=f"{cols['std'] + 1} ({ch}_std)")
             std[ch] = s
     meta.setdefault("source", str(path))
-    return FRFData(freq, chans, std, meta)
+    estimator = {}
+    if ESTIMATOR_KEY in meta:
+        try:
+            estimator = json.loads(meta.pop(ESTIMATOR_KEY))
+        except ValueError:
+            raise FormatError(path, f"the '# {ESTIMATOR_KEY}:' comment is not JSON") from None
+        if not isinstance(estimator, dict):
+            raise FormatError(path, f"the '# {ESTIMATOR_KEY}:' comment is not a JSON object")
+    return FRFData(freq, chans, std, meta, estimator=estimator)
 
 
 def _parse_header(path, header, lineno):
@@ -90,11 +104,12 @@ def write_csv(data: FRFData, path) -> Path:
     table = np.column_stack(cols)
     lines = [MAGIC]
     for k, v in data.meta.items():
-        if k != "source" and "\n" not in f"{k}{v}":
+        if k != "source" and k != ESTIMATOR_KEY and "\n" not in f"{k}{v}":
             lines.append(f"# {k}: {v}")
+    if data.estimator:  # how the FRFs were estimated travels with them (a Welch kernel is part of the model)
+        lines.append(f"# {ESTIMATOR_KEY}: {json.dumps(data.estimator, separators=(',', ':'))}")
     lines.append(",".join(header))
     lines += [",".join(f"{x:.17g}" for x in row) for row in table]
-    tmp = path.with_name(f".{path.name}.tmp{os.getpid()}")
-    tmp.write_text("\n".join(lines) + "\n", encoding="utf-8")
-    os.replace(tmp, path)
+    with atomic_write(path, "w") as fh:
+        fh.write("\n".join(lines) + "\n")
     return path

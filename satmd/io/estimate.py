@@ -1,4 +1,4 @@
-"""FRFs and transmissibilities from time recordings (Welch averaging, H1/H2).
+"""FRFs and transmissibilities from time recordings: the local polynomial method (default) or Welch H1/H2.
 
 Spectra are averaged over ``K`` windowed segments (``nperseg`` samples,
 ``overlap`` fraction, mean removed per segment):
@@ -28,7 +28,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import DataError
-from ._common import warn
+from ._common import atomic_write, warn
 from .frfdata import FRFData
 from .recording import Recording
 
@@ -85,6 +85,9 @@ class Spectra:
 def spectra(rec: Recording, reference: str, responses, nperseg=None, window="hann", overlap=0.5) -> Spectra:
     """Welch-averaged Gxx, Gxy, Gyy of ``reference`` against each of ``responses``."""
     n = rec.n_samples
+    if n < 16:  # before nperseg: its range 8..n would read "8..5"
+        raise DataError(f"{rec.meta.get('source', 'recording')}: {n} samples is too short to estimate spectra "
+                        f"(at least 16)")
     nperseg = default_nperseg(rec.fs_hz, n) if nperseg is None else nperseg
     if isinstance(nperseg, bool) or int(nperseg) != nperseg or not 8 <= nperseg <= n:
         raise DataError(f"nperseg must be an integer in 8..{n} (the recording's length), got {nperseg}")
@@ -172,20 +175,71 @@ def _usable(path, s: Spectra, arrays, band):
     return keep
 
 
-def estimate_frf(recording: Recording, nperseg: int | None = None, window="hann", overlap: float = 0.5,
-                 estimator: str = "H1", band=None) -> FRFData:
-    """FRFs a1 = acc1/force and a2 = acc2/force with coherence and std (see the module docstring).
+def estimate_frf(recording: Recording, nperseg: int | None = None, window=None, overlap: float | None = None,
+                 estimator: str | None = None, band=None, width_hz: float | None = None) -> FRFData:
+    """FRFs a1 = acc1/force and a2 = acc2/force with std, coherence and measurement-chain findings.
 
     Parameters
     ----------
-    recording : Recording with a ``force`` channel and ``acc1`` and/or ``acc2``
-    nperseg : samples per segment (default: `default_nperseg`)
-    window : any `scipy.signal.get_window` name
-    overlap : fraction of a segment shared with the next one
-    estimator : "H1" (noise on the responses; default) or "H2" (noise on the force)
-    band : (lo, hi) in Hz to keep, either may be None
+    recording : Recording
+        With a ``force`` channel and ``acc1`` and/or ``acc2``.
+    nperseg, window, overlap :
+        Welch settings (samples per segment, any `scipy.signal.get_window`
+        name, overlap fraction); giving any of them selects Welch H1.
+    estimator : {"lpm", "H1", "H2"}, optional
+        ``lpm``: the local polynomial method on the full record (the default:
+        no window, full resolution, leakage and transient removed, std from the
+        local residual; `satmd.io.lpm`). ``H1`` / ``H2``: Welch averaging
+        (noise on the responses / on the force).
+    band : (lo, hi), optional
+        Band to keep in Hz, either may be None. The LPM also keeps to the band
+        the force excites, and says so.
+    width_hz : float, optional
+        LPM window width in Hz (default: 0.3 Hz, or a fifth of the sharpest
+        resonance's half-power width when that is narrower).
+
+    Returns
+    -------
+    FRFData
+        With ``std``, ``coherence`` and ``estimator`` (method, settings,
+        ``noise_dof``, and ``measurement`` findings, see `satmd.io.chain`).
     """
-    est = _check_estimator(estimator)
+    welch_given = any(v is not None for v in (nperseg, window, overlap))
+    method = ("H1" if welch_given else "lpm") if estimator is None else str(estimator)
+    if method.lower() == "lpm":
+        if welch_given:
+            raise DataError("nperseg, window and overlap are Welch settings: they do not apply to the lpm estimator")
+        return _estimate_lpm(recording, band, width_hz)
+    return _estimate_welch(recording, nperseg, "hann" if window is None else window,
+                           0.5 if overlap is None else overlap, method, band)
+
+
+def _kernel_rms_hz(win: np.ndarray, fs_hz: float):
+    """RMS width of a window's power kernel |W(f)|², from Parseval: ∫f²|W|² = ∫|w'|²/(4π²).
+
+    None for windows that do not taper to zero (boxcar): their sinc² kernel has no
+    finite second moment, so no second-order model of their smoothing exists.
+    """
+    if win[0] > 0.01 * win.max():
+        return None
+    return float(fs_hz * np.sqrt(np.sum(np.diff(win) ** 2) / np.sum(win ** 2)) / (2 * np.pi))
+
+
+def describe_estimate(data) -> str:
+    """One line on how FRFs were estimated from a recording (empty for other FRFs)."""
+    e = data.estimator
+    if not e:
+        return ""
+    if e["method"] == "lpm":
+        lo, hi = e["band_hz"]
+        return (f"local polynomial method on the full {e['record_s']:g} s record, {e['points']} independent points "
+                f"{lo:.1f}–{hi:.1f} Hz (the band the force excites), windows of {e['window_hz']:.3g} Hz, "
+                f"noise from {e['noise_dof']:.0f} degrees of freedom")
+    return (f"Welch {e['method'][6:]}, {e['window']} window, nperseg={e['nperseg']} ({e['resolution_hz']:.3g} Hz), "
+            f"{e['segments']} averages")
+
+
+def _check_force(recording: Recording):
     source = recording.meta.get("source", "recording")
     if "force" not in recording.channels:
         raise DataError(f"{source}: no force channel (output-only recording): FRFs need the force; "
@@ -193,7 +247,54 @@ def estimate_frf(recording: Recording, nperseg: int | None = None, window="hann"
     responses = [r for r in _RESPONSES if r in recording.channels]
     if not responses:
         raise DataError(f"{source}: no acc1 or acc2 channel (has {', '.join(recording.channels)})")
+    return source, responses
+
+
+def _estimate_lpm(recording: Recording, band, width_hz) -> FRFData:
+    from .chain import clipping_findings, lpm_findings
+    from .lpm import lpm
+
+    source, _ = _check_force(recording)
+    if recording.n_samples < 256:
+        raise DataError(f"{source}: {recording.n_samples} samples is too short for a local-polynomial FRF "
+                        f"estimate (need at least 256)")
+    est = lpm(recording, band=band, width_hz=width_hz)
+    s = est.settings
+    findings = clipping_findings(recording) + lpm_findings(est.freq_hz, est.frf, est.std, s,
+                                                           est.force_noise_bias, band)
+    floor = 1e-10 * max(np.max(np.abs(h)) for h in est.frf.values())
+    std = {c: np.maximum(v, floor) for c, v in est.std.items()}
+    info = {"method": "lpm", "reference": "Pintelon et al. 2010, local polynomial method",
+            "record_s": round(s["record_s"], 6), "band_hz": [round(b, 6) for b in s["band_hz"]],
+            "window_hz": round(s["window_hz"], 6), "bins_per_window": s["bins_per_window"],
+            "degree": s["degree"], "points": int(est.freq_hz.size), "noise_dof": round(s["noise_dof"], 1),
+            "force_noise_floor_detected": s["force_noise_floor"] is not None,
+            "max_force_noise_bias": float(np.max(est.force_noise_bias)),
+            "measurement": [f.to_dict() for f in findings]}
+    meta = {"source": str(source), "estimator": "lpm", "resolution_hz": f"{s['window_hz']:.6g}",
+            "band_hz": f"{s['band_hz'][0]:.6g}:{s['band_hz'][1]:.6g}", "noise_dof": f"{s['noise_dof']:.0f}",
+            "noise": "local-polynomial residual, noise spectra smoothed over "
+                     f"{s['smooth_windows']} windows"}
+    return FRFData(est.freq_hz, est.frf, std, meta, coherence=est.coherence, estimator=info,
+                   correlation=est.correlation)
+
+
+def _estimate_welch(recording: Recording, nperseg, window, overlap, estimator, band) -> FRFData:
+    from .chain import clipping_findings, welch_findings
+
+    from .lpm import excited_band
+
+    est = _check_estimator(estimator)
+    source, responses = _check_force(recording)
     s = spectra(recording, "force", responses, nperseg, window, overlap)
+    # bins the force never excited are noise over noise: keep to the excited band, as the LPM does
+    lo, hi, _ = excited_band(recording["force"], recording.fs_hz)
+    requested = band
+    band = (lo if not band or band[0] is None else max(lo, band[0]),
+            hi if not band or band[1] is None else min(hi, band[1]))
+    if band[1] <= band[0]:
+        raise DataError(f"band {requested[0]}:{requested[1]} Hz holds no frequency bin the force excites "
+                        f"({lo:.1f}–{hi:.1f} Hz)")
     results = {r: _frf_from_spectra(s, r, est) for r in responses}
     keep = _usable(source, s, [a for res in results.values() for a in res], band)
     f = s.freq_hz[keep]
@@ -205,9 +306,16 @@ def estimate_frf(recording: Recording, nperseg: int | None = None, window="hann"
         std[ch] = np.maximum(sd[keep], _FLOOR * np.max(np.abs(h[keep])))
     if s.segments < 8:
         warn(source, f"only {s.segments} averages: coherence and std are rough; use a shorter nperseg")
+    resolution = recording.fs_hz / int(s.meta["nperseg"])
+    findings = clipping_findings(recording) + welch_findings(f, channels, std, resolution, s.segments, est)
     meta = {"source": str(source), "estimator": est, **s.meta, "n_eff": f"{s.n_eff:.4g}",
             "noise": "coherence-based std (Bendat & Piersol)"}
-    return FRFData(f, channels, std, meta, coherence=coh)
+    info = {"method": f"welch-{est}", "window": s.meta["window"], "nperseg": int(s.meta["nperseg"]),
+            "kernel_rms_hz": _kernel_rms_hz(get_window(window, int(s.meta["nperseg"])), recording.fs_hz),
+            "overlap": float(s.meta["overlap"]), "segments": s.segments, "resolution_hz": resolution,
+            "points": int(f.size), "noise_dof": round(2 * max(s.n_eff - 1.0, 0.5), 1),
+            "measurement": [x.to_dict() for x in findings]}
+    return FRFData(f, channels, std, meta, coherence=coh, estimator=info)
 
 
 @dataclass(frozen=True)
@@ -268,5 +376,6 @@ def save_transmissibility(t: Transmissibility, path) -> Path:
     lines.append("freq_hz,t_re,t_im,t_std,coherence")
     table = np.column_stack([t.freq_hz, t.value.real, t.value.imag, t.std, t.coherence])
     lines += [",".join(f"{x:.17g}" for x in row) for row in table]
-    path.write_text("\n".join(lines) + "\n", encoding="utf-8")
+    with atomic_write(path, "w") as fh:
+        fh.write("\n".join(lines) + "\n")
     return path

@@ -1,7 +1,7 @@
 """FRFData: measured or simulated FRFs on a frequency grid, with optional noise std."""
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -24,6 +24,13 @@ class FRFData:
     meta : dict of strings (source, units, comments)
     coherence : dict name -> (n,) float array in [0, 1]; ordinary coherence
         of an FRF estimated from time data (may be empty).
+    correlation : dict "c1,c2" -> (n,) complex; correlation coefficient
+        E[e1 e2*]/(σ1 σ2) of the noise of two channels at each point (both see
+        the same force-sensor noise when estimated from one recording); may be
+        empty (independent channels).
+    estimator : dict, JSON-ready; how FRFs estimated from a recording were
+        made (method, settings, ``noise_dof`` behind the std, measurement-chain
+        findings); empty for FRFs read from a file or simulated.
     """
 
     freq_hz: np.ndarray
@@ -31,6 +38,8 @@ class FRFData:
     std: dict = field(default_factory=dict)
     meta: dict = field(default_factory=dict)
     coherence: dict = field(default_factory=dict)
+    estimator: dict = field(default_factory=dict)
+    correlation: dict = field(default_factory=dict)
 
     def __post_init__(self):
         f = np.asarray(self.freq_hz, dtype=float)
@@ -50,31 +59,25 @@ class FRFData:
             if not np.all(np.isfinite(v)):
                 raise DataError(f"channel {name} contains NaN or infinite values")
             chans[name] = v
-        stds = {}
-        for name, s in (self.std or {}).items():
-            if name not in chans:
-                raise DataError(f"std given for channel {name}, which has no data")
-            s = np.asarray(s, dtype=float)
-            if s.shape != f.shape:
-                raise DataError(f"std of {name} has shape {s.shape}, frequency grid has {f.shape}")
-            if not np.all(np.isfinite(s)) or np.any(s < 0):
-                raise DataError(f"std of {name} must be finite and >= 0")
-            stds[name] = s
-        cohs = {}
-        for name, g in (self.coherence or {}).items():
-            if name not in chans:
-                raise DataError(f"coherence given for channel {name}, which has no data")
-            g = np.asarray(g, dtype=float)
-            if g.shape != f.shape:
-                raise DataError(f"coherence of {name} has shape {g.shape}, frequency grid has {f.shape}")
-            if not np.all(np.isfinite(g)) or np.any(g < 0) or np.any(g > 1):
-                raise DataError(f"coherence of {name} must lie in [0, 1]")
-            cohs[name] = g
+        stds = _per_channel("std", self.std, chans, f.shape, lambda s: np.all(s >= 0), "must be finite and >= 0")
+        cohs = _per_channel("coherence", self.coherence, chans, f.shape, lambda g: np.all((g >= 0) & (g <= 1)),
+                            "must lie in [0, 1]")
         object.__setattr__(self, "freq_hz", f)
         object.__setattr__(self, "channels", chans)
         object.__setattr__(self, "std", stds)
         object.__setattr__(self, "meta", dict(self.meta or {}))
         object.__setattr__(self, "coherence", cohs)
+        object.__setattr__(self, "estimator", dict(self.estimator or {}))
+        corr = {}
+        for key, r in (self.correlation or {}).items():
+            pair = key.split(",")
+            if len(pair) != 2 or any(c not in chans for c in pair):
+                raise DataError(f"correlation {key!r} must name two channels of the data as 'c1,c2'")
+            r = np.asarray(r, dtype=complex)
+            if r.shape != f.shape or not np.all(np.isfinite(r)) or np.any(np.abs(r) >= 1):
+                raise DataError(f"correlation {key} must be finite, inside the unit circle, one per frequency")
+            corr[key] = r
+        object.__setattr__(self, "correlation", corr)
 
     @property
     def names(self) -> tuple[str, ...]:
@@ -97,7 +100,8 @@ class FRFData:
         chans = {c: self[c] for c in channels}
         std = {c: self.std[c] for c in channels if c in self.std}
         coh = {c: self.coherence[c] for c in channels if c in self.coherence}
-        return FRFData(self.freq_hz, chans, std, self.meta, coh)
+        corr = {k: r for k, r in self.correlation.items() if all(c in chans for c in k.split(","))}
+        return replace(self, channels=chans, std=std, coherence=coh, correlation=corr)
 
     def band(self, lo: float | None = None, hi: float | None = None) -> "FRFData":
         """Only the points with lo <= f <= hi."""
@@ -109,16 +113,17 @@ class FRFData:
         if keep.sum() == 0:
             raise DataError(f"band {lo}:{hi} Hz holds no data point (data span "
                             f"{self.freq_hz[0]:g}..{self.freq_hz[-1]:g} Hz)")
-        return FRFData(
-            self.freq_hz[keep],
-            {c: v[keep] for c, v in self.channels.items()},
-            {c: s[keep] for c, s in self.std.items()},
-            self.meta,
-            {c: g[keep] for c, g in self.coherence.items()},
+        return replace(
+            self,
+            freq_hz=self.freq_hz[keep],
+            channels={c: v[keep] for c, v in self.channels.items()},
+            std={c: s[keep] for c, s in self.std.items()},
+            coherence={c: g[keep] for c, g in self.coherence.items()},
+            correlation={k: r[keep] for k, r in self.correlation.items()},
         )
 
     def with_std(self, std: dict) -> "FRFData":
-        return FRFData(self.freq_hz, self.channels, std, self.meta, self.coherence)
+        return replace(self, std=std)
 
     @classmethod
     def from_response(cls, response, channels=("a1", "a2"), std=None, meta=None) -> "FRFData":
@@ -133,3 +138,18 @@ class FRFData:
         s = " with std" if self.std else ""
         return (f"FRFData({len(f)} points, {f[0]:g}..{f[-1]:g} Hz, "
                 f"channels {', '.join(self.channels)}{s})")
+
+
+def _per_channel(what, given, chans, shape, valid, rule) -> dict:
+    """Real per-channel arrays (std, coherence) checked against the data's channels and frequency grid."""
+    out = {}
+    for name, s in (given or {}).items():
+        if name not in chans:
+            raise DataError(f"{what} given for channel {name}, which has no data")
+        s = np.asarray(s, dtype=float)
+        if s.shape != shape:
+            raise DataError(f"{what} of {name} has shape {s.shape}, frequency grid has {shape}")
+        if not (np.all(np.isfinite(s)) and valid(s)):
+            raise DataError(f"{what} of {name} {rule}")
+        out[name] = s
+    return out

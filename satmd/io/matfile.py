@@ -27,7 +27,8 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import DataError, FormatError
-from ._common import read_bytes, warn
+from ._common import read_bytes, short_error, warn
+from .atomic import atomic_write
 from .frfdata import CHANNELS, FRFData
 
 RECORDING_NAMES = ("force", "acc1", "acc2")
@@ -49,7 +50,7 @@ def load_variables(path) -> dict:
         except (zipfile.BadZipFile, EOFError):
             raise FormatError(path, "not a NumPy .npz archive (corrupt or truncated zip)") from None
         except Exception as exc:  # noqa: BLE001 - numpy and zipfile raise many kinds
-            raise FormatError(path, f"cannot read .npz archive ({_short(exc)})") from None
+            raise FormatError(path, f"cannot read .npz archive ({short_error(exc)})") from None
     return read_mat5(path, raw)
 
 
@@ -169,10 +170,6 @@ def _matrix(path, data, order, out):
     out[name] = arr.reshape(dims, order="F")
 
 
-def _short(exc) -> str:
-    return " ".join(str(exc).split())[:120] or type(exc).__name__
-
-
 def _vector(path, name, value, complex_ok=False) -> np.ndarray:
     v = np.asarray(value)
     if v.ndim > 1 and sum(s > 1 for s in v.shape) <= 1:
@@ -199,13 +196,19 @@ def _scalar(path, name, value) -> float:
     return x
 
 
+def _variables_with(path, name, other, hint) -> dict:
+    """The file's variables; without ``name`` a `FormatError` lists them (adding ``hint`` when ``other`` is there)."""
+    v = load_variables(path)
+    if name not in v:
+        hint = hint if other in v else ""
+        raise FormatError(path, f"no variable {name!r}{hint}; found: {', '.join(sorted(v)) or 'nothing'}")
+    return v
+
+
 def read_frf_variables(path) -> FRFData:
     """FRFData from a .mat / .npz file with the documented variable names."""
     path = Path(path)
-    v = load_variables(path)
-    if "freq_hz" not in v:
-        hint = " (it looks like a recording: use satmd estimate-frf)" if "fs_hz" in v else ""
-        raise FormatError(path, f"no variable 'freq_hz'{hint}; found: {', '.join(sorted(v)) or 'nothing'}")
+    v = _variables_with(path, "freq_hz", "fs_hz", " (it looks like a recording: use satmd estimate-frf)")
     freq = _vector(path, "freq_hz", v["freq_hz"])
     channels, std, coh, used = {}, {}, {}, {"freq_hz"}
     for ch in CHANNELS:
@@ -229,10 +232,7 @@ def read_frf_variables(path) -> FRFData:
 def read_recording_variables(path):
     """(fs_hz, {name: series}) from a .mat / .npz recording."""
     path = Path(path)
-    v = load_variables(path)
-    if "fs_hz" not in v:
-        hint = " (it looks like FRFs)" if "freq_hz" in v else ""
-        raise FormatError(path, f"no variable 'fs_hz'{hint}; found: {', '.join(sorted(v)) or 'nothing'}")
+    v = _variables_with(path, "fs_hz", "freq_hz", " (it looks like FRFs)")
     fs = _scalar(path, "fs_hz", v["fs_hz"])
     signals = {n: _vector(path, n, v[n]) for n in RECORDING_NAMES if n in v}
     if not signals:
@@ -273,11 +273,11 @@ def write_recording_variables(fs_hz: float, signals: dict, path) -> Path:
 
 def _write(variables: dict, path) -> Path:
     path = Path(path)
-    if path.suffix.lower() == ".npz":
-        with open(path, "wb") as fh:  # an open file: np.savez would otherwise append '.npz'
+    with atomic_write(path) as fh:  # an open file: np.savez would otherwise append '.npz'
+        if path.suffix.lower() == ".npz":
             np.savez(fh, **variables)
-    else:
-        from scipy.io import savemat
+        else:
+            from scipy.io import savemat
 
-        savemat(path, {k: np.asarray(v) for k, v in variables.items()}, oned_as="column")
+            savemat(fh, {k: np.asarray(v) for k, v in variables.items()}, oned_as="column")
     return path

@@ -1,16 +1,28 @@
-"""Simulated time recordings: band-limited random force through the linear model.
+"""Simulated time recordings that look like the lab: a test bed for the measurement chain.
 
-Method (frequency-domain synthesis of one periodic record). For ``N`` samples
-at ``fs`` the force is built on the FFT grid ``f_k = k fs / N``: independent
-complex Gaussian coefficients inside the excitation band, zero outside. Each
-acceleration is ``A_k = H(f_k) F_k`` with ``H`` from `satmd.physics.frf`
-(effects included, so sensor effects act as they do on measured FRFs), and
-the inverse real FFT gives the signals. This is the exact steady-state
-response of the linear model to the periodic continuation of the force, so
-there are no start-up transients and no approximation beyond sampling.
+Excitation (``excitation=``):
 
-Sensor noise: independent white Gaussian noise on every channel with
-standard deviation ``noise × RMS`` of that channel's clean signal.
+``random``     (default) band-limited Gaussian force that is *not* periodic in
+               the record: white noise filtered to the band on a longer
+               record and cut, so every estimator meets leakage as it does on a
+               rig.
+``sweep``      one logarithmic sine sweep across the band (with 5 % cosine
+               tapers so the force starts and ends at zero).
+``multisine``  a periodic random-phase multisine on the record's DFT grid and
+               the exact steady-state response (no transient, no leakage: the
+               ideal case, kept to compare against).
+
+Response. For ``random`` and ``sweep`` the structure starts at rest ``burn_in_s``
+before the record starts (0 by default, so the start-up transient is in the
+record) and the accelerations are the *linear convolution* of the force with the
+model's impulse response, computed by FFT on a grid long enough that the
+impulse response has decayed to round-off (measured, not assumed). With
+``sensor_gain`` and ``time_delay`` effects the sensors report what they do on a
+rig, since the impulse response comes from `satmd.physics.frf` with effects.
+
+Noise. Independent white Gaussian noise on *every* channel: ``noise`` × RMS on
+each accelerometer and ``force_noise`` × RMS on the force (default half of
+``noise``: a load cell is usually cleaner than an accelerometer, never perfect).
 """
 from __future__ import annotations
 
@@ -22,20 +34,48 @@ from ..errors import DataError
 from ..physics import Rig, frf
 from .recording import Recording
 
+EXCITATIONS = ("random", "sweep", "multisine")
+MAX_SAMPLES = 50_000_000  # ~1.2 GB of float64 per channel set: longer records are refused up front
+_RESPONSES = (("a1", "acc1"), ("a2", "acc2"))
+
 
 def simulate_recording(duration_s: float = 60.0, fs_hz: float = 1000.0, rig: Rig | None = None,
                        effects: Sequence = (), band_hz=(20.0, 200.0), force_rms: float = 1.0,
-                       noise: float = 0.0, seed: int | None = None) -> Recording:
-    """A recording of force, acc1, acc2 for a band-limited random force on the primary mass.
+                       noise: float = 0.0, seed: int | None = None, excitation: str = "random",
+                       force_noise: float | None = None, burn_in_s: float = 0.0) -> Recording:
+    """A recording of force, acc1, acc2 for a force on the primary mass (see the module docstring).
 
     Parameters
     ----------
-    duration_s, fs_hz : length and sample rate
-    rig, effects : the model (defaults: the paper's rig, no effects)
-    band_hz : (lo, hi) excitation band in Hz, inside (0, fs/2)
-    force_rms : RMS of the clean force in N
-    noise : sensor noise std relative to each channel's RMS (0.02 = 2 %)
-    seed : random seed (same seed, same recording)
+    duration_s : float
+        Length of the record in s.
+    fs_hz : float
+        Sample rate in Hz.
+    rig : Rig, optional
+        The model (default: the paper's rig).
+    effects : sequence of Effect
+        Missing physics included in the simulation.
+    band_hz : (float, float)
+        Excitation band (lo, hi) in Hz, inside (0, fs/2). The response is
+        rolled off smoothly from max(hi, 0.6 fs/2) to fs/2, as by an
+        anti-aliasing filter.
+    force_rms : float
+        RMS of the clean force in N.
+    noise : float
+        Accelerometer noise std relative to each accelerometer's RMS (0.02 = 2 %).
+    seed : int, optional
+        Random seed (same seed, same recording).
+    excitation : {"random", "sweep", "multisine"}
+        Force signal; ``random`` is the realistic default.
+    force_noise : float, optional
+        Force-sensor noise std relative to the force RMS (default ``noise / 2``).
+    burn_in_s : float
+        Time the rig is excited before the record starts (0: the record starts at rest).
+
+    Returns
+    -------
+    Recording
+        Channels ``force`` [N], ``acc1``, ``acc2`` [m/s²]; ``meta`` says how it was made.
     """
     rig = Rig() if rig is None else rig
     if rig.batch_shape != ():
@@ -43,36 +83,137 @@ def simulate_recording(duration_s: float = 60.0, fs_hz: float = 1000.0, rig: Rig
     for name, value in (("duration_s", duration_s), ("fs_hz", fs_hz), ("force_rms", force_rms)):
         if not np.isfinite(value) or value <= 0:
             raise DataError(f"{name} must be a finite number > 0, got {value}")
-    if not np.isfinite(noise) or noise < 0:
-        raise DataError(f"noise must be >= 0, got {noise}")
+    force_noise = 0.5 * noise if force_noise is None else force_noise
+    for name, value in (("noise", noise), ("force_noise", force_noise), ("burn_in_s", burn_in_s)):
+        if not np.isfinite(value) or value < 0:
+            raise DataError(f"{name} must be a finite number >= 0, got {value}")
+    if excitation not in EXCITATIONS:
+        raise DataError(f"excitation must be one of {', '.join(EXCITATIONS)}, got {excitation!r}")
     n = int(round(duration_s * fs_hz))
+    burn = int(round(burn_in_s * fs_hz))
+    if n + burn > MAX_SAMPLES:
+        raise DataError(f"{duration_s:g} s (+ {burn_in_s:g} s burn-in) at {fs_hz:g} Hz is {n + burn} samples; "
+                        f"the simulator takes at most {MAX_SAMPLES}")
     lo, hi = float(band_hz[0]), float(band_hz[1])
     if not 0 < lo < hi < fs_hz / 2:
         raise DataError(f"excitation band {lo:g}:{hi:g} Hz must lie inside (0, fs/2 = {fs_hz / 2:g}) Hz")
-    f = np.fft.rfftfreq(n, 1.0 / fs_hz)
-    band = (f >= lo) & (f <= hi)
-    if np.count_nonzero(band) < 2:
+    if np.count_nonzero((np.fft.rfftfreq(n, 1.0 / fs_hz) >= lo) & (np.fft.rfftfreq(n, 1.0 / fs_hz) <= hi)) < 2:
         raise DataError(f"{duration_s:g} s at {fs_hz:g} Hz gives fewer than 2 frequency lines in the band")
     rng = np.random.default_rng(seed)
-    F = np.zeros(f.size, dtype=complex)
-    F[band] = rng.standard_normal(band.sum()) + 1j * rng.standard_normal(band.sum())
-    response = frf(f[band], rig, effects, outputs=("a1", "a2"))
-    spectra = {"force": F}
-    for ch, name in (("a1", "acc1"), ("a2", "acc2")):
-        A = np.zeros_like(F)
-        A[band] = response.channel(ch) * F[band]
-        spectra[name] = A
-    clean = {name: np.fft.irfft(S, n) for name, S in spectra.items()}
+    if excitation == "multisine":
+        clean = _steady_state_multisine(n, fs_hz, rig, effects, lo, hi, rng)
+    else:
+        total = n + burn
+        if excitation == "random":
+            # the force goes on after the record ends: the anti-aliasing roll-off looks a few ms ahead
+            force = _random_force(total + int(fs_hz), fs_hz, lo, hi, rng)
+        else:
+            force = _sweep(total, fs_hz, lo, hi)
+        clean = {"force": force, **_convolve(force, fs_hz, rig, effects, hi)}
+        clean = {k: v[burn:total] for k, v in clean.items()}
     gain = force_rms / np.sqrt(np.mean(clean["force"] ** 2))  # linear: one scale for all channels
     signals = {}
     for name, x in clean.items():
         x = x * gain
-        if noise:
-            x = x + noise * np.sqrt(np.mean(x * x)) * rng.standard_normal(n)
+        rel = force_noise if name == "force" else noise
+        if rel:
+            x = x + rel * np.sqrt(np.mean(x * x)) * rng.standard_normal(n)
         signals[name] = x
-    meta = {"generator": "satmd simulate --time", "band_hz": f"{lo:g}:{hi:g}", "force_rms": f"{force_rms:g}",
-            "noise": f"{noise:g}", "seed": str(seed)}
+    meta = {"generator": "satmd simulate --time", "excitation": excitation, "band_hz": f"{lo:g}:{hi:g}",
+            "force_rms": f"{force_rms:g}", "noise": f"{noise:g}", "force_noise": f"{force_noise:g}",
+            "burn_in_s": f"{burn_in_s:g}", "seed": str(seed)}
     meta.update({k: f"{float(v):.12g}" for k, v in rig.as_dict().items()})
     for eff in effects:
         meta[f"effect {eff.name}"] = ", ".join(f"{k}={float(v):.12g}" for k, v in eff.params.items())
     return Recording(fs_hz, signals, {"force": "N", "acc1": "m/s^2", "acc2": "m/s^2"}, meta)
+
+
+def _random_force(n, fs_hz, lo, hi, rng) -> np.ndarray:
+    """Band-limited Gaussian noise, filtered on a record 4x longer and cut: not periodic in n samples."""
+    m = 4 * n
+    spectrum = np.fft.rfft(rng.standard_normal(m))
+    f = np.fft.rfftfreq(m, 1.0 / fs_hz)
+    spectrum[(f < lo) | (f > hi)] = 0.0
+    start = int(rng.integers(0, m - n))
+    return np.fft.irfft(spectrum, m)[start:start + n]
+
+
+def _sweep(n, fs_hz, lo, hi) -> np.ndarray:
+    """One logarithmic sine sweep lo -> hi over the record, tapered in and out."""
+    t = np.arange(n) / fs_hz
+    duration = n / fs_hz
+    rate = np.log(hi / lo)
+    x = np.sin(2 * np.pi * lo * duration / rate * (np.exp(t / duration * rate) - 1.0))
+    taper = max(1, int(0.05 * n))
+    ramp = 0.5 - 0.5 * np.cos(np.pi * np.arange(taper) / taper)
+    x[:taper] *= ramp
+    x[n - taper:] *= ramp[::-1]
+    return x
+
+
+def _convolve(force, fs_hz, rig, effects, pass_hz=0.0) -> dict:
+    """Accelerations for a force that starts at sample 0 with the rig at rest: linear convolution by FFT."""
+    n = force.size
+    tail = _impulse_length(fs_hz, rig, effects, pass_hz)
+    size = _fast_length(n + tail)
+    f = np.fft.rfftfreq(size, 1.0 / fs_hz)
+    h = _frf_with_dc(f, rig, effects, pass_hz)
+    spectrum = np.fft.rfft(force, size)
+    return {name: np.fft.irfft(h[ch] * spectrum, size)[:n] for ch, name in _RESPONSES}
+
+
+def _impulse_length(fs_hz, rig, effects, pass_hz, max_s: float = 120.0) -> int:
+    """Samples after which every impulse response has decayed below 1e-9 of its peak (and stays there)."""
+    size = _fast_length(int(max_s * fs_hz))
+    f = np.fft.rfftfreq(size, 1.0 / fs_hz)
+    h = _frf_with_dc(f, rig, effects, pass_hz)
+    need = int(0.5 * fs_hz)
+    for ch, _ in _RESPONSES:
+        ir = np.abs(np.fft.irfft(h[ch], size))
+        ir[0] = 0.0  # the direct (mass-line) term is not a tail
+        above = np.flatnonzero(ir[: size // 2] > 1e-9 * ir.max())
+        if above.size:
+            need = max(need, int(above[-1]) + 1)
+    return need
+
+
+def _frf_with_dc(f, rig, effects, pass_hz) -> dict:
+    """a1, a2 on an rfft grid from 0 Hz to Nyquist, rolled off smoothly above max(pass_hz, 0.6 Nyquist).
+
+    Accelerations vanish at DC but tend to 1/m1 at high frequency; cut off at
+    Nyquist that step rings through the whole impulse response. The raised-cosine
+    roll-off keeps the impulse response short and leaves the excited band untouched.
+    """
+    r = frf(f[1:], rig, effects, outputs=("a1", "a2"))
+    nyquist = f[-1]
+    start = max(0.6 * nyquist, pass_hz)
+    x = np.clip((f - start) / max(nyquist - start, 1e-9 * nyquist), 0.0, 1.0)
+    rolloff = 0.5 + 0.5 * np.cos(np.pi * x)
+    out = {}
+    for ch, _ in _RESPONSES:
+        h = np.zeros(f.size, dtype=complex)
+        h[1:] = r.channel(ch) * rolloff[1:]
+        out[ch] = h
+    return out
+
+
+def _steady_state_multisine(n, fs_hz, rig, effects, lo, hi, rng) -> dict:
+    """Periodic random-phase multisine on the record's DFT grid and its exact steady-state response."""
+    f = np.fft.rfftfreq(n, 1.0 / fs_hz)
+    band = (f >= lo) & (f <= hi)
+    F = np.zeros(f.size, dtype=complex)
+    F[band] = np.exp(2j * np.pi * rng.random(band.sum()))
+    response = frf(f[band], rig, effects, outputs=("a1", "a2"))
+    spectra = {"force": F}
+    for ch, name in _RESPONSES:
+        A = np.zeros_like(F)
+        A[band] = response.channel(ch) * F[band]
+        spectra[name] = A
+    return {name: np.fft.irfft(S, n) for name, S in spectra.items()}
+
+
+def _fast_length(n: int) -> int:
+    """A length >= n made of small primes (fast FFTs)."""
+    from scipy.fft import next_fast_len
+
+    return int(next_fast_len(int(n), real=True))

@@ -55,7 +55,7 @@ def read_txt(path, freq_axis=None, channel: str = "a1") -> FRFData:
     values = read_values(path)
     if freq_axis is None:
         raise FormatError(path, f"{values.size} complex values but no frequency axis: pass "
-                                "freq_axis='START:STEP' (CLI --freq-axis START:STEP, Hz)")
+                                "freq_axis START:STEP (Hz)")
     if channel not in CHANNELS:
         raise DataError(f"channel {channel!r}: choose from {', '.join(CHANNELS)}")
     start, step = parse_freq_axis(freq_axis)

@@ -14,12 +14,17 @@ from .effects import (
     DielectricLoss,
     Effect,
     ExtraMode,
+    MatchedFilter,
+    Parameter,
     ParameterOffset,
     SensorGain,
     ShuntCapacitance,
     StructuralDamping,
     TimeDelay,
     effect,
+    register,
+    registered_names,
+    unregister,
 )
 from .model import CHANNELS, STATES, Response, frf, parameter_names, solve, terms
 from .rig import PAPER_GRID_HZ, PARAMETER_INFO, Rig
@@ -28,5 +33,5 @@ __all__ = [
     "CHANNELS", "STATES", "OFFSET_PARAMETERS", "VOCABULARY", "VOCABULARY_NAMES", "PAPER_GRID_HZ",
     "PARAMETER_INFO", "Rig", "Response", "frf", "parameter_names", "solve", "terms", "effect", "Effect",
     "SensorGain", "TimeDelay", "StructuralDamping", "DielectricLoss", "ShuntCapacitance", "ExtraMode",
-    "ParameterOffset",
+    "ParameterOffset", "Parameter", "MatchedFilter", "register", "unregister", "registered_names",
 ]

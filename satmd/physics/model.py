@@ -17,24 +17,28 @@ over (batch, frequency) in float64/complex128.
 Jacobians are forward-mode: the small intermediate quantities (K1, K's parts,
 Z33, ...) carry exact tangents through `dual.Dual`; the solve propagates them
 in closed form, dx/dθ = -Z⁻¹ (dZ/dθ) x, written out for the eliminated system.
+`frf` runs both on NumPy chunks through the kernels of `kernels.py` (in place,
+bit for bit the arithmetic of `solve`).
 """
 from __future__ import annotations
 
 import os
-from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
 from typing import Iterable, Sequence
 
 import numpy as np
 
+from ..errors import DataError  # a ValueError: user-facing, one line
+
 from . import dual
 from .effects import Effect
+from .kernels import Workspace, solve_into, solve_with_tangents
 from .rig import Rig
 
 STATES = ("u1", "u2", "q")
 CHANNELS = ("u1", "u2", "q", "a1", "a2")
-# complex elements per chunk: keeps the working set in cache
-_CHUNK_ELEMENTS = 16384
+# complex elements per chunk: keeps the working set (about 16 arrays) in a 2 MB L2 cache
+_CHUNK_ELEMENTS = 8192
 # below this many (batch x frequency) points threads cost more than they give
 _THREADED_POINTS = 100_000
 
@@ -55,7 +59,21 @@ class Terms:
 
 
 def terms(omega, rig: Rig, effects: Sequence[Effect] = ()) -> Terms:
-    """Z's entries, written once. Works for NumPy, torch tensors and duals."""
+    """Z's entries, written once. Works for NumPy, torch tensors and duals.
+
+    Parameters
+    ----------
+    omega : angular frequencies [rad/s], broadcasting with the rig's fields.
+    rig : Rig
+        Parameter values (fields may be arrays, tensors or duals).
+    effects : sequence of Effect
+        Applied in order: rig changes first, then host, capacitance, shunt and sensor hooks.
+
+    Returns
+    -------
+    Terms
+        K1, Kp, M2, b, Z33, F0 and the sensor factors the closed-form solve needs.
+    """
     for eff in effects:
         rig = eff.rig(rig)
     w2 = omega * omega
@@ -83,7 +101,18 @@ def terms(omega, rig: Rig, effects: Sequence[Effect] = ()) -> Terms:
 
 
 def solve(t: Terms) -> dict:
-    """Closed-form solution of Z x = [F0, 0, 0] (plus measured accelerations)."""
+    """Closed-form solution of Z x = [F0, 0, 0] (plus measured accelerations).
+
+    Parameters
+    ----------
+    t : Terms
+        The entries of Z from `terms`.
+
+    Returns
+    -------
+    dict
+        ``u1, u2, q`` (physical states) and ``a1, a2`` (measured accelerations, sensor effects applied).
+    """
     bz = t.b / t.Z33
     K = t.Kp - t.b * bz
     KmM = K - t.M2
@@ -95,91 +124,6 @@ def solve(t: Terms) -> dict:
     a1 = mw2 * u1 if t.s1 is None else (mw2 * t.s1) * u1
     a2 = mw2 * u2 if t.s2 is None else (mw2 * t.s2) * u2
     return {"u1": u1, "u2": u2, "q": q, "a1": a1, "a2": a2}
-
-
-def solve_with_tangents(t: Terms, wrt: Sequence[str], outputs: Sequence[str], out_values: dict, out_jac: dict):
-    """Values and d(output)/d(parameter) for each name in ``wrt``, written into
-    ``out_values[ch]`` (rows, F) and ``out_jac[ch]`` (rows, F, P).
-
-    ``t`` holds duals; the solve is done on their values and tangents are
-    pushed through the closed form. Every parameter acts through a handful of
-    intermediates (K, m2 ω², K1, F0, b, Z33, sensor factors), so the
-    coefficient d(output)/d(intermediate) is computed once and shared by all
-    parameters: a 4-parameter Jacobian costs a few FRFs, not four.
-    """
-    v = {k: dual.value(getattr(t, k)) for k in ("omega", "K1", "Kp", "b", "Z33", "M2", "F0", "s1", "s2")}
-    K1, b, Z33, M2, F0 = v["K1"], v["b"], v["Z33"], v["M2"], v["F0"]
-    bz = b / Z33
-    K = v["Kp"] - b * bz
-    KmM = K - M2
-    rdet = 1.0 / (K1 * KmM - K * M2)
-    inv = F0 * rdet
-    u = {"u1": KmM * inv, "u2": K * inv}
-    q = (bz * M2) * inv
-    mw2 = -(v["omega"] * v["omega"])
-    gain = {"a1": mw2 if v["s1"] is None else mw2 * v["s1"], "a2": mw2 if v["s2"] is None else mw2 * v["s2"]}
-    values = {"u1": u["u1"], "u2": u["u2"], "q": q, "a1": gain["a1"] * u["u1"], "a2": gain["a2"] * u["u2"]}
-    for ch in outputs:
-        out_values[ch][...] = values[ch]
-
-    base = {}  # d(u1, u2)/d(intermediate)
-
-    def du(key):
-        if key not in base:
-            if key == "K":
-                T = (K1 - M2) * rdet
-                base[key] = (inv - u["u1"] * T, inv - u["u2"] * T)
-            elif key == "M2":
-                S = (K1 + K) * rdet
-                base[key] = (u["u1"] * S - inv, u["u2"] * S)
-            elif key == "K1":
-                base[key] = (-u["u1"] * KmM * rdet, -u["u2"] * KmM * rdet)
-            else:  # F0
-                base[key] = (KmM * rdet, K * rdet)
-        return base[key]
-
-    coefs = {}  # d(channel)/d(intermediate)
-
-    def coef(key, ch):
-        if (key, ch) not in coefs:
-            d1, d2 = du(key)
-            if ch == "q":
-                coefs[key, ch] = -bz * (d1 - d2)
-            elif ch in ("a1", "a2"):
-                coefs[key, ch] = gain[ch] * (d1 if ch == "a1" else d2)
-            else:
-                coefs[key, ch] = d1 if ch == "u1" else d2
-        return coefs[key, ch]
-
-    for j, name in enumerate(wrt):
-        d = {k: dual.tangent(getattr(t, k), name) for k in ("K1", "Kp", "b", "Z33", "M2", "F0", "s1", "s2")}
-        dK = d["Kp"]
-        if d["b"] is not None:
-            dK = _acc(dK, (-2.0 * bz) * d["b"])
-        if d["Z33"] is not None:
-            dK = _acc(dK, (bz * bz) * d["Z33"])
-        moves = [(key, dx) for key, dx in (("K", dK), ("M2", d["M2"]), ("K1", d["K1"]), ("F0", d["F0"])) if dx is not None]
-        for ch in outputs:
-            col = None
-            for key, dx in moves:
-                c = coef(key, ch)
-                col = _acc(col, c if _is_one(dx) else c * dx)
-            if ch == "q":  # q = b M2 F0 / (det Z33) depends on b and Z33 directly too
-                if d["b"] is not None:
-                    col = _acc(col, (q / b) * d["b"])
-                if d["Z33"] is not None:
-                    col = _acc(col, (-q / Z33) * d["Z33"])
-            elif ch in ("a1", "a2") and d["s" + ch[1]] is not None:
-                col = _acc(col, (mw2 * d["s" + ch[1]]) * u["u" + ch[1]])
-            out_jac[ch][..., j] = 0.0 if col is None else col
-
-
-def _is_one(x):
-    return isinstance(x, (int, float)) and x == 1.0
-
-
-def _acc(total, x):
-    return x if total is None else total + x
 
 
 @dataclass
@@ -203,10 +147,10 @@ class Response:
 
     def channel(self, name: str) -> np.ndarray:
         if name not in CHANNELS:
-            raise ValueError(f"unknown channel {name!r}; known: {', '.join(CHANNELS)}")
+            raise DataError(f"unknown channel {name!r}; known: {', '.join(CHANNELS)}")
         value = getattr(self, name)
         if value is None:
-            raise ValueError(f"channel {name} was not computed")
+            raise DataError(f"channel {name} was not computed")
         return value
 
     def stack(self, channels: Iterable[str]) -> np.ndarray:
@@ -215,7 +159,19 @@ class Response:
 
 
 def parameter_names(rig: Rig, effects: Sequence[Effect]) -> list[str]:
-    """Every name a Jacobian can be taken with respect to."""
+    """Every name a Jacobian can be taken with respect to.
+
+    Parameters
+    ----------
+    rig : Rig
+        The rig (all its fields are names).
+    effects : sequence of Effect
+        Their parameters are named ``effect.param``.
+
+    Returns
+    -------
+    list of str
+    """
     names = list(Rig.names())
     for eff in effects:
         names += [eff.qualified(p) for p in eff.parameter_names]
@@ -238,8 +194,8 @@ def resolve_parameter(name: str, effects: Sequence[Effect]) -> tuple[int, str]:
     if len(hits) == 1:
         return hits[0]
     if not hits:
-        raise ValueError(f"no parameter {name!r}; known: {', '.join(parameter_names(Rig(), effects))}")
-    raise ValueError(f"parameter name {name!r} is ambiguous; use the qualified form effect.param")
+        raise DataError(f"no parameter {name!r}; known: {', '.join(parameter_names(Rig(), effects))}")
+    raise DataError(f"parameter name {name!r} is ambiguous; use the qualified form effect.param")
 
 
 def frf(
@@ -283,12 +239,12 @@ def frf(
         rig.validate()
     freq = np.asarray(freq_hz, dtype=float)
     if freq.ndim != 1:
-        raise ValueError(f"freq_hz must be 1-D, got shape {freq.shape}")
+        raise DataError(f"freq_hz must be 1-D, got shape {freq.shape}")
     if not np.all(np.isfinite(freq)):
-        raise ValueError("freq_hz contains NaN or infinite values")
+        raise DataError("freq_hz contains NaN or infinite values")
     unknown = [o for o in outputs if o not in CHANNELS]
     if unknown:
-        raise ValueError(f"unknown output channel(s) {unknown}; known: {', '.join(CHANNELS)}")
+        raise DataError(f"unknown output channel(s) {unknown}; known: {', '.join(CHANNELS)}")
     wrt = tuple(wrt or ())
     targets = [resolve_parameter(n, effects) for n in wrt]
 
@@ -306,7 +262,7 @@ def frf(
     flat_rig = {n: _flatten(getattr(rig, n), batch) for n in Rig.names()}
     flat_eff = [{p: _flatten(eff.params[p], batch) for p in eff.parameter_names} for eff in effects]
 
-    def run(sl):
+    def run(sl, work):
         rig_c = Rig(**{n: _rows(v, sl) for n, v in flat_rig.items()})
         effs_c = [eff.replace(**{p: _rows(v, sl) for p, v in fp.items()}) for eff, fp in zip(effects, flat_eff)]
         if wrt:
@@ -316,18 +272,32 @@ def frf(
                 {ch: out[ch][sl] for ch in outputs}, {ch: jac[ch][sl] for ch in outputs},
             )
         else:
-            values = solve(terms(omega, rig_c, effs_c))
-            for ch in outputs:
-                out[ch][sl] = values[ch]
+            solve_into(terms(omega, rig_c, effs_c), {ch: out[ch][sl] for ch in outputs}, work)
 
     chunks = [slice(i, min(i + step, n_rows)) for i in range(0, n_rows, step)]
     n_threads = _threads(threads, n_rows * n_freq, len(chunks))
     if n_threads > 1:  # NumPy releases the GIL inside ufuncs
+        import threading  # only big batches need threads
+        from concurrent.futures import ThreadPoolExecutor
+
+        lock, todo = threading.Lock(), iter(chunks)
+
+        def worker():  # one workspace per thread; chunks handed out one at a time, so a busy core holds none back
+            work = Workspace()
+            while True:
+                with lock:
+                    sl = next(todo, None)
+                if sl is None:
+                    return
+                run(sl, work)
+
         with ThreadPoolExecutor(n_threads) as pool:
-            list(pool.map(run, chunks))
+            for f in [pool.submit(worker) for _ in range(n_threads)]:
+                f.result()
     else:
+        work = Workspace()
         for sl in chunks:
-            run(sl)
+            run(sl, work)
 
     shape = batch + (n_freq,)
     res = Response(freq_hz=freq, wrt=wrt)

@@ -7,6 +7,8 @@ from typing import Any
 
 import numpy as np
 
+from ..errors import DataError  # a ValueError: user-facing, one line
+
 # Units and one-line roles, used in reports and CLI help.
 PARAMETER_INFO = {
     "m1": ("kg", "primary mass"),
@@ -51,7 +53,7 @@ class Rig:
     def replace(self, **changes) -> "Rig":
         unknown = set(changes) - set(self.names())
         if unknown:
-            raise ValueError(f"unknown rig parameter(s) {sorted(unknown)}; known: {', '.join(self.names())}")
+            raise DataError(f"unknown rig parameter(s) {sorted(unknown)}; known: {', '.join(self.names())}")
         return dataclasses.replace(self, **changes)
 
     @staticmethod
@@ -73,11 +75,11 @@ class Rig:
                 continue
             arr = np.asarray(value, dtype=float)
             if not np.all(np.isfinite(arr)):
-                raise ValueError(f"rig parameter {name} is not finite")
+                raise DataError(f"rig parameter {name} is not finite")
             if name in _POSITIVE and np.any(arr <= 0):
-                raise ValueError(f"rig parameter {name} must be > 0 (got {arr.min():g})")
+                raise DataError(f"rig parameter {name} must be > 0 (got {arr.min():g})")
             if name in _NON_NEGATIVE and np.any(arr < 0):
-                raise ValueError(f"rig parameter {name} must be >= 0 (got {arr.min():g})")
+                raise DataError(f"rig parameter {name} must be >= 0 (got {arr.min():g})")
         return self
 
 
@@ -86,5 +88,4 @@ def _is_traced(value) -> bool:
     return not isinstance(value, (int, float, np.ndarray, np.generic, list, tuple))
 
 
-PAPER_RIG = Rig()
 PAPER_GRID_HZ = np.linspace(40.0, 130.0, 60)

@@ -14,7 +14,11 @@ and effect parameter.
 """
 from __future__ import annotations
 
+import os
+import warnings
 from typing import Sequence
+
+from ..errors import DataError
 
 try:
     import torch
@@ -32,7 +36,7 @@ def real_dtype(dtype: torch.dtype) -> torch.dtype:
     try:
         return _REAL[dtype]
     except KeyError:
-        raise ValueError(f"dtype must be torch.complex128 or torch.complex64, got {dtype}") from None
+        raise DataError(f"dtype must be torch.complex128 or torch.complex64, got {dtype}") from None
 
 
 def _leaf(x, real, device):
@@ -49,11 +53,18 @@ def frf(
     dtype: torch.dtype = torch.complex128,
     device=None,
     outputs: Sequence[str] = CHANNELS,
+    compiled: bool | None = None,
 ) -> dict:
     """FRFs as complex tensors of shape (*batch, n_freq), keyed by channel.
 
     Rig and effect parameters may be Python numbers, arrays or tensors
     (with ``requires_grad``); batched tensors broadcast like the NumPy model.
+
+    ``compiled`` runs the closed form through `torch.compile`, which fuses its
+    elementwise operations instead of launching one kernel each. None (the
+    default) compiles on CUDA devices only, unless the environment sets
+    ``SATMD_TORCH_COMPILE=0``; when compiling fails the eager path (the
+    reference) runs instead, with one warning.
     """
     rig = Rig() if rig is None else rig
     real = real_dtype(dtype)
@@ -61,11 +72,32 @@ def frf(
     omega = 2.0 * torch.pi * freq.to(dtype=real, device=device)
     rig_t = Rig(**{n: _leaf(getattr(rig, n), real, device) for n in Rig.names()})
     effs_t = [eff.replace(**{p: _leaf(v, real, device) for p, v in eff.params.items()}) for eff in effects]
-    values = solve(terms(omega, rig_t, effs_t))
+    if compiled is None:
+        compiled = omega.device.type == "cuda" and os.environ.get("SATMD_TORCH_COMPILE", "1") != "0"
+    values = _compiled_closed_form(omega, rig_t, effs_t) if compiled else _closed_form(omega, rig_t, effs_t)
     unknown = [o for o in outputs if o not in CHANNELS]
     if unknown:
-        raise ValueError(f"unknown output channel(s) {unknown}")
+        raise DataError(f"unknown output channel(s) {unknown}")
     return {ch: values[ch].to(dtype) for ch in outputs}
+
+
+def _closed_form(omega, rig, effects):
+    return solve(terms(omega, rig, effects))
+
+
+_COMPILED = {}  # "fn": the compiled closed form, or "failed": why compiling did not work
+
+
+def _compiled_closed_form(omega, rig, effects):
+    if "failed" not in _COMPILED:
+        try:
+            fn = _COMPILED.setdefault("fn", torch.compile(_closed_form, dynamic=True))
+            return fn(omega, rig, effects)
+        except Exception as exc:  # noqa: BLE001 - any compiler failure: the eager path gives the same numbers
+            _COMPILED["failed"] = f"{type(exc).__name__}: {exc}"
+            warnings.warn(f"torch.compile of the twin failed, running it eagerly ({_COMPILED['failed'][:200]})",
+                          RuntimeWarning, stacklevel=3)
+    return _closed_form(omega, rig, effects)
 
 
 def features(out: dict, channels: Sequence[str] = ("a1", "a2")) -> torch.Tensor:

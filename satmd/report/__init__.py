@@ -61,7 +61,11 @@ def reproduce(out, only=None, quick=False, log=print) -> Path:
         sys.stdout.flush()
     md = "\n".join(parts)
     index = ctx.out / "index.md"
-    index.write_text(md, encoding="utf-8")
-    (ctx.out / "index.html").write_text(markdown_to_html(md, title="satmd report"), encoding="utf-8")
-    (ctx.out / "results.json").write_text(json.dumps(ctx.results, indent=2, default=float), encoding="utf-8")
+    from ..io.atomic import all_or_none, atomic_write
+
+    with all_or_none():
+        for name, text in ((index.name, md), ("index.html", markdown_to_html(md, title="satmd report")),
+                           ("results.json", json.dumps(ctx.results, indent=2, default=float))):
+            with atomic_write(ctx.out / name, "w") as fh:
+                fh.write(text)
     return index

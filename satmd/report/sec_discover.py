@@ -10,7 +10,7 @@ TITLE = "Missing-physics discovery: concealed effects found, named and modelled"
 
 
 def _row(label, truth, rep):
-    found = ", ".join(f"{e['name']}" + (f" (≡ {', '.join(e['equivalent'])})" if e["equivalent"] else "")
+    found = ", ".join(e.name + (f" (≡ {', '.join(e.equivalent)})" if e.equivalent else "")
                       for e in rep.effects) or "nothing"
     return (f"| {label} | {truth} | {found} | {rep.fit_before['chi2_reduced']:.3g} → "
             f"{rep.fit_after['chi2_reduced']:.3g} | {rep.fit_before['rel_error']:.3g} | {rep.wall_time:.2f} s |")

@@ -44,6 +44,7 @@ def _model(ctx):
 
 def build(ctx) -> str:
     from ..explain.run import neural_analysis, symbolic_analysis
+    from .explain_text import neural_markdown, symbolic_markdown
 
     parts = ["The paper's use case III, and the comparisons its discussion asks for: neural attribution against "
              "the physical sensitivity of the forward model, the R/L disentanglement test of the latent, and "
@@ -51,9 +52,11 @@ def build(ctx) -> str:
     model, note = _model(ctx)
     parts += [note, ""]
     if model is not None:
-        md, ctx.results["explain_neural"] = neural_analysis(model, ctx.figure, quick=ctx.quick)
-        parts.append(md)
-    md, res = symbolic_analysis(ctx.figure, quick=ctx.quick, modal=not ctx.quick)
+        neural = neural_analysis(model, quick=ctx.quick)
+        ctx.results["explain_neural"] = neural.to_dict()
+        parts.append(neural_markdown(neural, ctx.figure))
+    sym = symbolic_analysis(quick=ctx.quick, modal=not ctx.quick)
+    md, res = symbolic_markdown(sym, ctx.figure), sym.to_dict()
     ctx.results["explain_symbolic"] = {
         "paper_formula": res["paper_formula"], "paper_reported": res["paper_reported"],
         "xi": {k: res["xi"][k] for k in ("expression", "complexity", "r2_train", "r2_test", "mae_train",

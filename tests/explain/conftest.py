@@ -1,6 +1,6 @@
 """A small stand-in for a trained inverse model, following the contract of
 `satmd.inverse.InverseModel` that `satmd.explain` relies on (see
-`satmd/explain/_model.py`): the SPEC §5 architecture (240 -> 256 -> 128 ->
+`satmd.explain.contract.ExplainableModel`): the SPEC §5 architecture (240 -> 256 -> 128 ->
 64 -> 2, ReLU, sigmoid), briefly trained on labels so that the latent carries
 R and L, with a per-feature standardisation ``scaler_``."""
 import numpy as np
@@ -10,6 +10,7 @@ torch = pytest.importorskip("torch")
 torch.set_num_threads(1)
 
 from satmd.physics import PAPER_GRID_HZ, Rig, frf  # noqa: E402
+from satmd.inverse.dataset import features_to_complex  # noqa: E402
 
 BOUNDS = {"R": (0.0, 103.0), "L": (0.0, 0.5)}
 
@@ -80,6 +81,14 @@ class StandInModel:
             z = x.reshape(x.shape[0], -1)
             return np.concatenate([z.real, z.imag], axis=-1)
         return x.reshape(-1, 240)
+
+    def as_complex(self, x):
+        if hasattr(x, "a1"):  # a dataset or a Response
+            x = np.stack([x.a1, x.a2], axis=-2)
+        x = np.asarray(x)
+        if not np.iscomplexobj(x):
+            x = features_to_complex(x.reshape(-1, 240))
+        return x.reshape(-1, 2, x.shape[-1]), None
 
     def features(self, x):
         return self.scaler_.transform(self._raw(x))

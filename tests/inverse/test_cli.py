@@ -30,10 +30,54 @@ def test_predict_json(trained, tmp_path, capsys):
     capsys.readouterr()
     assert main(["inverse", "predict", str(trained), str(f), "--json"]) == 0
     p = json.loads(capsys.readouterr().out)
-    assert set(p) == {"R", "L", "R_std", "L_std"}
-    assert all(np.isfinite(v) for v in p.values())
+    assert set(p) == {"R", "L", "R_std", "L_std", "residual", "residual_expected", "residual_ratio", "explained",
+                      "warnings"}
+    assert all(np.isfinite(p[k]) for k in ("R", "L", "R_std", "L_std", "residual", "residual_ratio"))
+    assert isinstance(p["explained"], bool) and isinstance(p["warnings"], list)
     assert main(["inverse", "predict", str(trained), str(f)]) == 0
-    assert "R =" in capsys.readouterr().out
+    out = capsys.readouterr().out
+    assert "R =" in out and "forward check: residual" in out
+
+
+def test_predict_flags_an_unexplained_rig(trained, tmp_path, capsys):
+    """SPEC §5's rig is fixed; data from another rig (m2 0.7, kp 1.5e5) must not pass silently."""
+    f = tmp_path / "offm.csv"
+    save_frf(simulate(rig=Rig(m2=0.7, kp=1.5e5, R=22.0, L=0.064), noise=0.01, seed=0), f)
+    # least squares: the best R, L of the paper's rig; still no explanation of this rig's data
+    model = tmp_path / "opt"
+    assert main(["inverse", "train", "--kind", "optimization", "--quiet", "--out", str(model)]) == 0
+    capsys.readouterr()
+    assert main(["inverse", "predict", str(model), str(f), "--json"]) == 0
+    cap = capsys.readouterr()
+    p = json.loads(cap.out)
+    assert p["explained"] is False and p["residual_ratio"] > 3
+    assert any("does not explain the data" in w for w in p["warnings"])
+    assert "satmd inverse predict: warning:" in cap.err and len(cap.err.strip().splitlines()) == len(p["warnings"])
+
+
+def test_predict_takes_lab_grids_and_band(trained, tmp_path, capsys):
+    f = tmp_path / "lab.csv"
+    save_frf(simulate(freq_hz=np.linspace(20, 200, 721), rig=Rig(R=30.0, L=0.15), noise=0.005, seed=1), f)
+    capsys.readouterr()
+    assert main(["inverse", "predict", str(trained), str(f), "--json"]) == 0
+    p = json.loads(capsys.readouterr().out)
+    assert np.isfinite(p["R"]) and not any("cover" in w for w in p["warnings"])
+    assert main(["inverse", "predict", str(trained), str(f), "--band", "50:110", "--json"]) == 0
+    cap = capsys.readouterr()
+    p = json.loads(cap.out)
+    assert np.isfinite(p["R"]) and any("not the model's 40..130 Hz" in w for w in p["warnings"])
+    assert "filled from the forward model" in cap.err
+
+
+def test_predict_takes_a_recording(trained, tmp_path, capsys):
+    from satmd.io import save_recording, simulate_recording
+
+    rec = tmp_path / "rec.npz"
+    save_recording(simulate_recording(20.0, rig=Rig(R=30.0, L=0.15), seed=0), rec)
+    capsys.readouterr()
+    assert main(["inverse", "predict", str(trained), str(rec), "--json"]) == 0
+    p = json.loads(capsys.readouterr().out)
+    assert np.isfinite(p["R"]) and np.isfinite(p["residual"])
 
 
 def test_evaluate_json(trained, capsys):

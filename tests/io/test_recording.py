@@ -168,13 +168,87 @@ def test_uff_recording_mapped_to_a_pressure_is_refused(tmp_path):
 
 # --- time simulation --------------------------------------------------------------
 def test_simulation_is_seeded_band_limited_and_scaled():
-    a = simulate_recording(4.0, 400.0, seed=1, band_hz=(30, 90), force_rms=2.0)
-    b = simulate_recording(4.0, 400.0, seed=1, band_hz=(30, 90), force_rms=2.0)
+    a = simulate_recording(4.0, 400.0, seed=1, band_hz=(30, 90), force_rms=2.0, excitation="multisine")
+    b = simulate_recording(4.0, 400.0, seed=1, band_hz=(30, 90), force_rms=2.0, excitation="multisine")
     np.testing.assert_array_equal(a["acc2"], b["acc2"])
     assert np.sqrt(np.mean(a["force"] ** 2)) == pytest.approx(2.0)
     spec = np.abs(np.fft.rfft(a["force"]))
     f = np.fft.rfftfreq(a.n_samples, 1 / 400.0)
-    assert spec[(f < 29) | (f > 91)].max() < 1e-9 * spec.max()
+    assert spec[(f < 29) | (f > 91)].max() < 1e-9 * spec.max()  # periodic: no leakage at all
+
+
+def test_default_recording_is_random_not_periodic_and_starts_at_rest():
+    r = simulate_recording(20.0, 2000.0, seed=3, noise=0.02)
+    assert r.meta["excitation"] == "random" and float(r.meta["force_noise"]) == pytest.approx(0.01)
+    clean = simulate_recording(20.0, 2000.0, seed=3)
+    # at rest at t = 0: the absorber (no direct path from the force) starts from nothing
+    assert abs(clean["acc2"][0]) < 0.02 * np.std(clean["acc2"])
+    # not periodic in the record: the force's first and last samples do not join up
+    spec = np.abs(np.fft.rfft(clean["force"]))
+    f = np.fft.rfftfreq(clean.n_samples, 1 / 2000.0)
+    leak = spec[(f > 5) & (f < 15)].max() / spec.max()
+    assert 1e-6 < leak < 0.05
+    # noise on every channel: the noisy force differs from the clean one by ~1 % of its RMS
+    d = r["force"] - clean["force"]
+    assert np.std(d) == pytest.approx(0.01 * np.sqrt(np.mean(clean["force"] ** 2)), rel=0.1)
+
+
+def test_convolution_from_rest_reaches_the_exact_steady_state():
+    """A periodic force repeated: once the transient has died, the response equals the exact steady state."""
+    from satmd.io.timesim import _convolve, _steady_state_multisine
+
+    rng = np.random.default_rng(0)
+    n, fs = 4000, 1000.0
+    steady = _steady_state_multisine(n, fs, Rig(), (), 20.0, 200.0, rng)
+    out = _convolve(np.tile(steady["force"], 5), fs, Rig(), (), 200.0)
+    for name in ("acc1", "acc2"):
+        err = np.abs(out[name][3 * n:4 * n] - steady[name]).max() / np.abs(steady[name]).max()
+        assert err < 1e-9, name
+
+
+@pytest.mark.parametrize("excitation", ["random", "sweep", "multisine"])
+def test_lpm_recovers_the_model_at_full_resolution(excitation):
+    """Noise-free: the LPM estimate equals the model to well below any realistic noise, peaks included."""
+    rig = Rig(R=30.0)
+    effects = [effect("time_delay", tau_s=2e-4)]
+    r = simulate_recording(40.0, 1000.0, rig, effects, seed=2, band_hz=(20, 250), excitation=excitation)
+    d = estimate_frf(r, band=(40, 200))
+    assert d.estimator["method"] == "lpm" and d.freq_hz[0] >= 40 and d.freq_hz[-1] <= 200
+    model = frf(d.freq_hz, rig, effects, outputs=("a1", "a2"))
+    for ch in ("a1", "a2"):
+        err = np.abs(d[ch] - model.channel(ch)) / np.abs(model.channel(ch))
+        assert np.max(err) < 3e-3, ch
+
+
+def test_lpm_std_is_honest_with_noise_on_every_channel():
+    """Standardised errors of the LPM estimate have unit variance with force and response noise."""
+    z = []
+    for seed in range(3):
+        r = simulate_recording(60.0, 1000.0, noise=0.03, force_noise=0.02, seed=seed)
+        d = estimate_frf(r)
+        model = frf(d.freq_hz, outputs=("a1", "a2"))
+        for ch in ("a1", "a2"):
+            e = (d[ch] - model.channel(ch)) / d.std[ch]
+            z += [e.real, e.imag]
+    z = np.concatenate(z)
+    assert 0.9 < z.var() < 1.1
+    assert abs(z.mean()) < 0.05
+    assert d.estimator["noise_dof"] > 100
+
+
+def test_lpm_finds_the_excited_band_and_says_so():
+    r = simulate_recording(30.0, 1000.0, noise=0.02, seed=1, band_hz=(30, 150))
+    d = estimate_frf(r, band=(10, 400))
+    assert 30 <= d.freq_hz[0] < 31 and 149 < d.freq_hz[-1] <= 150
+    names = [m["name"] for m in d.estimator["measurement"]]
+    assert "unexcited_band" in names
+
+
+def test_welch_resolution_bias_is_named_as_a_measurement_finding():
+    r = simulate_recording(120.0, 1000.0, noise=0.02, seed=1)
+    d = estimate_frf(r, nperseg=1024, band=(30, 150))
+    assert "resolution_bias" in [m["name"] for m in d.estimator["measurement"]]
+    assert not estimate_frf(r, band=(30, 150)).estimator["measurement"]
     with pytest.raises(DataError, match="inside"):
         simulate_recording(1.0, 100.0, band_hz=(10, 60))
 

@@ -111,7 +111,7 @@ def test_mapping_errors_are_one_line(tmp_path):
     p = tmp_path / "lab.uff"
     _third_party(p, [{"data": m["a1"], "rsp": (1, 3)}, {"data": m["a2"], "rsp": (2, 3)},
                      {"data": m["a2"], "rsp": (2, 3), "ref": (4, 3)}])
-    with pytest.raises(FormatError, match="3 FRF records .* --map a1=NODE:DIR"):
+    with pytest.raises(FormatError, match="3 FRF records .* channel_map a1=NODE:DIR"):
         load_frf(p)
     with pytest.raises(FormatError, match="2 FRF records match .* a2=#N"):
         load_frf(p, channel_map="a1=1:3,a2=2:3")

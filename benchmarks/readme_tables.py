@@ -1,0 +1,416 @@
+"""Write the README's result tables and figures from `benchmarks/results/*.json`.
+
+Every number the README reports from a benchmark sits between two markers,
+
+    <!-- results:NAME -->
+    ...generated lines...
+    <!-- /results:NAME -->
+
+and this script rewrites those regions from the JSON files that the benchmarks
+write (no number in a region is typed by hand). Text outside the markers is
+left alone.
+
+    python benchmarks/readme_tables.py            # rewrite README.md in place
+    python benchmarks/readme_tables.py --check    # exit 1 (and name the regions) if README.md is stale
+
+`tests/test_readme.py` runs the check, so README and results cannot drift:
+after a benchmark writes new JSON, run this script and commit both.
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import re
+import sys
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+RESULTS = ROOT / "benchmarks" / "results"
+README = ROOT / "README.md"
+
+# the opening marker ends its line; the body is whole lines; the closing marker may be indented (inside a list item)
+REGION = re.compile(r"(<!-- results:(?P<name>[\w-]+) -->\n)(?P<body>(?:.*\n)*?)([ \t]*<!-- /results:(?P=name) -->)")
+
+
+def load(name: str) -> dict:
+    path = RESULTS / f"{name}.json"
+    try:
+        return json.loads(path.read_text(encoding="utf-8"))
+    except OSError as exc:
+        raise SystemExit(f"readme_tables: cannot read {path}: {exc.strerror}") from None
+
+
+def g(x, digits=3) -> str:
+    """A number with `digits` significant figures (general format)."""
+    return f"{x:.{digits}g}"
+
+
+def sci(x, digits=2) -> str:
+    """`digits` significant figures, exponent without '+' or leading zeros (2.1e7, 3.1e-5)."""
+    return re.sub(r"e([+-])0*(\d)", lambda m: "e" + ("-" if m.group(1) == "-" else "") + m.group(2), f"{x:.{digits}g}")
+
+
+def pct(x, digits=0) -> str:
+    return f"{100 * x:.{digits}f} %"
+
+
+def frac(num, den) -> str:
+    return f"{num}/{den}"
+
+
+def _cell(inv, kind, preset, noise):
+    for c in inv["cells"]:
+        if c["kind"] == kind and c["preset"] == preset and abs(c["noise"] - noise) < 1e-12:
+            return c
+    raise KeyError(f"inverse.json has no cell {kind}/{preset}/{noise}")
+
+
+def _off(inv, kind, preset):
+    for o in inv["off_curve"]:
+        if o["kind"] == kind and o["preset"] == preset:
+            return o
+    raise KeyError(f"inverse.json has no off-curve entry {kind}/{preset}")
+
+
+# --------------------------------------------------------------------------------------------- regions
+
+
+def table2() -> str:
+    from satmd.inverse.ablation import table2_markdown
+
+    return table2_markdown(load("inverse"))
+
+
+def ablation_run() -> str:
+    inv = load("inverse")
+    m = inv["machine"]
+    minutes = inv["benchmark_wall_s"] / 60
+    n_pairs = inv["n_test"] // (inv["per_pair"] + 1)
+    return (f"**Ablation** (`python benchmarks/inverse.py`, one run on {inv['date'][:10]}, {minutes:.0f} min on a "
+            f"{m['cpu_count']}-core machine with {m['torch_threads']} torch thread). The test set is the "
+            f"{n_pairs} blind pairs plus {inv['per_pair']} neighbours of each ({inv['n_test']} FRFs never seen "
+            f"in training). Noise is at the training level, and the test FRFs carry their std. FRF error is the\n"
+            f"relative L2 error of the FRFs rebuilt from the prediction. Coverage is the share of |error| ≤ 2σ.\n"
+            f"`hybrid` shares the physics nets of its row, so its training time is theirs.")
+
+
+def ablation() -> str:
+    from satmd.inverse.ablation import ablation_markdown
+
+    return ablation_markdown(load("inverse"))
+
+
+def off_curve() -> str:
+    from satmd.inverse.ablation import off_curve_markdown
+
+    return off_curve_markdown(load("inverse"))
+
+
+def loop_speedup() -> str:
+    s = load("inverse")["speedup"]
+    return (f"Vectorised training pushes whole mini-batches of all members through the twin.\n"
+            f"One physics epoch ({s['n_train']} samples, {s['n_members']} members, batch {s['batch_size']}) takes "
+            f"{s['vectorised_epoch_s']:.2f} s, against {s['per_sample_epoch_s']:.1f} s for a Python loop over "
+            f"samples (×{s['speedup']:.0f}; {s['loop_epochs_timed']} loop epochs timed).")
+
+
+def preconditioner() -> str:
+    inv = load("inverse")
+    plain = inv["plain_physics"]["table2"]["mae_R"]
+    pre = inv["table2"]["physics"]["mae_R"]
+    return f"  Without the preconditioner, Table 2's MAE R is {plain:.3f} Ω instead of {pre:.3f} Ω."
+
+
+def discovery_noise() -> str:
+    d = load("discovery")
+    est, given, null_est = d["single_effect_noise_estimated"], d["single_effect"], d["null_noise_estimated"]
+    chi = [m["chi2_before"] for m in est["misses"] if m.get("chi2_before") is not None]
+    lost = (f"nominal χ²_red {min(chi):.2f}–{max(chi):.2f}" if len(chi) > 1 else
+            f"nominal χ²_red {chi[0]:.2f}" if chi else "none lost")
+    return "\n".join([
+        f"- {est['correct_of_detectable']} of {est['detectable']} "
+        f"({pct(est['correct_of_detectable'] / est['detectable'])}) are still found with estimated noise, "
+        f"against {given['correct_of_detectable']} of {given['detectable']} with std given;",
+        f"- null files are still not flagged ({null_est['false_positives']} of {null_est['n']});",
+        f"- the cases lost are the weakest ({lost}), because part of the mismatch is taken for noise.",
+    ])
+
+
+def distill() -> str:
+    d = load("distill")
+    pf, op, po = d["paper_formula_on_our_data"], d["operon"], d["paper_operators"]
+    p1, b30 = d["best_test_r2_within_paper_plus_1"], d["best_test_r2_within_30"]
+    an = d["anova"]
+    greedy = dict(an["r2_greedy"])
+    steps = [k for k, _ in an["r2_greedy"][1:3]]
+    s3 = d["sindy"]["3"]
+    target = d["targets"]["r2_test_at_paper_complexity"]
+    syms = op["settings"]["allowed_symbols"].replace(",constant,variable", "").replace(",", " ")
+    syms = syms.replace("add", "+").replace("sub", "−").replace("mul", "×").replace("div", "/")
+    reached = "reached" if d["meets"]["r2_test_at_paper_complexity"] else "**not reached**"
+    return "\n".join([
+        f"- **Symbolic distillation of ξ.** The paper's formula scores test R² {pf['r2_test']:.3f} on",
+        f"  our data (the paper reports {d['paper_reported']['r2_test']}); written as printed it has "
+        f"{pf['complexity']} sympy",
+        f"  nodes. pyoperon ({syms}, {op['seconds']:.0f} s on {op['threads']} core) reaches "
+        f"{op['r2_test']:.3f} at",
+        f"  {op['complexity']} nodes, {p1['r2_test']:.3f} at {p1['complexity']} nodes",
+        f"  (`{p1['expression'].replace('*', ' ').replace('  ', '*')}`)",
+        f"  and {b30['r2_test']:.3f} at {b30['complexity']} (≤ 30); with the paper's operators only, "
+        f"{po['r2_test']:.3f} at {po['complexity']} nodes.",
+        "  Constants a neighbour can absorb are pruned and refitted before nodes are",
+        f"  counted. The issue's target of {target} at the paper's node count is {reached}.",
+        "  The functional ANOVA of ξ over the grid (`satmd.explain.anova`) shows why: the four main",
+        f"  effects explain at most {an['r2_main']:.3f}; adding {steps[0].lstrip('+')} gives "
+        f"{greedy[steps[0]]:.3f} and {steps[1].lstrip('+')} {greedy[steps[1]]:.3f}, so a formula at {target}",
+        "  needs four curved main effects and more interaction than that. SINDy's cubic",
+        f"  polynomial reaches {s3['r2_test']:.3f} with {s3['complexity']} nodes.",
+    ])
+
+
+def tuning() -> str:
+    t = load("tuning")
+    no, k1, em, rb, cli = t["noisy"], t["k1_offset"], t["extra_mode"], t["robust"], t["cli"]
+    rows = [
+        "| what | result |",
+        "|---|---|",
+        f"| {no['n']} rigs drawn in SPEC §9's ranges, 1 % noise: `discover` → `tune`, true peak at the returned "
+        f"R, L vs the true optimum | {no['within']}/{no['n']} within 0.1 dB; median {no['median_gap_db']:.3f} dB, "
+        f"max {no['max_gap_db']:.3f} dB |",
+        f"| concealed k1 + 5 % ({k1['n']} rigs): tuned on the discovered model / on the nominal model | "
+        f"max {k1['max_gap_db']:.3f} dB / median {k1['nominal_median_gap_db']:.2f} dB, "
+        f"max {k1['nominal_max_gap_db']:.2f} dB above the true optimum |",
+        f"| concealed host mode at 60–120 Hz ({em['n']} rigs): discovered model / nominal model | "
+        f"max {em['max_gap_db']:.3f} dB / median {em['nominal_median_gap_db']:.2f} dB, "
+        f"max {em['nominal_max_gap_db']:.2f} dB |",
+        f"| robust tuning (10 % noise, 128 draws), {rb['n_fresh']} fresh draws of the fit's uncertainty | "
+        f"95 % quantile of the true peak {rb['q95_improvement_db']:.2f} dB lower than the nominal setting's; "
+        f"the guaranteed attenuation held in {pct(rb['coverage'])} of the draws |",
+        f"| `satmd tune FILE --json`, 60-point FRF, whole process (start-up, imports, discovery, tuning), "
+        f"H∞ / H2 | {cli['hinf']['process_cpu_s']:.2f} / {cli['h2']['process_cpu_s']:.2f} s of CPU; wall "
+        f"{cli['hinf']['process_s']:.1f} / {cli['h2']['process_s']:.1f} s on a shared {t['machine']['cpus']}-core "
+        f"machine ({cli['hinf']['in_process_s']:.1f} / {cli['h2']['in_process_s']:.1f} s inside a running "
+        f"interpreter) |",
+    ]
+    return "\n".join(rows)
+
+
+def tuning_summary() -> str:
+    t = load("tuning")
+    return (f"Tuning on the model that discovery completes is what makes the setting right:\n"
+            f"on the nominal model the same data give settings up to {t['k1_offset']['nominal_max_gap_db']:.1f} dB "
+            f"(k1 off by 5 %)\nand {t['extra_mode']['nominal_max_gap_db']:.1f} dB (an unmodelled mode) worse than "
+            f"they could be.")
+
+
+def measured() -> str:
+    ide, fwd, dis, st = load("identification"), load("forward"), load("discovery"), load("startup")
+    inv, dst, mem = load("inverse"), load("distill"), load("memory")
+    runs = load("inverse_training")
+    t1, ad, cov, gl = ide["table1"]["satmd"], ide["table1"]["adam"], ide["coverage"], ide["global"]
+    ns = ide.get("coverage_no_std", {})
+    s, r = fwd["satmd"], fwd["ratios"]
+    acc, se, se2 = dis["acceptance"], dis["single_effect"], dis["two_effects"]
+    ne, n0, n1 = dis["single_effect_noise_estimated"], dis["null_std_given"], dis["null_noise_estimated"]
+    p2, h2 = inv["table2"]["physics"], inv["table2"]["hybrid"]
+    train = _cell(inv, "physics", "paper", 0.0)["train_s"]
+    c1p, c1s = _cell(inv, "physics", "paper", 0.01), _cell(inv, "supervised", "paper", 0.01)
+    obp, obs = _off(inv, "physics", "box"), _off(inv, "supervised", "box")
+    last = runs[-1]
+    op, pf, p1, b30 = dst["operon"], dst["paper_formula_on_our_data"], dst["best_test_r2_within_paper_plus_1"], \
+        dst["best_test_r2_within_30"]
+    tgt = mem["target"]
+    at = next(row for row in mem["rows"] if row["points"] == tgt["points"])
+    big = max(mem["rows"], key=lambda row: row["points"])
+    cli = mem.get("cli_end_to_end")
+    heavy = ", ".join(st["heavy_modules_after_import"]) or "none of scipy.optimize, scipy.stats, matplotlib, torch"
+
+    def vals(c):
+        return ", ".join(f"{k} {v:.3g}" for k, v in c.items())
+
+    rows = [
+        "| what | result | script |",
+        "|---|---|---|",
+        f"| Table 1 with the paper's loss (λ = 1e-8), full state, paper start | relative FRF error "
+        f"{sci(t1['rel_error'], 4)} (paper: 2.35e-6) in {1e3 * t1['time_s']:.0f} ms "
+        f"(median wall; {1e3 * t1['cpu_time_s']:.0f} ms CPU): "
+        f"{ide['table1']['speedup']:.0f}× faster than the paper-style Adam loop ({ad['time_to_target_s']:.1f} s, "
+        f"{ad['epochs_to_target']} epochs) | `benchmarks/identification.py` |",
+        f"| global identification, {gl['n']} random truths (SPEC §9 ranges), noise-free | {gl['found']}/{gl['n']} "
+        f"recovered from the default start (max relative FRF error {sci(gl['max_rel_error'], 1)}), median "
+        f"{gl['median_time_s']:.3f} s | same |",
+        f"| 95 % interval coverage, {cov['replicates']} replicates at 1 % noise, std given | "
+        f"{vals(cov['coverage_95'])} | same |",
+    ]
+    for key, label in (("no_std_1pct", "1 %"), ("no_std_2pct", "2 %")):
+        if key in ns:
+            c = ns[key]
+            rows.append(f"| 95 % interval coverage, {c['replicates']} replicates at {label} noise, no std columns "
+                        f"| {vals(c['coverage_95'])} | same |")
+    rows += [
+        f"| forward model, 10⁴ rigs × {fwd['n_freq']} frequencies | {sci(s['all_channels_pts_per_s'])} points/s; "
+        f"{r['satmd_over_numpy_solve']:.1f}× batched `numpy.linalg.solve`, {r['satmd_over_torch_solve_c64']:.1f}× "
+        f"`torch.linalg.solve` (complex64); 4-parameter Jacobian {s['jacobian4_over_frf_a1a2']:.1f}× one FRF "
+        f"| `benchmarks/forward.py` |",
+        f"| discovery, shared acceptance files (`satmd discover --json`, shared scorer) | "
+        f"{acc['score']}/{acc['n']}, median {acc['median_time_s']:.1f} s per CLI run | `benchmarks/discovery.py` |",
+        f"| discovery, false positives on {n0['n']} null datasets (std given) / {n1['n']} (noise estimated) | "
+        f"{n0['false_positives']} / {n1['false_positives']} | same |",
+        f"| discovery, {se['n']} concealed single effects (std given) | {se['correct_of_detectable']}/"
+        f"{se['detectable']} of the detectable ones found ({se['n'] - se['detectable']} absorbed by the free "
+        f"parameters); median {se['median_time_s']:.2f} s | same |",
+        f"| discovery with noise estimated / two simultaneous effects | {ne['correct_of_detectable']}/"
+        f"{ne['detectable']} / {se2['correct_of_detectable']}/{se2['detectable']} of the detectable ones | same |",
+        f"| start-up: `import satmd`, `satmd --help` (fresh interpreter each, median of {st['repeats']}) | "
+        f"{st['median_cpu_s']['import_satmd']:.2f} s / {st['median_cpu_s']['satmd_help']:.2f} s of CPU "
+        f"(heavy modules loaded at import: {heavy}); wall {st['median_s']['import_satmd']:.2f} s / "
+        f"{st['median_s']['satmd_help']:.2f} s on a {st['cpu_count']}-core machine at load average "
+        f"{st['load_average'][0]:.1f} | `benchmarks/startup.py` |",
+        f"| identification memory and time, {at['points']:,}-point FRF (no std; fresh process, peak RSS) | "
+        f"peak {at['peak_mb']:.0f} MB, fit {at['identify_s']:.1f} s"
+        + (f"; `satmd identify --json` with std columns: peak {cli['peak_mb']:.0f} MB, {cli['wall_s']:.1f} s wall "
+           f"for the whole process" if cli else "")
+        + f" (target ≤ {tgt['peak_mb']:.0f} MB, ≤ {tgt['time_s']:.0f} s)"
+        + (f"; {big['points']:,} points: peak {big['peak_mb']:.0f} MB, fit {big['identify_s']:.1f} s"
+           if big is not at else "")
+        + " | `benchmarks/memory.py` |",
+        f"| Table 2 (use case II), physics net, six blind pairs (ablation run of {inv['date'][:10]}) | MAE R "
+        f"{sci(p2['mae_R'])} Ω, L {sci(p2['mae_L'])} H (paper: {inv['paper_table2_mae']['R']} Ω, "
+        f"{sci(inv['paper_table2_mae']['L'], 3)} H); trained in {train:.0f} s | `benchmarks/inverse.py` |",
+        f"| Table 2, physics net, latest training run ({last['date'][:10]}, {last['config']['twin_dtype']} twin, "
+        f"batch {last['config']['batch_size']}, {last['torch_threads']} torch thread) | MAE R "
+        f"{sci(last['table2_mae_R'])} Ω, L {sci(last['table2_mae_L'])} H; trained in {last['train_s']:.0f} s "
+        f"| `benchmarks/inverse.py` (`inverse_training.json`) |",
+        f"| Table 2, hybrid (net + least squares) | MAE R {sci(h2['mae_R'], 1)} Ω, L {sci(h2['mae_L'], 1)} H | "
+        f"`benchmarks/inverse.py` |",
+        f"| 2σ coverage of the net's std at 1 % noise, {c1p['n']} held-out FRFs | physics {pct(c1p['coverage'])}, "
+        f"supervised {pct(c1s['coverage'])} | same |",
+        f"| off-curve / on-curve MAE R of box-trained nets | physics "
+        f"{obp['off_curve']['mae_R'] / obp['on_curve']['mae_R']:.2f}, supervised "
+        f"{obs['off_curve']['mae_R'] / obs['on_curve']['mae_R']:.2f} | same |",
+        f"| symbolic distillation of ξ (SPEC §6), pyoperon, one core | test R² {op['r2_test']:.3f} at "
+        f"{op['complexity']} nodes (paper's formula: {pf['r2_test']:.3f} at {pf['complexity']}), "
+        f"{p1['r2_test']:.3f} at {p1['complexity']}, {b30['r2_test']:.3f} at {b30['complexity']} (≤ 30); target "
+        f"{dst['targets']['r2_test_at_paper_complexity']} "
+        f"{'reached' if dst['meets']['r2_test_at_paper_complexity'] else 'not reached'}; additive ceiling "
+        f"{dst['anova']['r2_main']:.3f} | `benchmarks/distill.py` |",
+    ]
+    return "\n".join(rows)
+
+
+def recordings() -> str:
+    path = RESULTS / "recordings.json"
+    if not path.exists():
+        return "_No results yet: run `python benchmarks/recordings.py`, then `python benchmarks/readme_tables.py`._"
+    r = load("recordings")
+    nu, se, te, cov = r["nulls"], r["single_effects"], r["two_effects"], r["identify_coverage_95"]
+
+    def found(x):
+        return (f"{x['found']}/{x['frf_path_detects']} found, {x['no_spurious']}/{x['frf_path_detects']} "
+                f"without a spurious effect")
+
+    rows = [
+        "| what | result |",
+        "|---|---|",
+        f"| null recordings: false alarms | {nu['false_alarms']}/{nu['n']} "
+        f"(median χ²_red {nu['median_chi2_reduced']:.2f}) |",
+        "| `identify` 95 % interval coverage on the null recordings | "
+        + ", ".join(f"{k} {v:.2f}" for k, v in cov.items()) + " |",
+        f"| single effects ({se['n']} recordings; counted over the {se['frf_path_detects']} the FRF path detects) | "
+        f"{found(se)} |",
+    ]
+    for name, x in r.get("per_effect", {}).items():
+        if x["frf_path_detects"]:
+            rows.append(f"| &nbsp;&nbsp;{name} | {found(x)} |")
+    rows.append(f"| two effects ({te['n']} recordings; {te['frf_path_detects']} detected by the FRF path) | "
+                f"{found(te)} |")
+    for label, b in r.get("estimator_bias", {}).items():
+        rows.append(f"| noise-free estimate at the first resonance ({b['freq_hz']:.1f} Hz), {label} | relative error "
+                    f"{b['rel_error_at_peak']:.2g}, {b['bias_over_std_at_peak']:.2g} std of a 2 % noise estimate |")
+    rows.append(f"| `discover(estimate_frf(rec))`, 120 s recording at 2 kHz | "
+                f"{r['seconds_per_120s_2kHz_recording']:.1f} s (median of 3) |")
+    return "\n".join(rows)
+
+
+def _from_benchmark(name: str):
+    """A region NAME that this file does not define: `benchmarks/NAME.py` may define `readme_markdown(result)`,
+    rendered from `benchmarks/results/NAME.json`."""
+    import importlib.util
+
+    script = ROOT / "benchmarks" / f"{name}.py"
+    if not script.exists():
+        return None
+    spec = importlib.util.spec_from_file_location(f"_bench_{name}", script)
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    fn = getattr(mod, "readme_markdown", None)
+    return None if fn is None else (lambda: fn(load(name)))
+
+
+REGIONS = {
+    "table2": table2,
+    "ablation-run": ablation_run,
+    "ablation": ablation,
+    "off-curve": off_curve,
+    "loop-speedup": loop_speedup,
+    "preconditioner": preconditioner,
+    "discovery-noise": discovery_noise,
+    "distill": distill,
+    "tuning": tuning,
+    "tuning-summary": tuning_summary,
+    "measured": measured,
+    "recordings": recordings,
+}
+
+
+def render(text: str) -> tuple[str, list[str]]:
+    """The README text with every region regenerated, and the names of the regions that changed."""
+    changed, unknown = [], []
+
+    def sub(m):
+        name = m.group("name")
+        fn = REGIONS.get(name) or _from_benchmark(name)
+        if fn is None:
+            unknown.append(name)
+            return m.group(0)
+        body = fn().rstrip("\n") + "\n"
+        if body != m.group("body"):
+            changed.append(name)
+        return m.group(1) + body + m.group(4)
+
+    out = REGION.sub(sub, text)
+    if unknown:
+        raise SystemExit(f"readme_tables: README has regions this script does not know: {', '.join(unknown)} "
+                         "(add a function to REGIONS here, or `readme_markdown(result)` to benchmarks/NAME.py)")
+    opened = re.findall(r"<!-- results:([\w-]+) -->", text)
+    closed = {m.group("name") for m in REGION.finditer(text)}
+    unmatched = [n for n in opened if n not in closed]
+    if unmatched:
+        raise SystemExit(f"readme_tables: unclosed region(s) in README: {', '.join(unmatched)}")
+    return out, changed
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--check", action="store_true", help="exit 1 if README.md differs from the results")
+    ap.add_argument("--readme", type=Path, default=README)
+    args = ap.parse_args(argv)
+    text = args.readme.read_text(encoding="utf-8")
+    out, changed = render(text)
+    missing = [n for n in REGIONS if f"<!-- results:{n} -->" not in text]
+    if missing:
+        print(f"readme_tables: note: no region for {', '.join(missing)} in {args.readme.name}", file=sys.stderr)
+    if args.check:
+        if changed:
+            print(f"readme_tables: {args.readme.name} is stale in: {', '.join(changed)} "
+                  f"(run `python benchmarks/readme_tables.py`)", file=sys.stderr)
+            return 1
+        return 0
+    if changed:
+        args.readme.write_text(out, encoding="utf-8")
+    print(f"readme_tables: {len(changed)} region(s) rewritten" + (f": {', '.join(changed)}" if changed else ""))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

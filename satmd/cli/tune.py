@@ -1,0 +1,180 @@
+"""satmd tune: the best shunt setting (R, L or any rig parameters) for measured data or a model rig."""
+from __future__ import annotations
+
+import argparse
+import sys
+import warnings
+from pathlib import Path
+
+from ..errors import DataError
+from ._common import (check_outputs, dumps_json, load_data, one_line_warnings, parse_effect, parse_kv, parse_list,
+                      parse_number, plot_suffixes)
+
+_DATA_TYPES = (".csv", ".uff", ".unv", ".mat", ".npz", ".txt", ".wav")
+
+
+def register(sub):
+    p = sub.add_parser("tune", help="best R and L (or any design) for a measured or modelled rig",
+                       description="Identify the rig from DATA (running discovery and tuning on the augmented "
+                                   "model when a significant mismatch is found) or take a model rig (--rig), "
+                                   "then find the globally best setting: H∞ = true peak, H2 = RMS of |U1| or "
+                                   "|A1| over the band. Several files or a folder: retune each step of a "
+                                   "drifting rig and compare with keeping the first setting.")
+    p.add_argument("data", metavar="DATA", nargs="*",
+                   help="FRF file(s) or recording(s), or a folder of them (several: retuning over time)")
+    p.add_argument("--rig", nargs="?", const="", default=None, metavar="KEY=VALUE,...",
+                   help="tune a model rig instead of data: the paper's rig with these changes (any rig field, "
+                        "e.g. m2=0.6,kp=1.2e5,R=22,L=0.064)")
+    p.add_argument("--effect", action="append", default=[], metavar="NAME:key=value,...",
+                   help="an effect of the model rig (with --rig; repeatable)")
+    p.add_argument("--objective", choices=("hinf", "h2"), default="hinf",
+                   help="hinf: true peak over the band (default); h2: RMS over the band")
+    p.add_argument("--output", choices=("u1", "a1"), default="u1", help="response to reduce (default u1)")
+    p.add_argument("--band", default="20:200", metavar="LO:HI", help="tuning band in Hz (default 20:200)")
+    p.add_argument("--design", default="R,L", metavar="R,L", help="rig parameters to design (default R,L)")
+    p.add_argument("--bounds", default=None, metavar="R=LO:HI,...",
+                   help="search box per design variable (default R 0.1:1000, L 0.001:5, others ×/÷10)")
+    p.add_argument("--current", default=None, metavar="R=22,L=0.064",
+                   help="the current setting (default: the identified or given values)")
+    p.add_argument("--robust", nargs="?", const=0.95, default=None, type=float, metavar="Q",
+                   help="minimise the Q quantile (default 0.95) over the fit's parameter uncertainty")
+    p.add_argument("--draws", type=int, default=128, help="parameter draws for --robust (default 128)")
+    p.add_argument("--uncertainty", default=None, metavar="kp=5e3,...",
+                   help="standard deviations for --robust (instead of the fit's covariance; needed with --rig)")
+    p.add_argument("--free", default="m2,kp,R,L", help="parameters identified from DATA (default m2,kp,R,L)")
+    p.add_argument("--channels", default=None, help="channels to fit (default a1,a2 when present)")
+    p.add_argument("--no-discover", action="store_true",
+                   help="tune on the nominal fit without looking for missing physics")
+    p.add_argument("--data-band", default=None, metavar="LO:HI", help="use only LO <= f <= HI Hz of DATA")
+    p.add_argument("--map", default=None, metavar="a1=NODE:DIR,a2=NODE:DIR", help="channel mapping for UFF files")
+    p.add_argument("--freq-axis", default=None, metavar="START:STEP", help="frequency axis for .txt files")
+    p.add_argument("--json", action="store_true", help="print the SPEC §10 JSON document only")
+    p.add_argument("--plot", default=None, metavar="FIG.png", help="response before/after (or retuning over time)")
+    p.set_defaults(func=run)
+
+
+def run(args):
+    from ..tune import retune, tune
+
+    options = _tune_options(args)
+    if (args.rig is None) == (not args.data):
+        raise DataError("give DATA (a file, several files or a folder) or --rig, not both")
+    files = data_files(args.data)
+    if args.plot:  # every output is checked before the first piece of work
+        check_outputs([("--plot", args.plot, plot_suffixes())], inputs=files)
+    if args.rig is not None:
+        model = _model_rig(args)
+        result = tune(model, effects=[parse_effect(e) for e in args.effect], **options)
+    else:
+        if args.effect:
+            raise DataError("--effect describes a model rig (--rig); with DATA the effects are discovered")
+        series = [_load(args, f) for f in files]
+        if len(series) > 1:
+            if args.robust is not None:
+                raise DataError("--robust applies to one FRF, not to a series")
+            free = parse_list(args.free) or ("m2", "kp", "R", "L")
+            options = {k: v for k, v in options.items() if k not in ("robust", "quantile", "n_draws", "uncertainty")}
+            with one_line_warnings("tune"):
+                result = retune(series, free=free, labels=[f.stem for f in files], **options)
+            return _finish(args, result)
+        result = tune(_identified(args, series[0]), **options)
+    return _finish(args, result)
+
+
+def _finish(args, result):
+    if args.plot:
+        result.plot(args.plot)
+    if args.json:
+        print(dumps_json(result.to_dict(), "tune", indent=2))
+        return 0
+    print(result.report())
+    return 0
+
+
+def _tune_options(args) -> dict:
+    from ..tune.objective import Objective
+    from ..tune.optimiser import DesignSpace
+
+    lo, sep, hi = args.band.partition(":")
+    if not sep:
+        raise DataError(f"--band {args.band!r}: expected LO:HI in Hz")
+    band = (parse_number(lo, "--band LO"), parse_number(hi, "--band HI"))
+    Objective(args.objective, args.output, band)  # validates the band now, before any work
+    design = parse_list(args.design)
+    if not design:
+        raise DataError("--design: give at least one rig parameter, e.g. R,L")
+    bounds = {}
+    for item in parse_list(args.bounds) or ():
+        name, eq, rng = item.partition("=")
+        a, colon, b = rng.partition(":")
+        if not eq or not colon:
+            raise DataError(f"--bounds {item!r}: expected NAME=LO:HI")
+        bounds[name.strip()] = (parse_number(a, f"--bounds {name} LO"), parse_number(b, f"--bounds {name} HI"))
+    DesignSpace.build(design, {n: 1.0 for n in design}, bounds)  # names and bounds checked before any work
+    q = args.robust
+    if q is not None and not 0.5 <= q < 1:
+        raise DataError(f"--robust {q}: the quantile must lie in [0.5, 1)")
+    if args.draws < 16:
+        raise DataError(f"--draws {args.draws}: need at least 16")
+    current = parse_kv(args.current, "--current") if args.current else None
+    uncertainty = parse_kv(args.uncertainty, "--uncertainty") if args.uncertainty else None
+    if uncertainty and q is None:
+        raise DataError("--uncertainty applies to --robust")
+    return {"objective": args.objective, "output": args.output, "band": band, "design": design,
+            "bounds": bounds or None, "robust": q is not None, "quantile": q or 0.95, "n_draws": args.draws,
+            "current": current, "uncertainty": uncertainty}
+
+
+def _model_rig(args):
+    from ..physics import Rig
+
+    changes = parse_kv(args.rig, "--rig") if args.rig else {}
+    try:
+        return Rig().replace(**changes).validate()
+    except ValueError as exc:
+        raise DataError(f"--rig: {exc}") from None
+
+
+def data_files(items) -> list[Path]:
+    """DATA arguments as a list of files (a folder: its data files, sorted by name)."""
+    files = []
+    for item in items:
+        path = Path(item)
+        if path.is_dir():
+            found = sorted(f for f in path.iterdir() if f.is_file() and f.suffix.lower() in _DATA_TYPES)
+            if not found:
+                raise DataError(f"{path}: no data files ({', '.join(_DATA_TYPES)}) in this folder")
+            files += found
+        elif path.is_file():
+            files.append(path)
+        else:
+            raise DataError(f"{path}: no such file or folder")
+    return files
+
+
+def _load(args, path):
+    ns = argparse.Namespace(data=str(path), band=args.data_band, map=args.map, freq_axis=args.freq_axis,
+                            command="tune")
+    return load_data(ns)
+
+
+def _identified(args, data):
+    """The model to tune: the discovery report (augmented model when a mismatch is found) or the fit."""
+    free = parse_list(args.free) or ("m2", "kp", "R", "L")
+    channels = parse_list(args.channels)
+    if args.no_discover:
+        from ..identify import identify
+
+        with one_line_warnings("tune"):
+            return identify(data, free=free, channels=channels)
+    from ..discover import discover
+    from ..io import DataWarning
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", DataWarning)  # discovery fits wrong models on purpose; its report speaks
+        rep = discover(data, free=free, channels=channels)
+    if rep.significant_mismatch:
+        found = ", ".join(rep.effect_names) or "nothing in the vocabulary"
+        print(f"satmd tune: note: discovery found a significant mismatch ({found}); "
+              "tuning on the augmented model", file=sys.stderr)
+    return rep

@@ -1,0 +1,137 @@
+"""What the measurement chain does to an FRF estimate, said in words (SPEC §9 ``measurement``).
+
+Every check here is about the *chain* (sensors, excitation, estimator), never
+about the structure: a finding names the artifact, how large it is next to the
+noise, and the setting that removes it. Discovery lists these apart from
+physics, so an artifact of the chain never appears as an effect.
+"""
+from __future__ import annotations
+
+from dataclasses import asdict, dataclass
+
+import numpy as np
+
+
+@dataclass(frozen=True)
+class MeasurementFinding:
+    """One artifact of the measurement chain.
+
+    Attributes
+    ----------
+    name : short identifier (``resolution_bias``, ``force_noise_bias``, ``clipping``, ...)
+    explanation : what it is and how large, in words
+    remedy : the setting or change that removes it
+    corrected : True when satmd already removed it from the estimate
+    """
+
+    name: str
+    explanation: str
+    remedy: str
+    corrected: bool = False
+
+    def to_dict(self) -> dict:
+        return asdict(self)
+
+
+def half_power_widths(freq_hz: np.ndarray, h: np.ndarray, min_height: float = 0.2) -> list[tuple[float, float]]:
+    """(peak frequency, half-power width) of each resonance peak of |h| taller than ``min_height`` × max."""
+    mag = np.abs(h)
+    out = []
+    top = mag.max()
+    for i in range(1, mag.size - 1):
+        if mag[i] < min_height * top or mag[i] < mag[i - 1] or mag[i] < mag[i + 1]:
+            continue
+        half = mag[i] / np.sqrt(2.0)
+        lo = i
+        while lo > 0 and mag[lo] > half:
+            lo -= 1
+        hi = i
+        while hi < mag.size - 1 and mag[hi] > half:
+            hi += 1
+        if mag[lo] > half or mag[hi] > half:
+            continue  # the peak runs off the band: no width to measure
+        f_lo = np.interp(half, [mag[lo], mag[lo + 1]], [freq_hz[lo], freq_hz[lo + 1]])
+        f_hi = np.interp(half, [mag[hi], mag[hi - 1]], [freq_hz[hi], freq_hz[hi - 1]])
+        out.append((float(freq_hz[i]), float(f_hi - f_lo)))
+    return out
+
+
+def sharpest_resonance(freq_hz, channels: dict):
+    """(frequency, half-power width) of the narrowest resonance over the channels, or None."""
+    peaks = [p for h in channels.values() for p in half_power_widths(freq_hz, h)]
+    return min(peaks, key=lambda p: p[1]) if peaks else None
+
+
+def welch_findings(freq_hz, channels: dict, std: dict, resolution_hz: float, segments: int,
+                   estimator: str) -> list[MeasurementFinding]:
+    """Resolution bias and too few averages of a Welch (H1/H2, Hann) estimate."""
+    found = []
+    sharp = sharpest_resonance(freq_hz, channels)
+    if sharp is not None:
+        f0, width = sharp
+        bias = 4.0 / 3.0 * (resolution_hz / width) ** 2  # Bendat & Piersol, B_e = 2Δf for Hann
+        i = int(np.argmin(np.abs(freq_hz - f0)))
+        rel_std = min(std[c][i] / max(abs(channels[c][i]), 1e-300) for c in channels)
+        if bias > 0.5 * rel_std:
+            need = 2 ** int(np.ceil(np.log2(resolution_hz / (width * np.sqrt(0.75 * 0.1 * rel_std)))))
+            found.append(MeasurementFinding(
+                "resolution_bias", corrected=True, explanation=
+                f"the {estimator} estimate's resolution ({resolution_hz:.3g} Hz) smears the resonance at "
+                f"{f0:.1f} Hz (half-power width {width:.2f} Hz): its peak is about {100 * bias:.2g} % low, "
+                f"{bias / max(rel_std, 1e-300):.1f}× the noise there. satmd compares the model through the same "
+                f"window (its power kernel, to second order), so the smearing is not taken for physics",
+                remedy=f"use the local polynomial estimator (the default), or nperseg at least {need}× longer"))
+    if segments < 16:
+        found.append(MeasurementFinding(
+            "too_few_averages",
+            f"only {segments} Welch averages: coherence and std are rough and H1 is biased where coherence is low",
+            "record longer, or use the local polynomial estimator (the default)"))
+    return found
+
+
+def lpm_findings(freq_hz, channels: dict, std: dict, settings: dict, force_noise_bias: np.ndarray,
+                 requested_band=None) -> list[MeasurementFinding]:
+    """Short record for the resonances, force-noise bias, unexcited band, for an LPM estimate."""
+    found = []
+    sharp = sharpest_resonance(freq_hz, channels)
+    window = settings["window_hz"]
+    if sharp is not None and window > sharp[1] / 4:
+        need = settings["record_s"] * window / (sharp[1] / 5)
+        found.append(MeasurementFinding(
+            "short_record",
+            f"each local window spans {window:.3g} Hz, more than a quarter of the narrowest resonance's "
+            f"half-power width ({sharp[1]:.2f} Hz at {sharp[0]:.1f} Hz): the local polynomial may bend the peak",
+            f"record at least {need:.0f} s"))
+    bias = float(np.max(force_noise_bias)) if np.size(force_noise_bias) else 0.0
+    if bias > 0:
+        rel = min(float(np.median(std[c] / np.maximum(np.abs(channels[c]), 1e-300))) for c in channels)
+        if bias > 0.1 * rel:
+            found.append(MeasurementFinding(
+                "force_noise_bias",
+                f"noise on the force sensor pulls the FRF towards zero by up to {100 * bias:.2g} % "
+                f"({bias / max(rel, 1e-300):.1f}× the typical noise); estimated from the force's noise floor "
+                f"outside the excited band and removed",
+                "a cleaner force signal (higher excitation level or a quieter load cell)", corrected=True))
+    lo, hi = settings["band_hz"]
+    req_lo, req_hi = requested_band or (None, None)
+    cut = [f"{a:g}–{b:g} Hz" for a, b in ((req_lo, lo), (hi, req_hi))
+           if a is not None and b is not None and b - a > max(2.0, 0.02 * (hi - lo))]
+    if cut:
+        found.append(MeasurementFinding(
+            "unexcited_band",
+            f"the force excites {lo:.1f}–{hi:.1f} Hz only; {' and '.join(cut)} of the requested band carry no "
+            f"force and were left out",
+            "widen the excitation band of the shaker signal"))
+    return found
+
+
+def clipping_findings(recording) -> list[MeasurementFinding]:
+    """A channel that sits on its extremes for several samples was clipped."""
+    from .recording import clipped_channels
+
+    return [MeasurementFinding(
+        "clipping",
+        f"channel {name} sits at its extreme value for {count} samples: it was clipped, which spreads "
+        f"harmonics over the band",
+        f"lower the excitation level or raise the input range of {name}")
+        for name, count in clipped_channels(recording).items()]

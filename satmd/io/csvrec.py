@@ -1,0 +1,65 @@
+"""Recordings as CSV: ``# satmd-recording v1`` (optional), then ``time_s,force,acc1,acc2`` in SI units.
+
+``force`` may be left out (output-only); sampling must be uniform.
+"""
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from ..errors import DataError, FormatError
+from ._common import decode_text, numeric_table, read_bytes, split_csv
+from .atomic import atomic_write
+from .recdata import ROLES, SI_UNITS, Recording, uniform_rate, warn_clipping
+
+CSV_MAGIC = "# satmd-recording v1"
+
+
+def read_recording_csv(path) -> Recording:
+    """A ``time_s,force,acc1,acc2`` CSV (SI units); malformed input names file, line and column."""
+    path = Path(path)
+    text = decode_text(path, read_bytes(path))
+    header, header_line, rows, meta = split_csv(path, text, "satmd-recording")
+    if header is None:
+        raise FormatError(path, "no column header (expected time_s,force,acc1,acc2)")
+    _check_header(path, header, header_line)
+    if len(rows) < 2:
+        raise FormatError(path, f"{len(rows)} data row(s): a recording needs at least 2 samples", line=header_line)
+    values = numeric_table(path, header, rows)
+    fs = uniform_rate(path, values[:, 0], [ln for ln, _ in rows])
+    channels = {name: values[:, j] for j, name in enumerate(header) if j}
+    meta.update({"source": str(path), "format": "csv"})
+    rec = Recording(fs, channels, {n: SI_UNITS[n] for n in channels}, meta,
+                    {n: f"column {j + 1}" for j, n in enumerate(header) if j})
+    warn_clipping(path, rec)
+    return rec
+
+
+def _check_header(path, header, lineno):
+    if header[0] != "time_s":
+        raise FormatError(path, f"first column must be time_s, got {header[0]!r}", line=lineno, column=1)
+    seen = set()
+    for j, name in enumerate(header[1:], start=2):
+        if name not in ROLES:
+            raise FormatError(path, f"unknown column {name!r} (known: {', '.join(ROLES)})", line=lineno, column=j)
+        if name in seen:
+            raise FormatError(path, f"duplicate column {name!r}", line=lineno, column=j)
+        seen.add(name)
+    if len(header) < 2:
+        raise FormatError(path, "no signal columns after time_s", line=lineno)
+
+
+def write_recording_csv(rec: Recording, path) -> Path:
+    path = Path(path)
+    names = [n for n in ROLES if n in rec.channels]
+    if len(names) != len(rec.channels):
+        raise DataError(f"CSV recordings hold {', '.join(ROLES)}; rename the other channels first")
+    lines = [CSV_MAGIC]
+    lines += [f"# {k}: {v}" for k, v in rec.meta.items() if k != "source" and "\n" not in f"{k}{v}"]
+    lines.append(",".join(["time_s"] + names))
+    table = np.column_stack([rec.time_s] + [rec.channels[n] for n in names])
+    lines += [",".join(f"{x:.17g}" for x in row) for row in table]
+    with atomic_write(path, "w") as fh:
+        fh.write("\n".join(lines) + "\n")
+    return path

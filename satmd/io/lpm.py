@@ -1,0 +1,286 @@
+"""FRFs from one full record by the Local Polynomial Method (Pintelon et al. 2010).
+
+Why not Welch. Averaging windowed segments trades resolution for averages: the
+Hann window smears a resonance of half-power width B_r over ≈ 2Δf and biases
+its peak by about −(4/3)(Δf/B_r)² (Bendat & Piersol), a few per cent on a
+lightly damped rig — far above the noise of a long record. A model fitted to
+such an FRF "finds" physics that is only the window.
+
+What the LPM does. The DFT of the whole record (no window) obeys, at every
+bin k, ``Y(k) = H(k) X(k) + T(k) + V(k)``: T is the leakage/transient term of a
+non-periodic record (smooth in k, it has the system's poles) and V the noise.
+Around each centre bin, over ``2n+1`` neighbouring bins r = −n..n, H and T are
+modelled as polynomials of degree ``R`` in r and fitted by linear least squares
+(2(R+1) complex unknowns). The constant term of H's polynomial is the estimate at
+the centre: full 1/T resolution, no window, leakage and transient removed. The
+residual leaves ``q = 2n+1 − 2(R+1)`` complex degrees of freedom for the noise.
+
+Independent points. Windows do not overlap, so every estimate uses its own bins
+and the estimates are independent: a χ² over them is a χ² (overlapping windows
+would correlate neighbours, and the tests downstream would lie).
+
+Noise. The residual variance of each window is a noisy (q-dof) estimate of
+``E|V|² = S_y + |H|² S_x``: sensor noise on the response plus force-sensor noise
+seen through H. Both spectra are smooth in frequency, so ``S_y`` and ``S_x`` are
+fitted locally over ±``smooth`` windows (weighted least squares, refined once)
+and the variance of each estimate is that smooth level times the window's
+``[(KᴴK)⁻¹]₀₀``. The std then rests on hundreds of degrees of freedom
+(``noise_dof``), not on q.
+
+Force noise also biases H low by S_x/S_xx (errors in variables, as for H1). Where
+the force has a measurable noise floor outside the excited band, the bias is
+estimated per window and removed; ``force_noise_bias`` records its size.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..errors import DataError
+
+_RESPONSES = {"acc1": "a1", "acc2": "a2"}
+
+
+@dataclass(frozen=True)
+class LPMEstimate:
+    """Per-window LPM results for one recording (see the module docstring).
+
+    Attributes
+    ----------
+    freq_hz : (M,) centre frequencies
+    frf : dict channel -> (M,) complex estimate
+    std : dict channel -> (M,) std on each of Re and Im
+    coherence : dict channel -> (M,) signal / (signal + noise) power in the window
+    force_noise_bias : (M,) relative bias removed (0 where no force-noise floor was seen)
+    settings : dict of what was done (bins per window, degree, band, dof)
+    correlation : {"a1,a2": (M,) complex} correlation of the two channels' errors (force noise)
+    """
+
+    freq_hz: np.ndarray
+    frf: dict
+    std: dict
+    coherence: dict
+    force_noise_bias: np.ndarray
+    settings: dict = field(default_factory=dict)
+    correlation: dict = field(default_factory=dict)
+
+
+def excited_band(force: np.ndarray, fs_hz: float, smooth_hz: float = 1.0, drop_db: float = 20.0):
+    """(lo, hi, floor) of the band the force excites, from its spectrum.
+
+    The force power, smoothed over ``smooth_hz``, is compared with its typical
+    level in the excited region (95th percentile): bins within ``drop_db`` of it
+    are excited; the band is the widest run of them (gaps under ``smooth_hz``
+    bridged). ``floor`` is the per-bin noise power E|N_k|² of the force outside
+    the band when the band is clearly limited (None otherwise).
+    """
+    n = force.size
+    X = np.fft.rfft(force - force.mean())
+    f = np.fft.rfftfreq(n, 1.0 / fs_hz)
+    power = np.abs(X) ** 2
+    k = max(1, int(round(smooth_hz * n / fs_hz)))
+    smoothed = np.convolve(power, np.ones(k) / k, mode="same")
+    smoothed[0] = 0.0
+    level = np.percentile(smoothed[1:], 95)
+    excited = smoothed > level * 10 ** (-drop_db / 10)
+    runs = _runs(excited, bridge=k)
+    if not runs:
+        raise DataError("the force has no excited frequency band")
+    i0, i1 = max(runs, key=lambda r: r[1] - r[0])
+    # stay clear of the filter's edges: the smoothing spreads them over k bins
+    i0, i1 = min(i0 + k, i1), max(i1 - k, i0)
+    outside = np.ones(f.size, bool)
+    outside[max(0, i0 - 4 * k): i1 + 4 * k] = False
+    outside[0] = False
+    floor = None
+    if outside.sum() > 100:
+        median = np.median(power[outside])
+        if median * np.log(2) * 1e3 < level:  # 30 dB below the excitation: a noise floor, not excitation
+            floor = float(median / np.log(2))  # |N_k|² is exponential: mean = median / ln 2
+    return float(f[i0]), float(f[i1]), floor
+
+
+def _runs(mask, bridge):
+    runs, start, gap = [], None, 0
+    for i, m in enumerate(mask):
+        if m:
+            if start is None:
+                start = i
+            end, gap = i, 0
+        elif start is not None:
+            gap += 1
+            if gap > bridge:
+                runs.append((start, end))
+                start, gap = None, 0
+    if start is not None:
+        runs.append((start, end))
+    return runs
+
+
+def lpm(recording, band=None, width_hz: float | None = None, degree: int = 2, smooth: int = 10) -> LPMEstimate:
+    """LPM FRF estimates a1 = acc1/force, a2 = acc2/force on non-overlapping windows.
+
+    Parameters
+    ----------
+    recording : Recording
+        With ``force`` and ``acc1`` and/or ``acc2``.
+    band : (lo, hi), optional
+        Band to estimate in Hz (either may be None); it is cut to the band the
+        force excites (`excited_band`).
+    width_hz : float, optional
+        Width of each local window in Hz (at least 2(degree+1)+1 bins). Narrow
+        windows keep the polynomial exact across resonances; wider ones give
+        fewer, more precise points. Default: 0.3 Hz, narrowed to a fifth of
+        the sharpest resonance's half-power width when that is smaller.
+    degree : int
+        Polynomial degree R of H and T in each window.
+    smooth : int
+        Half-width, in windows, of the local fit of the noise spectra.
+
+    Returns
+    -------
+    LPMEstimate
+    """
+    from .chain import sharpest_resonance
+
+    if degree < 0 or int(degree) != degree:
+        raise DataError(f"degree must be an integer >= 0, got {degree}")
+    if width_hz is not None and (not np.isfinite(width_hz) or width_hz <= 0):
+        raise DataError(f"width_hz must be > 0, got {width_hz}")
+    fs, n = recording.fs_hz, recording.n_samples
+    x = recording["force"]
+    excited_lo, excited_hi, floor = excited_band(x, fs)
+    lo, hi = excited_lo, excited_hi
+    band_lo, band_hi = (band or (None, None))
+    if band_lo is not None:
+        lo = max(lo, float(band_lo))
+    if band_hi is not None:
+        hi = min(hi, float(band_hi))
+    if hi <= lo:
+        raise DataError(f"band {band_lo}:{band_hi} Hz holds no frequency bin the force excites "
+                        f"({excited_lo:.1f}–{excited_hi:.1f} Hz)")
+    spectra = {"force": np.fft.rfft(x - x.mean())}
+    for name in _RESPONSES:
+        if name in recording.channels:
+            y = recording[name]
+            spectra[name] = np.fft.rfft(y - y.mean())
+    est = _local_fits(spectra, fs, n, lo, hi, width_hz or 0.3, degree, smooth, floor)
+    if width_hz is None:
+        sharp = sharpest_resonance(est.freq_hz, est.frf)
+        if sharp is not None and est.settings["window_hz"] > sharp[1] / 5:
+            narrower = _local_fits(spectra, fs, n, lo, hi, sharp[1] / 5, degree, smooth, floor)
+            if narrower.settings["window_hz"] < est.settings["window_hz"]:
+                est = narrower
+    return est
+
+
+def _local_fits(spectra, fs, n, lo, hi, width_hz, degree, smooth, floor) -> LPMEstimate:
+    """One LPM pass with windows of ``width_hz`` over lo..hi Hz (see the module docstring)."""
+    p = 2 * (degree + 1)
+    half = max(p // 2, int(round(width_hz * n / fs / 2)))  # window 2·half+1 bins, > p
+    width = 2 * half + 1
+    df = fs / n
+    first, last = int(np.ceil(lo / df)), int(np.floor(hi / df))
+    centres = np.arange(first + half, last - half + 1, width)
+    if centres.size < 4:
+        raise DataError(f"the band {lo:g}..{hi:g} Hz holds {centres.size} LPM windows of {width} bins "
+                        f"({width * df:.3g} Hz): record longer or choose a wider band")
+    idx = centres[:, None] + np.arange(-half, half + 1)  # (M, W)
+    u = np.arange(-half, half + 1) / max(half, 1)
+    powers = u[None, :, None] ** np.arange(degree + 1)  # (1, W, R+1)
+    Xw = spectra["force"][idx]
+    xscale = np.sqrt(np.mean(np.abs(Xw) ** 2, axis=1))  # conditioning: X columns of unit size
+    K = np.concatenate([Xw[..., None] / xscale[:, None, None] * powers,
+                        np.broadcast_to(powers, Xw.shape + (degree + 1,))], axis=2)  # (M, W, p)
+    Q, Rm = np.linalg.qr(K)
+    Rinv = np.linalg.inv(Rm)
+    c00 = np.sum(np.abs(Rinv[:, 0, :]) ** 2, axis=1) / xscale ** 2  # [(KᴴK)⁻¹]₀₀ in H's units
+    q = width - p
+    freq = centres * df
+    sxx = np.mean(np.abs(Xw) ** 2, axis=1)
+    bias = np.zeros(centres.size)
+    if floor is not None:
+        bias = floor / np.maximum(sxx - floor, 1e-300 * sxx + 1e-300)
+    out_h, out_std, out_coh, dof = {}, {}, {}, None
+    raw_h, resid, var = {}, {}, {}
+    for name, ch in _RESPONSES.items():
+        if name not in spectra:
+            continue
+        Y = spectra[name][idx]
+        theta = _solve(Q, Rinv, Y)
+        h = theta[:, 0] / xscale
+        resid[ch] = Y - np.einsum("mwp,mp->mw", K, theta)
+        s2 = np.sum(np.abs(resid[ch]) ** 2, axis=1) / max(q, 1)
+        v, dof = _smooth_noise(s2, np.abs(h) ** 2, q, smooth)
+        raw_h[ch], var[ch] = h, v
+        out_h[ch] = h * (1.0 + bias)  # errors in variables: the force noise pulled H towards zero
+        out_std[ch] = np.sqrt(v * c00 / 2.0)
+        signal = np.abs(h) ** 2 * sxx
+        out_coh[ch] = signal / (signal + v)
+    correlation = {}
+    if len(raw_h) == 2:
+        correlation["a1,a2"] = _channel_correlation(resid, raw_h, var, q, smooth)
+    settings = {"method": "lpm", "record_s": n / fs, "bins_per_window": width, "window_hz": width * df,
+                "degree": degree, "noise_dof_per_window": q, "noise_dof": dof, "smooth_windows": 2 * smooth + 1,
+                "band_hz": [float(lo), float(hi)], "force_noise_floor": floor}
+    return LPMEstimate(freq, out_h, out_std, out_coh, bias, settings, correlation)
+
+
+def _channel_correlation(resid, h, var, q, half):
+    """Correlation of the a1 and a2 estimates: both see the same force noise, E[V1 V2*] = S_x H1 H2*.
+
+    S_x is fitted locally from the residuals' cross products (the same neighbourhood
+    as the noise spectra); the correlation of the estimates is S_x H1 H2* / sqrt(v1 v2)
+    (both share the window's regressors, so the [(KᴴK)⁻¹]₀₀ factors cancel).
+    """
+    s12 = np.sum(resid["a1"] * np.conj(resid["a2"]), axis=1) / max(q, 1)
+    g12 = h["a1"] * np.conj(h["a2"])
+    w = 1.0 / np.maximum(var["a1"] * var["a2"], 1e-300)
+    kernel = np.ones(2 * min(half, (s12.size - 1) // 2) + 1)
+    num = np.convolve(w * np.real(s12 * np.conj(g12)), kernel, mode="same")
+    den = np.convolve(w * np.abs(g12) ** 2, kernel, mode="same")
+    s_x = np.maximum(num / np.maximum(den, 1e-300), 0.0)
+    rho = s_x * g12 / np.sqrt(var["a1"] * var["a2"])
+    scale = np.maximum(np.abs(rho) / 0.99, 1.0)  # a correlation stays inside the unit disc
+    return rho / scale
+
+
+def _solve(Q, Rinv, Y):
+    """Least-squares θ = R⁻¹ Qᴴ y for every window."""
+    qy = np.einsum("mwp,mw->mp", np.conj(Q), Y)
+    return np.einsum("mpk,mk->mp", Rinv, qy)
+
+
+def _smooth_noise(s2, g, q, half):
+    """Smooth E|V|² = a + b g (g = |H|²) by local weighted least squares; returns (variance, dof).
+
+    Each raw s2 is a mean of q exponential-like terms, so its variance is
+    ∝ (a + b g)²/q: the fit is weighted by the current model's inverse square and
+    refined once. Negative a or b fall back to the one-term fit.
+    """
+    kernel = np.ones(2 * min(half, (s2.size - 1) // 2) + 1)  # 'same' keeps the length only if kernel ≤ data
+
+    def local(v):
+        return np.convolve(v, kernel, mode="same")
+
+    model = np.full_like(s2, np.median(s2))
+    for _ in range(3):
+        w = 1.0 / np.maximum(model, 1e-300) ** 2
+        s00, s01, s11 = local(w), local(w * g), local(w * g * g)
+        t0, t1 = local(w * s2), local(w * g * s2)
+        det = s00 * s11 - s01 * s01
+        with np.errstate(divide="ignore", invalid="ignore"):
+            a = (t0 * s11 - t1 * s01) / det
+            b = (s00 * t1 - s01 * t0) / det
+        bad = ~np.isfinite(a) | ~np.isfinite(b) | (a < 0) | (b < 0)
+        a_only, b_only = t0 / s00, t1 / np.maximum(s11, 1e-300)
+        res_a = local(w * (s2 - a_only * 1.0) ** 2)
+        res_b = local(w * (s2 - b_only * g) ** 2)
+        use_a = res_a <= res_b
+        a = np.where(bad, np.where(use_a, a_only, 0.0), a)
+        b = np.where(bad, np.where(use_a, 0.0, b_only), b)
+        model = np.maximum(a + b * g, 1e-300)
+    counts = local(np.ones_like(s2))
+    dof = float(2 * max(q, 1) * np.median(counts) - 4)
+    return model, dof

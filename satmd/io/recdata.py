@@ -1,0 +1,156 @@
+"""`Recording`: uniformly sampled time channels, and the checks every recording reader shares.
+
+A `Recording` holds uniformly sampled channels. The channels satmd uses are
+``force`` [N] on the primary mass and ``acc1``, ``acc2`` [m/s²] of the
+primary mass and the absorber; other channels (a microphone, a fourth
+accelerometer) are kept under their own names for inspection. The files
+recordings come in are read and written by `satmd.io.recording`.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..errors import DataError, FormatError
+from ._common import warn
+
+ROLES = ("force", "acc1", "acc2")
+MAX_ABS_SAMPLE = 1e100  # no sensor reads this; beyond it spectra overflow
+SI_UNITS = {"force": "N", "acc1": "m/s^2", "acc2": "m/s^2"}
+MAP_ALIASES = {"a1": "acc1", "a2": "acc2"}
+
+
+@dataclass(frozen=True)
+class Recording:
+    """Uniformly sampled channels.
+
+    Attributes
+    ----------
+    fs_hz : sample rate in Hz
+    channels : dict name -> (n,) float array (``force``, ``acc1``, ``acc2`` or other names)
+    units : dict name -> unit label ("N", "m/s^2"; the file's label when not converted)
+    meta : dict of strings (source, generator, ...)
+    labels : dict name -> where the channel came from (e.g. "UFF #2, node 1 +Z")
+    """
+
+    fs_hz: float
+    channels: dict
+    units: dict = field(default_factory=dict)
+    meta: dict = field(default_factory=dict)
+    labels: dict = field(default_factory=dict)
+
+    def __post_init__(self):
+        fs = float(self.fs_hz)
+        if not math.isfinite(fs) or fs <= 0:
+            raise DataError(f"sample rate must be a finite number > 0, got {self.fs_hz!r}")
+        if not self.channels:
+            raise DataError("a recording needs at least one channel")
+        chans, n = {}, None
+        for name, v in self.channels.items():
+            v = np.asarray(v, dtype=float)
+            if v.ndim != 1:
+                raise DataError(f"channel {name} must be 1-D, has shape {v.shape}")
+            if n is not None and v.size != n:
+                raise DataError(f"channels have different lengths ({name}: {v.size}, others: {n})")
+            n = v.size
+            bad = np.flatnonzero(~np.isfinite(v))
+            if bad.size:
+                raise DataError(f"channel {name} has NaN or infinite values (first at sample {bad[0]}, "
+                                f"t = {bad[0] / fs:g} s)")
+            big = np.flatnonzero(np.abs(v) > MAX_ABS_SAMPLE)  # squares (power spectra) would overflow
+            if big.size:
+                raise DataError(f"channel {name} reaches {v[big[0]]:.3g} at sample {big[0]}: not a measurement "
+                                f"in SI units (a damaged file or a wrong sample format?)")
+            chans[name] = v
+        if n < 2:
+            raise DataError(f"a recording needs at least 2 samples, has {n}")
+        object.__setattr__(self, "fs_hz", fs)
+        object.__setattr__(self, "channels", chans)
+        object.__setattr__(self, "units", {k: str(v) for k, v in (self.units or {}).items() if k in chans})
+        object.__setattr__(self, "meta", dict(self.meta or {}))
+        object.__setattr__(self, "labels", {k: str(v) for k, v in (self.labels or {}).items() if k in chans})
+
+    @property
+    def n_samples(self) -> int:
+        return next(iter(self.channels.values())).size
+
+    @property
+    def duration_s(self) -> float:
+        return self.n_samples / self.fs_hz
+
+    @property
+    def time_s(self) -> np.ndarray:
+        return np.arange(self.n_samples) / self.fs_hz
+
+    @property
+    def has_force(self) -> bool:
+        return "force" in self.channels
+
+    def __getitem__(self, name) -> np.ndarray:
+        try:
+            return self.channels[name]
+        except KeyError:
+            raise DataError(f"no channel {name!r} in the recording (has {', '.join(self.channels)})") from None
+
+    def rename(self, mapping: dict) -> "Recording":
+        """New names for some channels: {old: new}."""
+        new = {mapping.get(k, k): v for k, v in self.channels.items()}
+        if len(new) != len(self.channels):
+            raise DataError(f"renaming {mapping} makes two channels share a name")
+        return Recording(self.fs_hz, new, {mapping.get(k, k): u for k, u in self.units.items()}, self.meta,
+                         {mapping.get(k, k): u for k, u in self.labels.items()})
+
+    def __repr__(self):
+        return (f"Recording({len(self.channels)} channels {', '.join(self.channels)}, {self.fs_hz:g} Hz, "
+                f"{self.n_samples} samples = {self.duration_s:g} s)")
+
+
+def clipped_channels(rec: Recording, extremes: dict | None = None) -> dict:
+    """{name: number of samples at the channel's extremes} for channels that look clipped.
+
+    A clipped sensor sits on its largest or smallest value for several
+    samples in a row (flat tops); a healthy signal passes its extremes.
+    ``extremes`` may give a channel's full-scale limits (integer WAV data).
+    """
+    out = {}
+    for name, v in rec.channels.items():
+        lo, hi = (extremes or {}).get(name, (v.min(), v.max()))
+        if hi <= lo:
+            continue
+        at = (v >= hi) | (v <= lo)
+        flat_tops = np.count_nonzero(at[1:] & at[:-1] & (v[1:] == v[:-1]))
+        if flat_tops >= 3:
+            out[name] = int(np.count_nonzero(at))
+    return out
+
+
+def warn_clipping(path, rec, extremes=None):
+    """A `DataWarning` per channel that `clipped_channels` finds (every reader calls this)."""
+    for name, count in clipped_channels(rec, extremes).items():
+        warn(path, f"channel {name} looks clipped: {count} samples sit at its extremes "
+                   f"({100 * count / rec.n_samples:.2g} %); FRFs near those peaks are unreliable")
+
+
+# --- time axes ------------------------------------------------------------------
+def uniform_rate(path, t, lines=None) -> float:
+    """Sample rate of a time axis; a gap, a repeat or jitter over 1 % of a step is refused."""
+    dt = np.diff(t)
+    typical = np.median(dt)  # a single gap does not move the median
+    if not typical > 0:
+        raise FormatError(path, "time does not increase", line=lines[1] if lines else None,
+                          column="1 (time_s)" if lines else None)
+    bad = np.flatnonzero(np.abs(dt - typical) > 0.01 * typical)
+    if bad.size:
+        k = bad[0] + 1
+        raise FormatError(path, f"non-uniform sampling: step {dt[k - 1]:g} s at t = {t[k]:g} s, "
+                                f"expected {typical:g} s", line=lines[k] if lines else None,
+                          column="1 (time_s)" if lines else None)
+    return snap_rate((t.size - 1) / (t[-1] - t[0]))  # the mean step: most digits
+
+
+def snap_rate(fs: float) -> float:
+    """Rates like 1/1.52588e-05 (a step written with 6 digits) back to 65536 Hz."""
+    r = round(fs)
+    return float(r) if r > 0 and abs(fs - r) <= 2e-5 * fs else fs
