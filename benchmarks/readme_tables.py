@@ -250,8 +250,11 @@ def measured() -> str:
     rows += [
         f"| forward model, 10⁴ rigs × {fwd['n_freq']} frequencies | {sci(s['all_channels_pts_per_s'])} points/s; "
         f"{r['satmd_over_numpy_solve']:.1f}× batched `numpy.linalg.solve`, {r['satmd_over_torch_solve_c64']:.1f}× "
-        f"`torch.linalg.solve` (complex64); 4-parameter Jacobian {s['jacobian4_over_frf_a1a2']:.1f}× one FRF "
-        f"| `benchmarks/forward.py` |",
+        f"`torch.linalg.solve` (complex64); 4-parameter Jacobian {s['jacobian4_over_frf_a1a2']:.1f}× one FRF"
+        + (f" (same run; {fwd['machine']['cpu_count']}-core CPU at load average "
+           f"{fwd['machine']['load_average_1_5_15_before'][0]:.1f})"
+           if fwd.get("machine", {}).get("load_average_1_5_15_before") else "")
+        + " | `benchmarks/forward.py` |",
         f"| discovery, shared acceptance files (`satmd discover --json`, shared scorer) | "
         f"{acc['score']}/{acc['n']}, median {acc['median_time_s']:.1f} s per CLI run | `benchmarks/discovery.py` |",
         f"| discovery, false positives on {n0['n']} null datasets (std given) / {n1['n']} (noise estimated) | "

@@ -65,6 +65,7 @@ class Workspace:
         self._tiles = {}
 
     def get(self, name, shape):
+        """The complex scratch array ``name`` of ``shape`` (its contents are whatever was left there)."""
         view = self._views.get((name, shape))
         if view is None:
             size = math.prod(shape)
@@ -89,7 +90,8 @@ class Workspace:
         return cached[1]
 
 
-def solve_with_tangents(t, wrt: Sequence[str], outputs: Sequence[str], out_values: dict, out_jac: dict):
+def solve_with_tangents(t, wrt: Sequence[str], outputs: Sequence[str], out_values: dict, out_jac: dict,
+                        work: "Workspace | None" = None):
     """Values and d(output)/d(parameter) for each name in ``wrt``, written into
     ``out_values[ch]`` (rows, F) and ``out_jac[ch]`` (rows, F, P).
 
@@ -97,10 +99,18 @@ def solve_with_tangents(t, wrt: Sequence[str], outputs: Sequence[str], out_value
     pushed through the closed form. Every parameter acts through a handful of
     intermediates (K, m2 ω², K1, F0, b, Z33, sensor factors), so the
     coefficient d(output)/d(intermediate) is computed once and shared by all
-    parameters: a 4-parameter Jacobian costs a few FRFs, not four.
+    parameters: a 4-parameter Jacobian costs a few FRFs, not four. ``work``
+    keeps frequency-only tangents (d(m2 ω²)/dm2 = ω², ...) broadcast across chunks.
     """
+    shape = next(iter(out_values.values())).shape
+
+    def full(key, x):
+        return x if work is None else work.full(key, x, shape)
+
     v = {k: dual.value(getattr(t, k)) for k in ("omega", "K1", "Kp", "b", "Z33", "M2", "F0", "s1", "s2")}
-    K1, b, Z33, M2, F0 = v["K1"], v["b"], v["Z33"], v["M2"], v["F0"]
+    K1, b, Z33, M2, F0 = full("K1", v["K1"]), v["b"], v["Z33"], v["M2"], v["F0"]
+    if isinstance(M2, np.ndarray) and M2.dtype.kind == "f":  # cast once (exact), not in each product
+        M2 = M2.astype(complex)
     bz = b / Z33
     K = v["Kp"] - b * bz
     KmM = K - M2
@@ -109,7 +119,8 @@ def solve_with_tangents(t, wrt: Sequence[str], outputs: Sequence[str], out_value
     u = {"u1": np.multiply(KmM, inv, **_into(out_values, "u1")), "u2": np.multiply(K, inv, **_into(out_values, "u2"))}
     q = np.multiply(bz * M2, inv, **_into(out_values, "q")) if "q" in outputs else None
     mw2 = -(v["omega"] * v["omega"])
-    gain = {"a1": mw2 if v["s1"] is None else mw2 * v["s1"], "a2": mw2 if v["s2"] is None else mw2 * v["s2"]}
+    gain = {"a1": full("g1", mw2 if v["s1"] is None else mw2 * v["s1"]),
+            "a2": full("g2", mw2 if v["s2"] is None else mw2 * v["s2"])}
     for ch in ("a1", "a2"):
         if ch in outputs:
             np.multiply(gain[ch], u["u" + ch[1]], out=out_values[ch])
@@ -149,15 +160,20 @@ def solve_with_tangents(t, wrt: Sequence[str], outputs: Sequence[str], out_value
                 coefs[key, ch] = d1 if ch == "u1" else d2
         return coefs[key, ch]
 
-    for j, name in enumerate(wrt):
+    params = []  # per parameter: its tangents and how it moves the intermediates
+    for name in wrt:
         d = {k: dual.tangent(getattr(t, k), name) for k in ("K1", "Kp", "b", "Z33", "M2", "F0", "s1", "s2")}
+        d = {k: x if x is None or _is_one(x) else full(f"d{k}/d{name}", x) for k, x in d.items()}
         dK = d["Kp"]
         if d["b"] is not None:
             dK = _acc(dK, bz_times(-2.0) * d["b"])
         if d["Z33"] is not None:
             dK = _acc(dK, bz_times("bz") * d["Z33"])
         moves = [(key, dx) for key, dx in (("K", dK), ("M2", d["M2"]), ("K1", d["K1"]), ("F0", d["F0"])) if dx is not None]
-        for ch in outputs:
+        params.append((d, moves))
+    for ch in outputs:
+        cols = []
+        for d, moves in params:
             col = None
             for key, dx in moves:
                 c = coef(key, ch)
@@ -169,6 +185,8 @@ def solve_with_tangents(t, wrt: Sequence[str], outputs: Sequence[str], out_value
                     col = _acc(col, (-q / Z33) * d["Z33"])
             elif ch in ("a1", "a2") and d["s" + ch[1]] is not None:
                 col = _acc(col, (mw2 * d["s" + ch[1]]) * u["u" + ch[1]])
+            cols.append(col)
+        for j, col in enumerate(cols):  # the columns back to back: the chunk's (rows, F, P) block stays in cache
             out_jac[ch][..., j] = 0.0 if col is None else col
 
 

@@ -260,16 +260,17 @@ def frf(
     jac = {ch: np.empty((n_rows, n_freq, len(wrt)), dtype=complex) for ch in outputs} if wrt else {}
     step = max(1, _CHUNK_ELEMENTS // max(n_freq, 1))
     flat_rig = {n: _flatten(getattr(rig, n), batch) for n in Rig.names()}
+    rig_arrays = [n for n, v in flat_rig.items() if isinstance(v, np.ndarray)]
     flat_eff = [{p: _flatten(eff.params[p], batch) for p in eff.parameter_names} for eff in effects]
 
     def run(sl, work):
-        rig_c = Rig(**{n: _rows(v, sl) for n, v in flat_rig.items()})
+        rig_c = Rig(**{**flat_rig, **{n: flat_rig[n][sl, None] for n in rig_arrays}})
         effs_c = [eff.replace(**{p: _rows(v, sl) for p, v in fp.items()}) for eff, fp in zip(effects, flat_eff)]
         if wrt:
             rig_c, effs_c = _seed_duals(rig_c, effs_c, wrt, targets)
             solve_with_tangents(
                 terms(omega, rig_c, effs_c), wrt, outputs,
-                {ch: out[ch][sl] for ch in outputs}, {ch: jac[ch][sl] for ch in outputs},
+                {ch: out[ch][sl] for ch in outputs}, {ch: jac[ch][sl] for ch in outputs}, work,
             )
         else:
             solve_into(terms(omega, rig_c, effs_c), {ch: out[ch][sl] for ch in outputs}, work)
