@@ -24,6 +24,8 @@ import re
 import sys
 from pathlib import Path
 
+import numpy as np
+
 ROOT = Path(__file__).resolve().parents[1]
 RESULTS = ROOT / "benchmarks" / "results"
 README = ROOT / "README.md"
@@ -330,8 +332,16 @@ def recordings() -> str:
     for label, b in r.get("estimator_bias", {}).items():
         rows.append(f"| noise-free estimate at the first resonance ({b['freq_hz']:.1f} Hz), {label} | relative error "
                     f"{b['rel_error_at_peak']:.2g}, {b['bias_over_std_at_peak']:.2g} std of a 2 % noise estimate |")
-    rows.append(f"| `discover(estimate_frf(rec))`, 120 s recording at 2 kHz | "
+    rows.append(f"| `discover(estimate_frf(rec))`, 120 s null recording at 2 kHz | "
                 f"{r['seconds_per_120s_2kHz_recording']:.1f} s (median of 3) |")
+    effect_times = [c["seconds"] for c in r["cases"]["effects"]]
+    if effect_times:
+        rows.append(f"| the same with a hidden effect (every effect case above, {r['machine']['workers']} "
+                    f"in parallel) | median {np.median(effect_times):.0f} s, longest {max(effect_times):.0f} s |")
+    z = r.get("identify_z_std")
+    if z:
+        rows.append("| spread of (estimate − truth)/std on the null recordings (1 if the std is right) | "
+                    + ", ".join(f"{k} {v:.2f}" for k, v in z.items()) + " |")
     return "\n".join(rows)
 
 

@@ -37,7 +37,7 @@ from .noise import estimate_std
 from .report import SCHEMA, DiscoveryReport, describe_effect, describe_unexplained
 from .select import Model, Search, equivalents, select
 
-__all__ = ["discover", "discover_many", "discover_frf", "DiscoveryReport", "EffectFinding", "UnexplainedFinding",
+__all__ = ["discover", "discover_many", "DiscoveryReport", "EffectFinding", "UnexplainedFinding",
            "SCHEMA"]
 
 
@@ -79,7 +79,7 @@ def discover(
         from ..io.estimate import estimate_frf
 
         data = estimate_frf(data)
-    report = discover_frf(data, rig, free, candidates, channels, alpha, max_effects)
+    report = _discover_frf(data, rig, free, candidates, channels, alpha, max_effects)
     if not data.estimator:
         return report
     return replace(report, estimator=dict(data.estimator), measurement=list(data.estimator.get("measurement", [])))
@@ -116,7 +116,7 @@ def discover_many(datas: Sequence, executor=None, progress: bool = False, chunks
                      "dataset")
 
 
-def discover_frf(
+def _discover_frf(
     data: FRFData,
     rig: Rig | None = None,
     free: Sequence[str] = ("m2", "kp", "R", "L"),
@@ -125,24 +125,7 @@ def discover_frf(
     alpha: float = 1e-3,
     max_effects: int = 3,
 ) -> DiscoveryReport:
-    """Find what physics the nominal model leaves out of ``data``.
-
-    Parameters
-    ----------
-    data : FRFData with measured channels (a1, a2 by default).
-    rig : values of the fixed parameters (default: the paper's rig).
-    free : parameters fitted in every model (default m2, kp, R, L; their true
-        values may be anywhere in the SPEC §9 ranges).
-    candidates : effect names to consider (default: every registered effect,
-        `satmd.physics.effects.registered_names`).
-    channels : channels to fit (default a1, a2 when present, else all).
-    alpha : level of the mismatch test (global and band-wise together).
-    max_effects : most effects a model may hold.
-
-    Returns
-    -------
-    DiscoveryReport
-    """
+    """`discover` on FRFData (parameters as `discover`): the steps of the module docstring."""
     t0 = time.perf_counter()
     rig = Rig() if rig is None else rig
     free = tuple(free)

@@ -44,6 +44,29 @@ def load_frf(path, **options) -> FRFData:
 
     Options go to the reader: ``channel_map`` (UFF), ``freq_axis`` and
     ``channel`` (.txt). An option the format has no use for is refused.
+
+    Parameters
+    ----------
+    path : str or Path
+        An existing file: ``.csv``, ``.uff``/``.unv``, ``.mat``, ``.npz`` or
+        ``.txt`` (suffix case does not matter).
+    **options
+        Keywords for the reader: ``channel_map`` (``.uff``/``.unv``: which
+        record is which channel), ``freq_axis="START:STEP"`` (Hz; required for
+        ``.txt``) and ``channel`` (``.txt``: the channel the values are,
+        default ``a1``). Options set to None are ignored.
+
+    Returns
+    -------
+    FRFData
+        The file's FRFs, with ``std``, coherence and metadata where the file
+        holds them (``meta["source"]`` names the file unless the file says otherwise).
+
+    Raises
+    ------
+    FormatError
+        No such file, a directory, an unknown suffix, an option the format
+        does not take, or a malformed file or invalid data (naming the file).
     """
     path = Path(path)
     if not path.exists():
@@ -66,7 +89,29 @@ def load_frf(path, **options) -> FRFData:
 
 
 def save_frf(data: FRFData, path, **options) -> Path:
-    """Save FRFs; the writer is chosen by the suffix."""
+    """Save FRFs; the writer is chosen by the suffix.
+
+    Parameters
+    ----------
+    data : FRFData
+        The FRFs to write, with their std and coherence where the format holds them.
+    path : str or Path
+        Target file: ``.csv`` (SPEC §7), ``.uff``/``.unv`` (UFF 58), ``.mat`` or
+        ``.npz``; its folder must exist. An existing file is replaced.
+    **options
+        Keywords for the writer: ``binary`` for UFF (default True: 58b;
+        False writes ASCII 58). The other writers take none.
+
+    Returns
+    -------
+    Path
+        The path written.
+
+    Raises
+    ------
+    FormatError
+        A suffix satmd cannot write (``.txt`` included) or a missing folder.
+    """
     path = Path(path)
     writer = WRITERS.get(path.suffix.lower())
     if writer is None:

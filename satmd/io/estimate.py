@@ -41,6 +41,20 @@ def default_nperseg(fs_hz: float, n_samples: int) -> int:
 
     0.5 Hz resolves the rig's sharpest resonance (half-power width ≈ 1.6 Hz)
     with a Hann-window bias well below the noise of 16+ averages.
+
+    Parameters
+    ----------
+    fs_hz : float
+        Sample rate in Hz.
+    n_samples : int
+        Length of the record in samples.
+
+    Returns
+    -------
+    int
+        The smallest power of two ≥ 2·fs_hz (resolution ≤ 0.5 Hz), halved
+        until the record holds at least 16 half-overlapping segments; never
+        below 16 samples (so short records get fewer averages).
     """
     target = 2 ** int(np.ceil(np.log2(fs_hz * 2.0)))
     while target > 16 and 2 * n_samples // target - 1 < 16:
@@ -340,7 +354,23 @@ class Transmissibility:
 
 
 def model_transmissibility(freq_hz, rig=None, effects=()) -> np.ndarray:
-    """A2/A1 of the model: absorber over primary-mass acceleration (independent of the force)."""
+    """A2/A1 of the model: absorber over primary-mass acceleration (independent of the force).
+
+    Parameters
+    ----------
+    freq_hz : array_like, shape (n_freq,)
+        Frequencies in Hz.
+    rig : Rig, optional
+        The model (default: the paper's rig); fields may be arrays that
+        broadcast to a batch shape.
+    effects : sequence of Effect
+        Missing-physics effects applied to the model (`satmd.frf`).
+
+    Returns
+    -------
+    ndarray of complex, shape (n_freq,) or batch shape + (n_freq,)
+        ``a2 / a1`` of `satmd.frf` at each frequency.
+    """
     from ..physics import frf
 
     r = frf(freq_hz, rig, effects, outputs=("a1", "a2"))
@@ -354,6 +384,44 @@ def transmissibility(recording: Recording, nperseg: int | None = None, window="h
 
     H1 assumes the noise is on ``response``; with comparable noise on both
     accelerometers H1 is biased low and H2 high where the coherence drops.
+
+    Parameters
+    ----------
+    recording : Recording
+        With the ``reference`` and ``response`` channels; a force channel is
+        not needed (output-only recordings).
+    nperseg : int, optional
+        Samples per Welch segment, 8..n_samples (default: `default_nperseg`);
+        it must leave at least 2 segments.
+    window : str or tuple
+        Window of each segment: ``hann`` (default), ``hamming``, ``blackman``,
+        ``flattop``, ``boxcar``, or any `scipy.signal.get_window` name.
+    overlap : float
+        Overlap fraction of consecutive segments, in [0, 1).
+    estimator : {"H1", "H2"}
+        ``H1 = Gxy/Gxx`` (noise on the response) or ``H2 = Gyy/Gyx`` (noise on
+        the reference); case does not matter.
+    band : (lo, hi), optional
+        Band to keep in Hz, either may be None (default: every bin above 0 Hz).
+    reference : str
+        Channel in the denominator (default ``acc1``, the primary mass).
+    response : str
+        Channel in the numerator (default ``acc2``, the absorber).
+
+    Returns
+    -------
+    Transmissibility
+        ``freq_hz``, complex ``value``, ``std`` (on each of Re and Im, floored
+        at 1e-10 max|T|) and ``coherence`` on the kept bins (f > 0, inside
+        ``band``, where the reference has energy: others are dropped with a
+        `DataWarning`); ``meta`` gives the source, estimator, channels and
+        Welch settings (``nperseg``, ``segments``, ``resolution_hz``, ``n_eff``, ...).
+
+    Raises
+    ------
+    DataError
+        A missing channel, an unknown estimator or window, Welch settings the
+        record cannot support, or a band that holds no usable bin.
     """
     est = _check_estimator(estimator)
     source = recording.meta.get("source", "recording")
@@ -369,7 +437,23 @@ def transmissibility(recording: Recording, nperseg: int | None = None, window="h
 
 
 def save_transmissibility(t: Transmissibility, path) -> Path:
-    """CSV: ``# satmd-transmissibility v1`` then freq_hz,t_re,t_im,t_std,coherence."""
+    """CSV: ``# satmd-transmissibility v1`` then freq_hz,t_re,t_im,t_std,coherence.
+
+    The ``meta`` entries go in ``# key: value`` lines before the header;
+    floats have 17 significant digits, and the file is written atomically.
+
+    Parameters
+    ----------
+    t : Transmissibility
+        As `transmissibility` returns it.
+    path : str or Path
+        Target file (written as CSV whatever the suffix); an existing file is replaced.
+
+    Returns
+    -------
+    Path
+        The path written.
+    """
     path = Path(path)
     lines = ["# satmd-transmissibility v1"]
     lines += [f"# {k}: {v}" for k, v in t.meta.items() if "\n" not in f"{k}{v}"]

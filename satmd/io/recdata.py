@@ -113,6 +113,22 @@ def clipped_channels(rec: Recording, extremes: dict | None = None) -> dict:
     A clipped sensor sits on its largest or smallest value for several
     samples in a row (flat tops); a healthy signal passes its extremes.
     ``extremes`` may give a channel's full-scale limits (integer WAV data).
+
+    Parameters
+    ----------
+    rec : Recording
+        The recording to check, every channel.
+    extremes : dict, optional
+        ``{channel: (lo, hi)}`` limits a channel clips at (default: each
+        channel's own minimum and maximum). A channel whose limits have
+        ``hi <= lo`` (a constant one) is skipped.
+
+    Returns
+    -------
+    dict
+        ``{channel: number of samples at or beyond its extremes}`` for the
+        channels with at least 3 pairs of consecutive, equal samples at an
+        extreme (flat tops); empty when none looks clipped.
     """
     out = {}
     for name, v in rec.channels.items():

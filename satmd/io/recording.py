@@ -65,7 +65,35 @@ RECORDING_WRITERS = {".csv": write_recording_csv, ".uff": write_recording_uff, "
 
 
 def load_recording(path, channel_map=None, scale=None) -> Recording:
-    """Load a time recording; the reader is chosen by the suffix (see the module docstring)."""
+    """Load a time recording; the reader is chosen by the suffix (see the module docstring).
+
+    Parameters
+    ----------
+    path : str or Path
+        An existing ``.csv``, ``.uff``/``.unv``, ``.wav``, ``.npz`` or ``.mat``
+        file (suffix case does not matter).
+    channel_map : str, optional
+        Which record or column is which channel, e.g.
+        ``"force=#1,a1=1:+Z,a2=2:+Z"`` (UFF) or ``"force=#1,a1=#2"`` (WAV);
+        UFF and WAV only: the other formats name their channels.
+    scale : dict, optional
+        ``{channel: SI units per stored unit}`` (e.g. ``{"force": N_per_unit}``)
+        for WAV files, which carry no units; WAV only.
+
+    Returns
+    -------
+    Recording
+        The channels (``force``, ``acc1``, ``acc2``, others under their own
+        names) in SI units where the file states or ``scale`` gives them.
+        Clipped channels are reported with a `DataWarning`.
+
+    Raises
+    ------
+    FormatError
+        No such file, a directory, an unknown suffix, an option the format does
+        not take, or a malformed file (NaN, mismatched lengths, non-uniform
+        sampling, ...).
+    """
     path = Path(path)
     if not path.exists():
         raise FormatError(path, "no such file")
@@ -89,6 +117,29 @@ def load_recording(path, channel_map=None, scale=None) -> Recording:
 
 
 def save_recording(rec: Recording, path) -> Path:
+    """Save a time recording; the writer is chosen by the suffix (see the module docstring).
+
+    Parameters
+    ----------
+    rec : Recording
+        The recording to write. CSV holds only ``force``, ``acc1`` and
+        ``acc2``; WAV needs an integer sample rate (writers refuse others with
+        a `DataError`).
+    path : str or Path
+        Target file: ``.csv``, ``.uff``/``.unv`` (binary UFF 58b), ``.wav``
+        (64-bit float), ``.npz`` or ``.mat``; its folder must exist. An
+        existing file is replaced.
+
+    Returns
+    -------
+    Path
+        The path written.
+
+    Raises
+    ------
+    FormatError
+        A suffix satmd cannot write or a missing folder.
+    """
     path = Path(path)
     writer = RECORDING_WRITERS.get(path.suffix.lower())
     if writer is None:
@@ -100,7 +151,22 @@ def save_recording(rec: Recording, path) -> Path:
 
 
 def is_recording(path) -> bool:
-    """Whether a file holds time data (True) rather than FRFs (False); unreadable files raise FormatError."""
+    """Whether a file holds time data (True) rather than FRFs (False); unreadable files raise FormatError.
+
+    Parameters
+    ----------
+    path : str or Path
+        The file to look at; only its suffix and content decide.
+
+    Returns
+    -------
+    bool
+        True for ``.wav``; for ``.csv`` whose header (first line that is not
+        blank or a ``#`` comment) starts with ``time_s``; for ``.uff``/``.unv``
+        with time records (function type 1) and no FRF (type 4); for
+        ``.npz``/``.mat`` with ``fs_hz`` and no ``freq_hz``. False otherwise,
+        and for a path that is not a file (the FRF loader then says what is wrong).
+    """
     path = Path(path)
     suffix = path.suffix.lower()
     if not path.is_file():

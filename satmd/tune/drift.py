@@ -121,18 +121,48 @@ def retune(
 ) -> RetuneResult:
     """Identify each FRF of a drifting rig (warm-started) and retune at each step.
 
+    The first step is identified with the global search, each later one by
+    local least squares from the previous step's values; each fit is then
+    tuned with `satmd.tune`.
+
     Parameters
     ----------
-    series : sequence of FRFData, in time order
-    rig : fixed parameters of the model (default: the paper's rig)
-    free : parameters identified at each step
-    labels : names of the steps (default: each FRFData's meta "label", else its index)
-    objective, output, band, design, bounds : as `satmd.tune`
-    tune_options : further keywords for `satmd.tune`
+    series : sequence of FRFData
+        The measurements, in time order (at least one).
+    rig : Rig, optional
+        Fixed parameters of the model (default: the paper's rig).
+    free : sequence of str
+        Parameters identified at each step.
+    labels : sequence of str, optional
+        Names of the steps, one per FRF (default: each FRFData's
+        ``meta["label"]``, else its index).
+    objective : {"hinf", "h2"}
+        Peak (H∞) or RMS (H2) of ``output`` over ``band``, as `satmd.tune`.
+    output : {"u1", "a1"}
+        Primary displacement or primary acceleration, as `satmd.tune`.
+    band : (float, float)
+        Band (lo, hi) of the objective in Hz.
+    design : sequence of str
+        Rig fields tuned at each step.
+    bounds : dict, optional
+        ``{name: (lo, hi)}`` search bounds of the design (defaults as `satmd.tune`).
+    **tune_options
+        Further keywords for `satmd.tune` (``robust``, ``n_search``, ``seed``,
+        ...); the closed-form check is always off.
 
     Returns
     -------
     RetuneResult
+        Per step: the label, the identified parameters, the retuned design and
+        the objective with it (``value_retuned``), with the first step's design
+        kept (``value_fixed``, ``fixed_design``) and with the shunt open
+        (``value_open``); ``retuning_gain_db``, ``results`` (the `TuneResult`
+        of each step) and ``figure()`` / ``report()``.
+
+    Raises
+    ------
+    DataError
+        An empty series, or a number of labels other than the number of FRFs.
     """
     from ..identify import identify
     from .core import tune
