@@ -64,8 +64,8 @@ def acceptance():
 
 
 def _one(job):
-    from satmd.discover import discover
-    from satmd.discover.scenarios import concealed_case, judge
+    from satmd.discovery import discover
+    from satmd.discovery.scenarios import concealed_case, judge
 
     seed, n_effects, std_given = job
     sc = concealed_case(seed, n_effects=n_effects, std_given=std_given)

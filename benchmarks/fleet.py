@@ -34,7 +34,7 @@ SPEEDUP_TARGET = 1.7  # 2 workers over 1 (issue 14)
 
 
 def _warm(_):
-    import satmd.identify  # noqa: F401  (the import is what a worker pays once)
+    import satmd.identification  # noqa: F401  (the import is what a worker pays once)
 
     return 0
 

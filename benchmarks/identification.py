@@ -31,7 +31,7 @@ from pathlib import Path
 import numpy as np
 
 from satmd import PAPER_GRID_HZ, Rig, simulate
-from satmd.identify import identify
+from satmd.identification import identify
 from satmd.io.frfdata import FRFData
 from satmd.physics import frf
 

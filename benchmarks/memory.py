@@ -33,7 +33,7 @@ import json, resource, sys, time
 import numpy as np
 from satmd import Rig, simulate
 from satmd.io.frfdata import FRFData
-from satmd.identify import identify
+from satmd.identification import identify
 
 n = int(sys.argv[1])
 d = simulate(np.linspace(40.0, 130.0, n), Rig(m2=0.6, R=40.0), noise=(0.01, 0.001), seed=1)

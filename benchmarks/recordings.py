@@ -65,7 +65,7 @@ def score(report, truth):
 
 def run_null(seed):
     from satmd import discover
-    from satmd.discover.scenarios import random_rig
+    from satmd.discovery.scenarios import random_rig
     from satmd.io import estimate_frf, simulate_recording
 
     rng = np.random.default_rng(1000 + seed)
@@ -86,7 +86,7 @@ def run_null(seed):
 def run_effect(args):
     name_list, seed = args
     from satmd import discover
-    from satmd.discover.scenarios import random_effect, random_rig
+    from satmd.discovery.scenarios import random_effect, random_rig
     from satmd.io import FRFData, estimate_frf, simulate_recording
     from satmd.physics import frf
 

@@ -56,7 +56,7 @@ def random_rig(seed):
 
 
 def true_peak(rig, effects, design):
-    from satmd.tune.objective import Objective
+    from satmd.tuning.objective import Objective
 
     return float(Objective("hinf", "u1", BAND)(rig.replace(**design), effects)[0])
 
@@ -115,8 +115,8 @@ def cases(pool, n, kind, base):
 # --- 4. robust ---------------------------------------------------------------------------------------
 def robust(n_fresh=200, seed=11):
     from satmd import identify, simulate, tune
-    from satmd.tune.robust import draws_from_covariance
-    from satmd.tune.objective import Objective
+    from satmd.tuning.robust import draws_from_covariance
+    from satmd.tuning.objective import Objective
 
     warnings.simplefilter("ignore")
     rig = random_rig(seed)
@@ -179,7 +179,7 @@ def cli_time(repeats=3):
 # --- 6. tuning law -----------------------------------------------------------------------------------
 def tuning_law(n=6):
     from satmd import Rig, tune
-    from satmd.explain.distill import distill
+    from satmd.explain.distillation import distill
 
     m2s, kps = np.linspace(0.3, 0.8, n), np.geomspace(5e4, 2e5, n)
     X, R, L = [], [], []

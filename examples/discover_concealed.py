@@ -14,7 +14,7 @@ import subprocess
 import sys
 from pathlib import Path
 
-from satmd.discover.scenarios import concealed_case
+from satmd.discovery.scenarios import concealed_case
 
 
 def main():

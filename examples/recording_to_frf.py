@@ -30,7 +30,7 @@ import sys
 from pathlib import Path
 
 from satmd import Rig, discover
-from satmd.identify import identify
+from satmd.identification import identify
 from satmd.io import estimate_frf, load_recording, save_frf, save_recording, simulate_recording
 from satmd.io.estimate import describe_estimate
 

@@ -17,7 +17,7 @@ from pathlib import Path
 import numpy as np
 
 from satmd import Rig, discover, effect, identify, retune, simulate, tune
-from satmd.tune.objective import Objective
+from satmd.tuning.objective import Objective
 
 
 def main():
@@ -70,7 +70,7 @@ def main():
 
 def law(backend):
     """R_opt and L_opt over (m2, kp) as formulas in ln m2, ln kp; the classical laws for comparison."""
-    from satmd.explain.distill import distill
+    from satmd.explain.distillation import distill
 
     X, lnR, lnL = [], [], []
     for m2 in np.linspace(0.3, 0.8, 6):

@@ -15,7 +15,7 @@ from __future__ import annotations
 import sys
 
 from satmd import PAPER_GRID_HZ, Rig, simulate
-from satmd.identify import identify
+from satmd.identification import identify
 from satmd.plots import frf_figure, save
 
 NAMES = ("m2", "kp", "R", "L")

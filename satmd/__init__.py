@@ -19,10 +19,10 @@ from .physics import (
     effect,
     frf,
 )
-from .simulate import simulate
-from .identify import FitResult, identify, identify_many  # noqa: E402  (binds the functions over the subpackages)
-from .discover import DiscoveryReport, discover, discover_many  # noqa: E402
-from .tune import TuneResult, retune, tune  # noqa: E402  (light: scipy.optimize loads on first use)
+from .simulation import simulate
+from .identification import FitResult, identify, identify_many  # noqa: E402  (binds the functions over the subpackages)
+from .discovery import DiscoveryReport, discover, discover_many  # noqa: E402
+from .tuning import TuneResult, retune, tune  # noqa: E402  (light: scipy.optimize loads on first use)
 
 from .version import __version__  # noqa: E402
 

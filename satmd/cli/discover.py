@@ -21,7 +21,7 @@ def register(sub):
 
 
 def run(args):
-    from ..discover import discover
+    from ..discovery import discover
 
     data = load_data(args)
     free = parse_list(args.free) or ("m2", "kp", "R", "L")

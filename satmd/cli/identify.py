@@ -23,8 +23,8 @@ def register(sub):
 
 
 def run(args):
-    from ..identify import identify
-    from ..identify.intervals import describe_interval, intervals_to_dict
+    from ..identification import identify
+    from ..identification.intervals import describe_interval, intervals_to_dict
 
     data = load_data(args)
     free = parse_list(args.free) or ("m2", "kp", "R", "L")

@@ -6,7 +6,7 @@ from ..io import CHANNELS, WRITERS, save_frf
 from ..io.atomic import all_or_none
 from ..io.recording import RECORDING_WRITERS
 from ..physics import PAPER_GRID_HZ
-from ..simulate import simulate
+from ..simulation import simulate
 from ._common import (
     MAX_SAMPLES,
     SEED,

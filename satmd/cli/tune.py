@@ -54,7 +54,7 @@ def register(sub):
 
 
 def run(args):
-    from ..tune import retune, tune
+    from ..tuning import retune, tune
 
     options = _tune_options(args)
     if (args.rig is None) == (not args.data):
@@ -92,8 +92,8 @@ def _finish(args, result):
 
 
 def _tune_options(args) -> dict:
-    from ..tune.objective import Objective
-    from ..tune.optimiser import DesignSpace
+    from ..tuning.objective import Objective
+    from ..tuning.optimiser import DesignSpace
 
     lo, sep, hi = args.band.partition(":")
     if not sep:
@@ -163,11 +163,11 @@ def _identified(args, data):
     free = parse_list(args.free) or ("m2", "kp", "R", "L")
     channels = parse_list(args.channels)
     if args.no_discover:
-        from ..identify import identify
+        from ..identification import identify
 
         with one_line_warnings("tune"):
             return identify(data, free=free, channels=channels)
-    from ..discover import discover
+    from ..discovery import discover
     from ..io import DataWarning
 
     with warnings.catch_warnings():

@@ -29,10 +29,10 @@ Symbolic distillation: `distill(X, y, backend="operon"|"pysr"|"sindy")`
 satmd.explain`` works with NumPy/SciPy alone).
 """
 from .anova import GridAnova, grid_anova
-from .attribution import BLIND_CASES, PAPER_TABLE3, Attribution, attribution, peak_frequencies, table3_stats
+from .attributions import BLIND_CASES, PAPER_TABLE3, Attribution, attribution, peak_frequencies, table3_stats
 from .contract import ExplainableModel
 from .descriptors import NOMINAL, XI_GRID, DescriptorData, modal_descriptors, xi_dataset, xi_frf
-from .distill import DistillResult, distill, paper_formula_result
+from .distillation import DistillResult, distill, paper_formula_result
 from .latent import LatentMap, latent_map
 from .sensitivity import PhysicalSensitivity, agreement, chain_rule_check, physical_sensitivity
 

@@ -4,7 +4,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..plots import pyplot
-from .attribution import OUTPUTS, PAPER_PEAK_BANDS_HZ
+from .attributions import OUTPUTS, PAPER_PEAK_BANDS_HZ
 
 _UNITS = {"R": "Ω", "L": "H"}
 
@@ -92,7 +92,7 @@ def agreement_figure(att, phys_curves: np.ndarray, rows: list, title: str = ""):
 
 def distill_figure(res, X, y, title: str = "ξ_FRF"):
     """Figure 9 (predicted vs true on the test split) and the accuracy-complexity Pareto front."""
-    from .distill import split
+    from .distillation import split
 
     plt = pyplot()
     _, Zte, _, yte, _, _ = split(X, y)

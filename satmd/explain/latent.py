@@ -134,7 +134,7 @@ def latent_map(model, data, labels=None, anchors=None, n_sweep: int = 11, folds:
     """
     from sklearn.decomposition import PCA
 
-    from .attribution import BLIND_CASES
+    from .attributions import BLIND_CASES
 
     contract.check_net_model(model)
     R, L = _labels(data, labels)

@@ -14,9 +14,9 @@ import numpy as np
 from ..physics import frf
 from . import contract
 from .anova import GridAnova, grid_anova, grid_ceiling
-from .attribution import BLIND_CASES, OUTPUTS, PAPER_TABLE3, attribution, in_paper_bands
+from .attributions import BLIND_CASES, OUTPUTS, PAPER_TABLE3, attribution, in_paper_bands
 from .descriptors import MODAL_NAMES, xi_dataset
-from .distill import DistillResult, distill, paper_formula_result
+from .distillation import DistillResult, distill, paper_formula_result
 from .latent import LatentMap
 from .sensitivity import agreement, chain_rule_check, physical_sensitivity
 from .symbolic import PAPER_FORMULA, PAPER_METRICS, paper_complexity

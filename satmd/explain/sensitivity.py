@@ -24,7 +24,7 @@ import numpy as np
 from scipy.stats import spearmanr
 
 from ..physics import PAPER_GRID_HZ, Rig, frf
-from .attribution import OUTPUTS, normalise_max, per_frequency
+from .attributions import OUTPUTS, normalise_max, per_frequency
 
 
 @dataclass(frozen=True)

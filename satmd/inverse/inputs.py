@@ -8,7 +8,7 @@ Measured FRFs rarely sit on it. `prepare` brings them there:
   warning when the data are coarser than the grid;
 - grid points outside the data's span (a narrow ``--band``, a short sweep):
   model-based, the forward model at the (R, L) fitted by least squares to the
-  measured points (`satmd.identify.identify`, rig fixed), with a warning
+  measured points (`satmd.identification.identify`, rig fixed), with a warning
   naming how many points were filled.
 
 `forward_check` is the other half: every prediction goes back through the
@@ -177,7 +177,7 @@ def to_grid(freq, a, std, grid, rig=None, label="input"):
 
 def _least_squares_RL(freq, a, std, rig):
     """R, L of the rig fitted to the measured points (the model-based fill)."""
-    from ..identify import identify
+    from ..identification import identify
     from ..io import FRFData
 
     data = FRFData(freq, {"a1": a[0], "a2": a[1]}, {} if std is None else {"a1": std[0], "a2": std[1]})

@@ -130,7 +130,7 @@ def residual_ref(model, ds: InverseDataset) -> float:
 
 def least_squares(model, a, std, start):
     """R, L per FRF by least squares on the model grid: global search (``start`` None) or refined from ``start``."""
-    from ..identify import identify, identify_many
+    from ..identification import identify, identify_many
     from ..io import FRFData
 
     datas = [FRFData(model.freq_hz, {"a1": ai[0], "a2": ai[1]},
@@ -146,7 +146,7 @@ def least_squares(model, a, std, start):
 
 
 class OptimizationStrategy:
-    """Repeated global least squares per FRF (`satmd.identify.identify_many`, free R and L); nothing to train."""
+    """Repeated global least squares per FRF (`satmd.identification.identify_many`, free R and L); nothing to train."""
 
     has_net = False
     objective = None

@@ -7,7 +7,7 @@ Used by ``satmd explain``, the ``satmd reproduce`` section and
 """
 from __future__ import annotations
 
-from ..explain.attribution import OUTPUTS, PAPER_TABLE3, TABLE3_LABELS
+from ..explain.attributions import OUTPUTS, PAPER_TABLE3, TABLE3_LABELS
 from ..explain.run import AGREEMENT_KEYS, COMPLEXITY_CAP, SPACES, NeuralAnalysis, SymbolicAnalysis
 from ..explain.symbolic import PAPER_METRICS
 

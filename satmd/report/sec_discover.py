@@ -17,10 +17,10 @@ def _row(label, truth, rep):
 
 
 def build(ctx) -> str:
-    from ..discover import discover
-    from ..discover.scenarios import concealed_case
+    from ..discovery import discover
+    from ..discovery.scenarios import concealed_case
     from ..physics import Rig, effect
-    from ..simulate import simulate
+    from ..simulation import simulate
 
     lines = [
         "`satmd discover` fits the nominal model globally, tests the mismatch against the noise "

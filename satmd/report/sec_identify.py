@@ -16,10 +16,10 @@ RANGES = {"m2": (0.3, 0.8), "kp": (5e4, 2e5), "R": (5.0, 100.0), "L": (0.02, 0.5
 
 
 def build(ctx) -> str:
-    from ..identify import identify
+    from ..identification import identify
     from ..physics import PAPER_GRID_HZ, PARAMETER_INFO, Rig
     from ..plots import frf_figure
-    from ..simulate import simulate
+    from ..simulation import simulate
 
     truth = Rig()
     target = simulate(PAPER_GRID_HZ, truth, channels=STATE)

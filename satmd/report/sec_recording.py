@@ -36,7 +36,7 @@ def _row(label, rep):
 
 
 def build(ctx) -> str:
-    from ..discover import discover
+    from ..discovery import discover
     from ..io import estimate_frf, simulate_recording
     from ..io.estimate import describe_estimate
     from ..physics import Rig, effect, frf

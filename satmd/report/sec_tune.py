@@ -12,9 +12,9 @@ BAND = (20.0, 200.0)
 def _textbook_rows():
     """(check, satmd, exact) rows: classic TMD (μ = 0.05) and a piezo RL shunt on an undamped host."""
     from ..physics import Rig
-    from ..tune import tune
-    from ..tune.laws import equal_peak_shunt
-    from ..tune.objective import Objective
+    from ..tuning import tune
+    from ..tuning.laws import equal_peak_shunt
+    from ..tuning.objective import Objective
 
     m1, k1, mu = 1.0, (2 * math.pi) ** 2, 0.05
     m2 = mu * m1
@@ -44,7 +44,7 @@ def _textbook_rows():
 
 def build(ctx) -> str:
     from ..physics import Rig
-    from ..tune import tune
+    from ..tuning import tune
 
     rig = Rig()
     hinf = tune(rig, band=BAND)

@@ -120,7 +120,7 @@ def test_load_data_accepts_every_format_and_a_band(capsys, recording, tmp_path):
 
 
 def test_identify_takes_a_recording(capsys, recording):
-    pytest.importorskip("satmd.identify")
+    pytest.importorskip("satmd.identification")
     rc, out, err = run(capsys, "identify", recording, "--band", "30:150", "--json")
     assert rc == 0 and "is a time recording" in err
     import json

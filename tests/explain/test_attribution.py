@@ -2,7 +2,7 @@ import numpy as np
 import pytest
 
 from satmd.explain import BLIND_CASES, PAPER_TABLE3, attribution, peak_frequencies, table3_stats
-from satmd.explain.attribution import normalise_max, per_frequency
+from satmd.explain.attributions import normalise_max, per_frequency
 
 from .conftest import simulate, torch
 

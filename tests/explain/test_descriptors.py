@@ -47,7 +47,7 @@ def test_modal_descriptors_broadcast_over_a_batch():
 
 
 def test_grid_ceiling():
-    from satmd.explain.distill import grid_ceiling
+    from satmd.explain.distillation import grid_ceiling
 
     a, b = np.meshgrid(np.arange(4.0), np.arange(5.0), indexing="ij")
     X = np.stack([a.ravel(), b.ravel()], axis=1)

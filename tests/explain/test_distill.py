@@ -6,7 +6,7 @@ import sympy as sp
 
 from satmd.errors import SatmdError
 from satmd.explain import distill, node_count, paper_complexity
-from satmd.explain.distill import pareto_front
+from satmd.explain.distillation import pareto_front
 from satmd.explain.symbolic import compact, parse, polish, prune
 
 

@@ -2,7 +2,7 @@ import numpy as np
 import pytest
 
 from satmd.explain import agreement, chain_rule_check, physical_sensitivity
-from satmd.explain.attribution import per_frequency
+from satmd.explain.attributions import per_frequency
 from satmd.physics import PAPER_GRID_HZ, Rig
 
 from .conftest import simulate

@@ -3,7 +3,7 @@ import json
 import pytest
 
 pytest.importorskip("torch")
-pytest.importorskip("satmd.identify")
+pytest.importorskip("satmd.identification")
 
 from satmd.inverse.ablation import (ablation_markdown, headline, loop_speedup, off_curve_markdown, run_ablation,
                                     table2_markdown)

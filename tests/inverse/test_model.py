@@ -149,7 +149,7 @@ def test_input_errors(tiny_physics):
 
 
 def test_optimization_and_hybrid(tiny_physics, tmp_path):
-    pytest.importorskip("satmd.identify")
+    pytest.importorskip("satmd.identification")
     test = pairs_dataset(BLIND_PAIRS[[0, 5]])
     opt = InverseModel("optimization").fit()
     p = opt.predict(test)

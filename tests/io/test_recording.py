@@ -339,7 +339,7 @@ def test_transmissibility_matches_the_model(rec):
 
 def test_recording_to_identification_end_to_end(rec):
     """The chain recording -> FRF -> identify recovers the rig with an honest χ²."""
-    identify = pytest.importorskip("satmd.identify").identify
+    identify = pytest.importorskip("satmd.identification").identify
     d = estimate_frf(rec, band=(30, 150))
     fit = identify(d)
     true = Rig()

@@ -152,7 +152,7 @@ def tune(
 
 
 def _is_augmented(model) -> bool:
-    from ..discover.report import DiscoveryReport
+    from ..discovery.report import DiscoveryReport
 
     return (isinstance(model, DiscoveryReport) and model.significant_mismatch and model.final_fit is not None
             and model.final_fit is not model.nominal_fit and bool(model.final_fit.effects))
@@ -161,8 +161,8 @@ def _is_augmented(model) -> bool:
 def resolve_model(model, effects=()):
     """(rig, effects, source, reported parameters, uncertainty (names, values, cov) or None, notes,
     measured frequency span or None)."""
-    from ..discover.report import DiscoveryReport
-    from ..identify.result import FitResult
+    from ..discovery.report import DiscoveryReport
+    from ..identification.result import FitResult
 
     notes = []
     if isinstance(model, Rig):

@@ -9,7 +9,7 @@ import pytest
 
 from satmd import PAPER_GRID_HZ, Rig, simulate
 from satmd.errors import SatmdError
-from satmd.identify import FitResult, identify, identify_many
+from satmd.identification import FitResult, identify, identify_many
 
 TRUTH = {"m2": 0.518, "kp": 111e3, "R": 22.0, "L": 0.064}
 PAPER_START = {"m2": 0.3, "kp": 5e4, "R": 20.0, "L": 0.05}

@@ -16,8 +16,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..identify import identify
-from ..identify.problem import Problem
+from ..identification import identify
+from ..identification.problem import Problem
 from ..physics.effects import at_rest
 from .candidates import candidate_starts
 

@@ -12,7 +12,7 @@ import numpy as np
 
 from ..physics import Rig
 from ..physics.effects import VOCABULARY_NAMES, effect
-from ..simulate import simulate
+from ..simulation import simulate
 
 GRIDS = {"paper60": (40.0, 130.0, 60), "lin200": (30.0, 160.0, 200)}
 NOISE = (0.01, 0.002)
@@ -74,7 +74,7 @@ def concealed_case(seed: int, names=None, n_effects: int = 1, std_given: bool = 
     yet still looks right to the eye (relative error ≤ 4 × the 1 % noise):
     concealed, but present in the data. Without it, magnitudes are as drawn.
     """
-    from ..identify import identify
+    from ..identification import identify
 
     rng = np.random.default_rng(seed)
     grid = str(rng.choice(list(GRIDS)))
@@ -115,7 +115,7 @@ def concealed_case(seed: int, names=None, n_effects: int = 1, std_given: bool = 
 
 def _without(data, effects, i):
     """Nominal fit with every true effect but the i-th included at its true value."""
-    from ..identify import identify
+    from ..identification import identify
 
     return identify(data, effects=[e for j, e in enumerate(effects) if j != i])
 

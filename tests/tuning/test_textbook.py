@@ -4,10 +4,10 @@ import math
 import pytest
 
 from satmd import Rig
-from satmd.tune import tune
-from satmd.tune.laws import (asami_h2, den_hartog, equal_peak_shunt, hagood_von_flotow_shunt, nishihara_asami,
+from satmd.tuning import tune
+from satmd.tuning.laws import (asami_h2, den_hartog, equal_peak_shunt, hagood_von_flotow_shunt, nishihara_asami,
                              tmd_design)
-from satmd.tune.objective import Objective
+from satmd.tuning.objective import Objective
 
 MU = 0.05
 M1, K1 = 1.0, (2 * math.pi) ** 2  # host at 1 Hz

@@ -1,7 +1,7 @@
 """Parameter covariance of a least-squares fit, in relative scaling (Jacobian or HC3 sandwich).
 
-Shared by the result of a fit (`satmd.identify.statistics`) and its profile intervals
-(`satmd.identify.intervals`).
+Shared by the result of a fit (`satmd.identification.statistics`) and its profile intervals
+(`satmd.identification.intervals`).
 """
 from __future__ import annotations
 

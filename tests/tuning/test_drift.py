@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 from satmd import Rig, retune, simulate
-from satmd.tune import RetuneResult
+from satmd.tuning import RetuneResult
 
 
 def test_retune_tracks_kp_and_beats_the_fixed_setting(tmp_path):

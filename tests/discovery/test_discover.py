@@ -6,8 +6,8 @@ import pytest
 
 from satmd import Rig, effect, simulate
 from satmd.cli import main
-from satmd.discover import SCHEMA, discover
-from satmd.discover.scenarios import concealed_case, judge
+from satmd.discovery import SCHEMA, discover
+from satmd.discovery.scenarios import concealed_case, judge
 from satmd.io import save_frf
 from satmd.physics.effects import VOCABULARY_NAMES
 

@@ -3,7 +3,7 @@ import numpy as np
 import pytest
 
 from satmd import DataError, Rig
-from satmd.tune.objective import Objective, magnitude
+from satmd.tuning.objective import Objective, magnitude
 
 
 def dense_hinf(rig, band, n=400_001):

@@ -164,7 +164,7 @@ def retune(
     DataError
         An empty series, or a number of labels other than the number of FRFs.
     """
-    from ..identify import identify
+    from ..identification import identify
     from .core import tune
 
     t0 = time.perf_counter()

@@ -26,7 +26,7 @@ from functools import partial
 from typing import Sequence
 
 from .._fleet import fleet_map
-from ..identify import identify
+from ..identification import identify
 from ..io.frfdata import FRFData
 from ..physics import Rig
 from .candidates import default_candidates
@@ -35,7 +35,7 @@ from .findings import UNEXPLAINED, EffectFinding, UnexplainedFinding
 from .locate import test_mismatch
 from .noise import estimate_std
 from .report import SCHEMA, DiscoveryReport, describe_effect, describe_unexplained
-from .select import Model, Search, equivalents, select
+from .select import Model, Search, equivalents, select as select_effects
 
 __all__ = ["discover", "discover_many", "DiscoveryReport", "EffectFinding", "UnexplainedFinding",
            "SCHEMA"]
@@ -157,7 +157,7 @@ def _discover_frf(
     def significant(fit):
         return test_mismatch(fit, alpha, noise_dof).significant
 
-    final = select(search, nominal, significant, max_effects)
+    final = select_effects(search, nominal, significant, max_effects)
     effects = []
     if final.names:
         equiv = equivalents(search, final, nominal)

@@ -7,7 +7,7 @@ import pytest
 
 import satmd
 from satmd import DataError, Rig, effect, identify, simulate
-from satmd.tune import TuneResult, tune
+from satmd.tuning import TuneResult, tune
 
 SPEC_KEYS = ["objective", "output", "band_hz", "design", "value", "current", "attenuation_db", "model", "robust"]
 

@@ -103,6 +103,14 @@ def identify(
         nfev += fit.nfev
         if best is None or fit.cost < best.cost:
             best = fit
+    if global_search and _suspect(coarse, best, nominal):
+        # a narrow basin (a lightly damped shunt, a resonance at the band edge) can slip between the
+        # design's points: look again, 8x denser and with more starts, before settling for a poor fit
+        for s in _search(coarse, 8 * n_search, 4 * n_refine, seed + 1, starts):
+            fit = _local_fit(coarse, s, nominal, reg, max_nfev, tol)
+            nfev += fit.nfev
+            if fit.cost < best.cost:
+                best = fit
     if coarse is not problem:  # polish the best start on every point
         best = _local_fit(problem, coarse.values_from_x(best.x, nominal), nominal, reg, max_nfev, tol)
         nfev += best.nfev
@@ -114,6 +122,15 @@ def identify(
     if warn:
         emit_warnings(result)
     return result
+
+
+def _suspect(problem: Problem, fit, nominal) -> bool:
+    """A best fit that is far outside the noise, or sits on a bound: maybe not the global optimum."""
+    theta = problem.values_from_x(fit.x, nominal)
+    span = problem.upper - problem.lower
+    on_bound = np.any((theta - problem.lower <= 1e-9 * span) | (problem.upper - theta <= 1e-9 * span))
+    dof = max(problem.n_data - theta.size, 1)
+    return bool(on_bound or (problem.weighted and 2.0 * fit.cost / dof > 3.0))
 
 
 def _check_settings(reg, n_search, n_refine, max_nfev, tol):

@@ -13,10 +13,10 @@ import pytest
 
 from satmd import PAPER_GRID_HZ, ExtraMode, Rig, simulate
 from satmd.errors import DataError
-from satmd.identify import identify
-from satmd.identify import problem as problem_mod
-from satmd.identify.problem import Problem
-from satmd.identify.intervals import _scan, describe_interval, intervals_to_dict
+from satmd.identification import identify
+from satmd.identification import problem as problem_mod
+from satmd.identification.problem import Problem
+from satmd.identification.intervals import _scan, describe_interval, intervals_to_dict
 from satmd.io import DataWarning
 from satmd.io.frfdata import FRFData
 
@@ -246,7 +246,7 @@ def test_bad_settings_refused(kw, match):
 def test_satmd_internal_callers_are_not_warned():
     """discover fits wrong models on purpose: its fits keep their warnings on the result only."""
     data = simulate(effects=[ExtraMode(f_hz=66.0, zeta=0.01, mass_ratio=0.05)], noise=0.002, seed=1)
-    scope = {"__name__": "satmd.discover.fake", "identify": identify, "data": data}
+    scope = {"__name__": "satmd.discovery.fake", "identify": identify, "data": data}
     with warnings.catch_warnings():
         warnings.simplefilter("error", DataWarning)
         exec("fit = identify(data)", scope)
