@@ -16,7 +16,6 @@ import numpy as np
 from ..errors import FormatError, SatmdError
 from ..physics import Rig, effect
 
-
 # Upper bounds that keep memory bounded; refused up front with the number that was asked for.
 MAX_FREQ_POINTS = 1_000_000
 MAX_SAMPLES = 2 ** 24  # time samples per channel (3 channels of float64: 400 MB)
@@ -131,21 +130,10 @@ def check_outputs(outputs, inputs=()):
 # --- JSON: never NaN or Infinity ---------------------------------------------------
 def dumps_json(obj, command: str, **kw) -> str:
     """JSON text with non-finite numbers written as null (standard JSON has no NaN); a note names them."""
+    from ..jsonsafe import jsonable
+
     nulled = []
-
-    def clean(x, where):
-        if isinstance(x, dict):
-            return {k: clean(v, f"{where}.{k}" if where else str(k)) for k, v in x.items()}
-        if isinstance(x, (list, tuple)):
-            return [clean(v, f"{where}[{i}]") for i, v in enumerate(x)]
-        if hasattr(x, "tolist") and not isinstance(x, (str, bytes)):  # numpy scalars and arrays
-            return clean(x.tolist(), where)
-        if isinstance(x, float) and not math.isfinite(x):
-            nulled.append(where)
-            return None
-        return x
-
-    text = json.dumps(clean(obj, ""), allow_nan=False, **kw)
+    text = json.dumps(jsonable(obj, nulled), allow_nan=False, **kw)
     if nulled:
         shown = ", ".join(nulled[:6]) + (f" and {len(nulled) - 6} more" if len(nulled) > 6 else "")
         print(f"satmd {command}: note: not finite, written as null: {shown}", file=sys.stderr)

@@ -35,7 +35,8 @@ from .findings import UNEXPLAINED, EffectFinding, UnexplainedFinding
 from .locate import test_mismatch
 from .noise import estimate_std
 from .report import SCHEMA, DiscoveryReport, describe_effect, describe_unexplained
-from .select import Model, Search, equivalents, select as select_effects
+from .select import Model, Search, equivalents
+from .select import select as select_effects
 
 __all__ = ["discover", "discover_many", "DiscoveryReport", "EffectFinding", "UnexplainedFinding",
            "SCHEMA"]
@@ -116,15 +117,7 @@ def discover_many(datas: Sequence, executor=None, progress: bool = False, chunks
                      "dataset")
 
 
-def _discover_frf(
-    data: FRFData,
-    rig: Rig | None = None,
-    free: Sequence[str] = ("m2", "kp", "R", "L"),
-    candidates: Sequence[str] | None = None,
-    channels: Sequence[str] | None = None,
-    alpha: float = 1e-3,
-    max_effects: int = 3,
-) -> DiscoveryReport:
+def _discover_frf(data: FRFData, rig, free, candidates, channels, alpha, max_effects) -> DiscoveryReport:
     """`discover` on FRFData (parameters as `discover`): the steps of the module docstring."""
     t0 = time.perf_counter()
     rig = Rig() if rig is None else rig

@@ -22,6 +22,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import DataError, SatmdError
+from ..jsonsafe import jsonable
 from .dataset import BOUNDS
 from .strategies import KINDS, STRATEGIES
 
@@ -30,18 +31,6 @@ META = "model.json"
 WEIGHTS = "weights.pt"
 CHECKSUM = "sha256"
 _NOT_PARAMS = ("rig", "freq_hz")  # stored resolved, at the top level
-
-
-def _jsonable(x):
-    if isinstance(x, dict):
-        return {str(k): _jsonable(v) for k, v in x.items()}
-    if isinstance(x, (list, tuple)):
-        return [_jsonable(v) for v in x]
-    if isinstance(x, np.ndarray):
-        return x.tolist()
-    if isinstance(x, np.generic):
-        return x.item()
-    return x
 
 
 def _checksum(meta: dict) -> str:
@@ -77,7 +66,7 @@ def model_meta(model) -> dict:
         versions["torch"] = torch.__version__
         meta["network"] = {"class": "EnsembleNet", "n_members": model.ensemble_.n_members,
                            "sizes": list(model.ensemble_.sizes)}
-    meta = _jsonable(meta)
+    meta = jsonable(meta)
     meta[CHECKSUM] = _checksum(meta)
     return meta
 

@@ -7,6 +7,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..jsonsafe import jsonable
 from ..physics.rig import PARAMETER_INFO
 
 
@@ -16,20 +17,8 @@ def db(ratio: float) -> float:
 
 
 def clean(x):
-    """JSON-ready copy: NumPy scalars to Python, NaN/inf to None (NaN is never emitted)."""
-    if isinstance(x, dict):
-        return {str(k): clean(v) for k, v in x.items()}
-    if isinstance(x, (list, tuple)):
-        return [clean(v) for v in x]
-    if isinstance(x, np.ndarray):
-        return clean(x.tolist())
-    if isinstance(x, (bool, np.bool_)):
-        return bool(x)
-    if isinstance(x, (int, np.integer)):
-        return int(x)
-    if isinstance(x, (float, np.floating)):
-        return float(x) if np.isfinite(x) else None
-    return x
+    """JSON-ready copy: NumPy scalars to Python, NaN/inf to None (`satmd.jsonsafe.jsonable`)."""
+    return jsonable(x)
 
 
 @dataclass(frozen=True)
