@@ -149,7 +149,8 @@ class InverseModel:
             setattr(self, name, value)
         return self
 
-    def _validate_params(self):
+    def validate_params(self):
+        """Check the hyperparameters against the one constraint table (`satmd.inverse.params`)."""
         validate(self.get_params(), self._parameter_constraints)
 
     def _strategy(self):
@@ -158,7 +159,8 @@ class InverseModel:
         return STRATEGIES[self.kind]
 
     @property
-    def _rig(self) -> Rig:
+    def rig_or_default(self) -> Rig:
+        """The rig the model works with: ``rig``, or the paper's when None."""
         return Rig() if self.rig is None else self.rig
 
     def train_config(self, objective: str | None = None):
@@ -191,7 +193,7 @@ class InverseModel:
         -------
         InverseModel
         """
-        self._validate_params()
+        self.validate_params()
         strategy = self._strategy()
         for name in _LEARNED:
             self.__dict__.pop(name, None)
@@ -210,7 +212,8 @@ class InverseModel:
         self.fit_info_ = {**info, "train_s": time.perf_counter() - t0, "train_cpu_s": time.process_time() - c0}
         return self
 
-    def _set_ensemble(self, ensemble):
+    def set_ensemble(self, ensemble):
+        """Install a trained ensemble (the strategies and `load` call this), frozen for inference."""
         self.ensemble_ = ensemble.eval().requires_grad_(False)
         self.networks_ = [net.requires_grad_(False) for net in ensemble.members()]
 
@@ -234,7 +237,7 @@ class InverseModel:
         from ..io import DataWarning
         from .inputs import prepare
 
-        inputs = prepare(x, self.freq_hz, self._rig)
+        inputs = prepare(x, self.freq_hz, self.rig_or_default)
         for note in inputs.notes:
             warnings.warn(note, DataWarning, stacklevel=3)
         return inputs
@@ -288,8 +291,8 @@ class InverseModel:
         out = self._strategy().predict(self, inputs)
         if check:
             ref = float(self.fit_info_.get("residual_ref", DEFAULT_RESIDUAL_REF))
-            out.update(forward_check(inputs, out["R"], out["L"], self._rig, ref, float(self.noise)))
-            message = check_message(out, out["R"], out["L"], self._rig)
+            out.update(forward_check(inputs, out["R"], out["L"], self.rig_or_default, ref, float(self.noise)))
+            message = check_message(out, out["R"], out["L"], self.rig_or_default)
             if message:
                 warnings.warn(message, DataWarning, stacklevel=2)
         return out
@@ -314,7 +317,7 @@ class InverseModel:
 
         inputs = self._prepare(x)
         p = self.predict(x, check=False) if prediction is None else prediction
-        return forward_check(inputs, p["R"], p["L"], self._rig, 1.0, 0.0)["residual"]
+        return forward_check(inputs, p["R"], p["L"], self.rig_or_default, 1.0, 0.0)["residual"]
 
     # ------------------------------------------------------------ save / load
     def to_dict(self) -> dict:

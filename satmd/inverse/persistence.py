@@ -52,7 +52,7 @@ def model_meta(model) -> dict:
         "preset": model.preset,
         "bounds": {k: list(v) for k, v in model.bounds.items()},
         "freq_hz": np.asarray(model.freq_hz, float).tolist(),
-        "rig": {k: float(v) for k, v in model._rig.as_dict().items()},
+        "rig": {k: float(v) for k, v in model.rig_or_default.as_dict().items()},
         "feature_order": "[Re A1, Re A2, Im A1, Im A2] over freq_hz (satmd.physics.torch.features)",
         "scaler": model.scaler_.to_dict() if getattr(model, "scaler_", None) is not None else None,
         "std_scale": list(map(float, getattr(model, "std_scale_", np.ones(2)))),
@@ -104,7 +104,7 @@ def model_from_meta(cls, meta: dict, state: dict | None = None):
         if {k: tuple(map(float, v)) for k, v in meta["bounds"].items()} != {k: tuple(v) for k, v in BOUNDS.items()}:
             raise DataError(f"bounds {meta['bounds']} differ from eq. 20's {dict(BOUNDS)}")
         model = cls(**params, rig=Rig(**meta["rig"]).validate(), freq_hz=np.array(meta["freq_hz"], float))
-        model._validate_params()
+        model.validate_params()
         model.std_scale_ = np.array(meta["std_scale"], float).reshape(2)
         if strategy.has_net:
             from .training import Scaler
@@ -122,7 +122,7 @@ def model_from_meta(cls, meta: dict, state: dict | None = None):
     if strategy.has_net:
         if state is None:
             raise DataError("a network model needs its weights")
-        model._set_ensemble(_ensemble(meta["network"], state, model.freq_hz.size))
+        model.set_ensemble(_ensemble(meta["network"], state, model.freq_hz.size))
     return model
 
 

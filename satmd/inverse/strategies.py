@@ -70,12 +70,12 @@ class NetStrategy:
 
             raise DataError("no training samples")
         config = model.train_config(self.objective)
-        rig = model._rig
+        rig = model.rig_or_default
         model.scaler_ = Scaler.fit(train.features())
         model.std_scale_ = np.ones(2)
         ensemble, history = train_ensemble(train, val if len(val) else None, config, model.scaler_, rig,
                                            model.bounds, verbose=model.verbose)
-        model._set_ensemble(ensemble)
+        model.set_ensemble(ensemble)
         model.history_ = history
         info = {"objective": self.objective, "config": config.to_dict(), "dataset": data.info,
                 "n_train": len(train), "n_val": len(val), "device": history["device"],
@@ -89,7 +89,7 @@ class NetStrategy:
             model.scaler_ = Scaler.fit(data.features())
             ensemble, again = train_ensemble(data, None, config, model.scaler_, rig, model.bounds,
                                              verbose=model.verbose)
-            model._set_ensemble(ensemble)
+            model.set_ensemble(ensemble)
             model.history_["refit_loss"] = again["loss"]
             model.history_["train_s"] += again["train_s"]
             info.update(refit=True, n_final=len(data))
@@ -123,7 +123,7 @@ def residual_ref(model, ds: InverseDataset) -> float:
 
     a = np.stack([ds.a1, ds.a2], axis=1)
     mean, _ = net_predict(model, a, None)
-    rec = frf(ds.freq_hz, model._rig.replace(R=mean[:, 0], L=np.maximum(mean[:, 1], 1e-9)), outputs=("a1", "a2"))
+    rec = frf(ds.freq_hz, model.rig_or_default.replace(R=mean[:, 0], L=np.maximum(mean[:, 1], 1e-9)), outputs=("a1", "a2"))
     err = np.linalg.norm((np.stack([rec.a1, rec.a2], axis=1) - a).reshape(len(a), -1), axis=1)
     return float(max(np.quantile(err / np.linalg.norm(a.reshape(len(a), -1), axis=1), 0.99), 1e-4))
 
@@ -136,9 +136,9 @@ def least_squares(model, a, std, start):
     datas = [FRFData(model.freq_hz, {"a1": ai[0], "a2": ai[1]},
                      {} if std is None else {"a1": std[i][0], "a2": std[i][1]}) for i, ai in enumerate(a)]
     if start is None:
-        fits = identify_many(datas, rig=model._rig, free=("R", "L"), global_search=True, seed=int(model.seed))
+        fits = identify_many(datas, rig=model.rig_or_default, free=("R", "L"), global_search=True, seed=int(model.seed))
     else:
-        fits = [identify(d, rig=model._rig, free=("R", "L"), start={"R": float(s[0]), "L": float(max(s[1], 1e-5))},
+        fits = [identify(d, rig=model.rig_or_default, free=("R", "L"), start={"R": float(s[0]), "L": float(max(s[1], 1e-5))},
                          global_search=False, max_nfev=model.refine_nfev) for d, s in zip(datas, start)]
     out = {k: np.array([f.values[k] for f in fits]) for k in ("R", "L")}
     out.update({f"{k}_std": np.array([f.std.get(k, np.nan) for f in fits]) for k in ("R", "L")})

@@ -159,7 +159,7 @@ def test_optimization_and_hybrid(tiny_physics, tmp_path):
     assert InverseModel.load(tmp_path / "o").kind == "optimization"
 
     hyb = InverseModel("hybrid", epochs=4, warm_start_epochs=2, n_members=3, batch_size=64, seed=3, verbose=False)
-    hyb._set_ensemble(tiny_physics.ensemble_)  # reuse the fixture's nets: the hybrid only adds the refinement
+    hyb.set_ensemble(tiny_physics.ensemble_)  # reuse the fixture's nets: the hybrid only adds the refinement
     hyb.scaler_, hyb.fit_info_ = tiny_physics.scaler_, dict(tiny_physics.fit_info_)
     hyb.std_scale_ = tiny_physics.std_scale_
     q = hyb.predict(test)
