@@ -1,96 +1,126 @@
-"""Symbolic distillation of ξ_FRF on the SPEC §6 dataset with pyoperon (paper eqs. 27-29).
+"""Symbolic distillation of ξ_FRF and the modal descriptors (paper eqs. 27-29, issue 15).
 
-    python benchmarks/distill.py [--threads 1] [--out benchmarks/results/distill.json]
+    python benchmarks/distill.py [--splits 42,1,2,3,4,5] [--no-modal] [--out benchmarks/results/distill.json]
 
-6400 samples (R, L, m2, kp on the SPEC §6 grid), inputs z-scored, 80/20
-split with seed 42. Two pyoperon searches: the settings of
-`satmd.explain.run.XI_OPERON` (+ − × / square exp) and the same with the
-paper's operators only (+ − × / square). For each, the formula reported is
-the most accurate (training R²) with at most as many sympy nodes as the
-paper's formula (`paper_complexity()`, 20), and the best test R² at one
-node more and at ≤ 30 nodes are read off the Pareto front. The PySINDy
-polynomial baselines, the paper's own formula on the same split and the
-functional ANOVA of ξ over the grid (what additive/pairwise formulas can
-reach) are reported beside them. Writes a JSON file and prints one line.
+ξ: 6400 samples (R, L, m2, kp on the SPEC §6 grid), inputs z-scored, 80/20
+splits: SPEC's (seed 42) and five other seeds. On each split the search of
+`satmd reproduce` (`satmd.explain.run.XI_SEARCH`: two operon searches pooled
+with every product skeleton within 20 nodes, the formula chosen on a
+validation part of the training rows, one core) is run with the paper's node
+count (20) as the budget, and compared with the paper's formula, constants as
+printed, scored on the same split's test rows. Target: test R² ≥ paper + 0.01
+on every split, ≤ 120 s per run. The Pareto front of every run is kept.
+
+Modal descriptors (f1, f2, splitting, anti-resonance, attenuation) on SPEC's
+split with at most 15 nodes (`MODAL_SEARCH`), beside what the undamped
+physics says (no fit), a cubic polynomial in all four inputs (the smooth
+ceiling far beyond 15 nodes) and, below R² 0.99, the reason.
+
+The functional ANOVA of ξ over the grid is reported too. Writes a JSON file
+and prints one line.
 """
 from __future__ import annotations
 
 import argparse
 import json
-import os
-import platform
 import sys
 import time
 from pathlib import Path
 
+import numpy as np
+from _machine import describe, load_after, machine
+
 from satmd.explain import distill, paper_complexity, paper_formula_result, xi_dataset
-from satmd.explain.backends import OPERON_SYMBOLS
 from satmd.explain.anova import grid_anova
-from satmd.explain.run import COMPLEXITY_CAP, XI_OPERON
+from satmd.explain.descriptors import MODAL_NAMES, grid_rig, modal_physics
+from satmd.explain.run import MODAL_CAP, MODAL_SEARCH, XI_SEARCH, modal_reference
 from satmd.explain.symbolic import PAPER_METRICS
 
-TARGETS = {"r2_test_at_paper_complexity": 0.95, "seconds": 60.0}
-
-
-def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--threads", type=int, default=1, help="pyoperon threads (default 1)")
-    ap.add_argument("--out", default="benchmarks/results/distill.json")
-    args = ap.parse_args(argv)
-
-    t0 = time.perf_counter()
-    data = xi_dataset()
-    build_s = time.perf_counter() - t0
-    X, y = data.X, data.targets["xi"]
-    cap = paper_complexity()
-    paper = paper_formula_result(X, y)
-    t1 = time.perf_counter()
-    res = distill(X, y, backend="operon", names=data.names, max_complexity=cap, n_threads=args.threads, **XI_OPERON)
-    fit_s = time.perf_counter() - t1
-    best30 = res.best_within(COMPLEXITY_CAP)
-    one_more = res.best_within(cap + 1)
-    anova = grid_anova(X, y, data.names)
-    paper_ops = distill(X, y, backend="operon", names=data.names, max_complexity=cap, n_threads=args.threads,
-                        **{**XI_OPERON, "allowed_symbols": OPERON_SYMBOLS})
-    sindy = {}
-    for degree in (2, 3):
-        s = distill(X, y, backend="sindy", names=data.names, degree=degree)
-        sindy[str(degree)] = {"expression": str(s.expression), "complexity": s.complexity, "r2_train": s.r2_train,
-                              "r2_test": s.r2_test, "mae_test": s.mae_test,
-                              "best_within_30": _entry(s.best_within(COMPLEXITY_CAP))}
-    out = {
-        "dataset": {"n": int(len(y)), "build_s": build_s, "grid": "R 8..60 x10, L 0.032..0.3 x10, m2 0.3..0.6 x8, "
-                                                                  "kp 50e3..120e3 x8"},
-        "paper_reported": PAPER_METRICS,
-        "paper_formula_on_our_data": {k: v for k, v in paper.items()},
-        "operon": {**res.to_dict(), "fit_s": fit_s, "settings": XI_OPERON, "threads": args.threads},
-        "paper_complexity": cap,
-        "best_test_r2_within_30": _entry(best30),
-        "best_test_r2_within_paper_plus_1": _entry(one_more),
-        "paper_operators": {**paper_ops.to_dict(), "best_within_paper_plus_1": _entry(paper_ops.best_within(cap + 1)),
-                            "best_within_30": _entry(paper_ops.best_within(COMPLEXITY_CAP))},
-        "anova": anova.to_dict(),
-        "sindy": sindy,
-        "targets": TARGETS,
-        "meets": {"r2_test_at_paper_complexity": res.r2_test >= TARGETS["r2_test_at_paper_complexity"]
-                  and res.complexity <= cap, "seconds": fit_s < TARGETS["seconds"]},
-        "machine": {"python": sys.version.split()[0], "platform": platform.platform(), "cpu_count": os.cpu_count()},
-        "date": time.strftime("%Y-%m-%d %H:%M:%S"),
-    }
-    Path(args.out).parent.mkdir(parents=True, exist_ok=True)
-    Path(args.out).write_text(json.dumps(out, indent=1, default=float), encoding="utf-8")
-    b30 = f"{best30['r2_test']:.3f} ({best30['complexity']} nodes)" if best30 else "n/a"
-    p1 = f"{one_more['r2_test']:.3f}" if one_more else "n/a"
-    print(f"distill xi: operon test R2 {res.r2_test:.3f} with {res.complexity} nodes (paper {paper['r2_test']:.3f} "
-          f"with {cap}; target >= 0.95; paper operators {paper_ops.r2_test:.3f} with {paper_ops.complexity}), "
-          f"{p1} at <= {cap + 1}, best test R2 at <= {COMPLEXITY_CAP} nodes {b30}, fit {fit_s:.1f} s "
-          f"on {args.threads} thread(s); SINDy deg 3 test R2 {sindy['3']['r2_test']:.3f} with "
-          f"{sindy['3']['complexity']} nodes; additive ceiling {anova.r2_main:.3f} -> {args.out}")
-    return 0
+TARGETS = {"margin_over_paper": 0.01, "seconds_per_run": 120.0, "modal_r2": 0.99}
 
 
 def _entry(e):
     return None if e is None else {**e, "expression": str(e["expression"])}
+
+
+def xi_splits(X, y, names, seeds, cap):
+    runs = []
+    for seed in seeds:
+        paper = paper_formula_result(X, y, seed=seed)
+        t0 = time.perf_counter()
+        res = distill(X, y, names=names, max_complexity=cap, seed=seed, n_threads=1, **XI_SEARCH)
+        seconds = time.perf_counter() - t0
+        margin = res.r2_test - paper["r2_test"]
+        runs.append({"split_seed": seed, "paper_r2_test": paper["r2_test"], "paper_r2_train": paper["r2_train"],
+                     "r2_test": res.r2_test, "r2_train": res.r2_train, "complexity": res.complexity,
+                     "expression": str(res.expression), "margin": margin, "seconds": seconds,
+                     "pass": bool(margin >= TARGETS["margin_over_paper"] and res.complexity <= cap
+                                  and seconds <= TARGETS["seconds_per_run"]),
+                     "best_test_within_cap_plus_1": _entry(res.best_within(cap + 1)),
+                     "pareto": [_entry(p) for p in res.pareto], "info": res.info})
+        print(f"  split {seed}: ours {res.r2_test:.4f} ({res.complexity} nodes) vs paper {paper['r2_test']:.4f} "
+              f"(margin {margin:+.4f}), {seconds:.0f} s: {res.expression}", flush=True)
+    return runs
+
+
+def modal_runs(X, names):
+    data = xi_dataset(modal=True)
+    physics = modal_physics(grid_rig()[0])
+    out = {}
+    for name in MODAL_NAMES:
+        if name == "peak_db":  # attenuation_db is the same information against the host's own peak
+            continue
+        t = data.targets[name]
+        t0 = time.perf_counter()
+        res = distill(X, t, names=names, max_complexity=MODAL_CAP, n_threads=1, **MODAL_SEARCH)
+        seconds = time.perf_counter() - t0
+        cubic = distill(X, t, backend="sindy", names=names, degree=3)
+        label, phys_r2, switching = modal_reference(name, data.targets, physics)
+        out[name] = {"samples": int(np.isfinite(t).sum()), "r2_test": res.r2_test, "r2_train": res.r2_train,
+                     "complexity": res.complexity, "expression": str(res.expression), "seconds": seconds,
+                     "cubic_r2_test": cubic.r2_test, "physics": label, "physics_r2": phys_r2,
+                     "switching": switching, "pass": bool(res.r2_test >= TARGETS["modal_r2"]),
+                     "pareto": [_entry(p) for p in res.pareto]}
+        print(f"  {name}: R² {res.r2_test:.3f} ({res.complexity} nodes) {res.expression}; cubic {cubic.r2_test:.3f}; "
+              f"physics {phys_r2:.3f}; switching {switching:.0%}", flush=True)
+    return out
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--splits", default="42,1,2,3,4,5", help="split seeds (SPEC's is 42)")
+    ap.add_argument("--no-modal", action="store_true", help="skip the modal descriptors")
+    ap.add_argument("--out", default="benchmarks/results/distill.json")
+    args = ap.parse_args(argv)
+    seeds = [int(s) for s in args.splits.split(",")]
+    result = {"machine": machine(device="cpu", threads=1)}
+    data = xi_dataset()
+    X, y = data.X, data.targets["xi"]
+    cap = paper_complexity()
+    runs = xi_splits(X, y, data.names, seeds, cap)
+    result.update({
+        "dataset": {"n": int(len(y)), "grid": "R 8..60 x10, L 0.032..0.3 x10, m2 0.3..0.6 x8, kp 50e3..120e3 x8"},
+        "paper_reported": PAPER_METRICS, "paper_complexity": cap, "settings": XI_SEARCH, "xi": runs,
+        "anova": grid_anova(X, y, data.names).to_dict(), "targets": TARGETS,
+    })
+    if not args.no_modal:
+        result["modal"] = modal_runs(X, data.names)
+        result["modal_settings"] = {"cap": MODAL_CAP, **MODAL_SEARCH}
+    result["meets"] = {"xi_all_splits": all(r["pass"] for r in runs),
+                       "modal_all": None if args.no_modal else all(m["pass"] for m in result["modal"].values())}
+    result["machine"].update(load_after())
+    result["date"] = time.strftime("%Y-%m-%d %H:%M:%S")
+    Path(args.out).parent.mkdir(parents=True, exist_ok=True)
+    Path(args.out).write_text(json.dumps(result, indent=1, default=float), encoding="utf-8")
+    spec = runs[0]
+    margins = ", ".join(f"{r['margin']:+.3f}" for r in runs)
+    line = (f"distill xi: split {spec['split_seed']} test R² {spec['r2_test']:.3f} at {spec['complexity']} nodes vs paper "
+            f"{spec['paper_r2_test']:.3f} (target +0.01); margins over the paper on {len(runs)} splits: {margins}; "
+            f"max {max(r['seconds'] for r in runs):.0f} s/run")
+    if not args.no_modal:
+        line += "; modal R² at <= 15 nodes: " + ", ".join(f"{k} {v['r2_test']:.2f}" for k, v in result["modal"].items())
+    print(line + f" -> {args.out} | " + describe(result["machine"]))
+    return 0
 
 
 if __name__ == "__main__":

@@ -140,34 +140,38 @@ def discovery_noise() -> str:
 
 def distill() -> str:
     d = load("distill")
-    pf, op, po = d["paper_formula_on_our_data"], d["operon"], d["paper_operators"]
-    p1, b30 = d["best_test_r2_within_paper_plus_1"], d["best_test_r2_within_30"]
-    an = d["anova"]
+    runs, an = d["xi"], d["anova"]
+    spec = runs[0]
     greedy = dict(an["r2_greedy"])
     steps = [k for k, _ in an["r2_greedy"][1:3]]
-    s3 = d["sindy"]["3"]
-    target = d["targets"]["r2_test_at_paper_complexity"]
-    syms = op["settings"]["allowed_symbols"].replace(",constant,variable", "").replace(",", " ")
-    syms = syms.replace("add", "+").replace("sub", "−").replace("mul", "×").replace("div", "/")
-    reached = "reached" if d["meets"]["r2_test_at_paper_complexity"] else "**not reached**"
-    return "\n".join([
-        f"- **Symbolic distillation of ξ.** The paper's formula scores test R² {pf['r2_test']:.3f} on",
-        f"  our data (the paper reports {d['paper_reported']['r2_test']}); written as printed it has "
-        f"{pf['complexity']} sympy",
-        f"  nodes. pyoperon ({syms}, {op['seconds']:.0f} s on {op['threads']} core) reaches "
-        f"{op['r2_test']:.3f} at",
-        f"  {op['complexity']} nodes, {p1['r2_test']:.3f} at {p1['complexity']} nodes",
-        f"  (`{p1['expression'].replace('*', ' ').replace('  ', '*')}`)",
-        f"  and {b30['r2_test']:.3f} at {b30['complexity']} (≤ 30); with the paper's operators only, "
-        f"{po['r2_test']:.3f} at {po['complexity']} nodes.",
-        "  Constants a neighbour can absorb are pruned and refitted before nodes are",
-        f"  counted. The issue's target of {target} at the paper's node count is {reached}.",
-        "  The functional ANOVA of ξ over the grid (`satmd.explain.anova`) shows why: the four main",
-        f"  effects explain at most {an['r2_main']:.3f}; adding {steps[0].lstrip('+')} gives "
-        f"{greedy[steps[0]]:.3f} and {steps[1].lstrip('+')} {greedy[steps[1]]:.3f}, so a formula at {target}",
-        "  needs four curved main effects and more interaction than that. SINDy's cubic",
-        f"  polynomial reaches {s3['r2_test']:.3f} with {s3['complexity']} nodes.",
-    ])
+    info = spec["info"]
+    reached = "reached" if d["meets"]["xi_all_splits"] else "**not reached**"
+    margins = ", ".join(f"{r['margin']:+.3f}" for r in runs)
+    lines = [
+        f"- **Symbolic distillation of ξ.** The paper's formula ({d['paper_complexity']} sympy nodes) scores test R² "
+        f"{spec['paper_r2_test']:.3f} on SPEC's",
+        f"  split (the paper reports {d['paper_reported']['r2_test']}). satmd's search pools two pyoperon searches "
+        f"with every product skeleton",
+        f"  `c0 + c1·A·B [+ c2·x]` within the budget ({info['skeletons']} skeletons, affine `A`, `B` a square, "
+        "exponential or reciprocal,",
+        "  constants by variable projection) and chooses on a validation part of the training rows. At the paper's "
+        "20 nodes",
+        f"  it reaches {spec['r2_test']:.3f} (`{spec['expression']}`), in {spec['seconds']:.0f} s on one core.",
+        f"  Margins over the paper's formula on {len(runs)} splits (SPEC's first): {margins}; the issue's +0.01 on "
+        f"every split is {reached}.",
+        "  What a formula must capture (functional ANOVA of ξ over the grid, `satmd.explain.anova`): the main "
+        "effects",
+        f"  explain {an['r2_main']:.3f}, adding {steps[0].lstrip('+')} {greedy[steps[0]]:.3f} and "
+        f"{steps[1].lstrip('+')} {greedy[steps[1]]:.3f}.",
+    ]
+    if "modal" in d:
+        lines += ["", "  Modal descriptors at ≤ 15 nodes (SPEC's split; `physics` is the undamped value, no fit):", "",
+                  "  | descriptor | formula | test R² | cubic (35 terms) | physics R² | on another mode |",
+                  "  |---|---|---|---|---|---|"]
+        for name, m in d["modal"].items():
+            lines.append(f"  | {name} | `{m['expression']}` | {m['r2_test']:.3f} | {m['cubic_r2_test']:.3f} | "
+                         + (f"{m['physics_r2']:.3f} | {m['switching']:.0%} |" if m["physics"] else "— | — |"))
+    return "\n".join(lines)
 
 
 def tuning() -> str:
@@ -219,8 +223,6 @@ def measured() -> str:
     c1p, c1s = _cell(inv, "physics", "paper", 0.01), _cell(inv, "supervised", "paper", 0.01)
     obp, obs = _off(inv, "physics", "box"), _off(inv, "supervised", "box")
     last = runs[-1]
-    op, pf, p1, b30 = dst["operon"], dst["paper_formula_on_our_data"], dst["best_test_r2_within_paper_plus_1"], \
-        dst["best_test_r2_within_30"]
     tgt = mem["target"]
     at = next(row for row in mem["rows"] if row["points"] == tgt["points"])
     big = max(mem["rows"], key=lambda row: row["points"])
@@ -293,12 +295,11 @@ def measured() -> str:
         f"| off-curve / on-curve MAE R of box-trained nets | physics "
         f"{obp['off_curve']['mae_R'] / obp['on_curve']['mae_R']:.2f}, supervised "
         f"{obs['off_curve']['mae_R'] / obs['on_curve']['mae_R']:.2f} | same |",
-        f"| symbolic distillation of ξ (SPEC §6), pyoperon, one core | test R² {op['r2_test']:.3f} at "
-        f"{op['complexity']} nodes (paper's formula: {pf['r2_test']:.3f} at {pf['complexity']}), "
-        f"{p1['r2_test']:.3f} at {p1['complexity']}, {b30['r2_test']:.3f} at {b30['complexity']} (≤ 30); target "
-        f"{dst['targets']['r2_test_at_paper_complexity']} "
-        f"{'reached' if dst['meets']['r2_test_at_paper_complexity'] else 'not reached'}; additive ceiling "
-        f"{dst['anova']['r2_main']:.3f} | `benchmarks/distill.py` |",
+        f"| symbolic distillation of ξ (SPEC §6), at the paper's 20 nodes, one core | test R² "
+        f"{dst['xi'][0]['r2_test']:.3f} (paper's formula {dst['xi'][0]['paper_r2_test']:.3f}); margin over the paper "
+        f"on {len(dst['xi'])} splits {min(r['margin'] for r in dst['xi']):+.3f} to "
+        f"{max(r['margin'] for r in dst['xi']):+.3f} (target +0.01 "
+        f"{'reached' if dst['meets']['xi_all_splits'] else 'not reached'}) | `benchmarks/distill.py` |",
     ]
     return "\n".join(rows)
 

@@ -5,7 +5,7 @@
 2. the same curves for the physical sensitivity |∂A/∂R|, |∂A/∂L| of the
    forward model, and their agreement per case;
 3. the latent PCA (Figure 4) with the R/L sweeps of the disentanglement test;
-4. symbolic distillation of ξ_FRF (eq. 27) with pyoperon, against the
+4. symbolic distillation of ξ_FRF (eq. 27), operon pooled with the skeleton pass, against the
    paper's formula on the same data and split.
 
     python examples/uc3_explain.py [MODELDIR] [OUTDIR]

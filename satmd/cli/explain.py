@@ -6,7 +6,7 @@ from pathlib import Path
 from ..errors import SatmdError
 from ._common import Progress, check_outputs, dumps_json, integer
 
-BACKENDS = ("operon", "pysr", "sindy")
+BACKENDS = ("hybrid", "operon", "skeleton", "pysr", "sindy")
 
 
 def register(sub):
@@ -18,8 +18,9 @@ def register(sub):
                                    "explain.json.")
     p.add_argument("model", metavar="MODELDIR", help="folder written by `satmd inverse train`")
     p.add_argument("--out", default=None, metavar="DIR", help="output folder (default MODELDIR/explain)")
-    p.add_argument("--backend", default="operon", choices=BACKENDS,
-                   help="symbolic-regression backend (default operon; pysr needs a Julia runtime)")
+    p.add_argument("--backend", default="hybrid", choices=BACKENDS,
+                   help="symbolic-regression backend (default hybrid: operon pooled with the skeleton pass; "
+                        "pysr needs a Julia runtime)")
     p.add_argument("--threads", type=integer(1), default=1, metavar="N",
                    help="threads for the symbolic search (default 1)")
     p.add_argument("--quick", action="store_true", help="smaller latent set and shorter symbolic searches")

@@ -31,7 +31,7 @@ satmd.explain`` works with NumPy/SciPy alone).
 from .anova import GridAnova, grid_anova
 from .attributions import BLIND_CASES, PAPER_TABLE3, Attribution, attribution, peak_frequencies, table3_stats
 from .contract import ExplainableModel
-from .descriptors import NOMINAL, XI_GRID, DescriptorData, modal_descriptors, xi_dataset, xi_frf
+from .descriptors import NOMINAL, XI_GRID, DescriptorData, modal_descriptors, modal_physics, xi_dataset, xi_frf
 from .distillation import DistillResult, distill, paper_formula_result
 from .latent import LatentMap, latent_map
 from .sensitivity import PhysicalSensitivity, agreement, chain_rule_check, physical_sensitivity
@@ -51,6 +51,6 @@ def __getattr__(name):
 __all__ = [
     "latent_map", "LatentMap", "attribution", "Attribution", "table3_stats", "peak_frequencies", "PAPER_TABLE3",
     "BLIND_CASES", "physical_sensitivity", "PhysicalSensitivity", "agreement", "chain_rule_check", "xi_frf",
-    "xi_dataset", "modal_descriptors", "DescriptorData", "NOMINAL", "XI_GRID", "distill", "DistillResult",
+    "xi_dataset", "modal_descriptors", "modal_physics", "DescriptorData", "NOMINAL", "XI_GRID", "distill", "DistillResult",
     "paper_formula_result", "grid_anova", "GridAnova", "ExplainableModel", "node_count", "paper_complexity", "PAPER_FORMULA", "PAPER_METRICS",
 ]

@@ -19,35 +19,69 @@ OPERON_SYMBOLS = "add,sub,mul,div,square,constant,variable"
 
 
 def operon(Z, y, *, seed=42, n_threads=1, time_limit=None, max_length=15, max_depth=8, generations=300,
-           population_size=500, optimizer_iterations=5, search_samples=None, **extra):
+           population_size=500, optimizer_iterations=5, search_samples=None, restarts=1, **extra):
     """pyoperon's NSGA-II over (R², tree length): the Pareto front's trees.
 
     ``search_samples``: run the search on a random subset of that many training
     rows (constants are polished on all of them afterwards); ``None``: all.
+    ``restarts``: independent searches from seeds ``seed, seed + 1, ...``
+    (``time_limit`` is shared among them); their fronts are pooled and
+    `satmd.explain.distill` chooses among them (on a validation part when asked).
     """
     try:
         from pyoperon.sklearn import SymbolicRegressor
     except ImportError as exc:
         raise SatmdError("the operon backend needs pyoperon: pip install 'satmd[symbolic]'") from exc
-    rng = np.random.default_rng(seed)
-    if search_samples and search_samples < len(y):
-        idx = rng.choice(len(y), int(search_samples), replace=False)
-        Z, y = Z[idx], y[idx]
-    options = dict(allowed_symbols=OPERON_SYMBOLS, objectives=["r2", "length"], max_length=int(max_length),
-                   max_depth=int(max_depth), generations=int(generations), population_size=int(population_size),
-                   optimizer_iterations=int(optimizer_iterations), n_threads=int(n_threads), random_state=int(seed),
-                   max_evaluations=10**9)
-    if time_limit:
-        options["max_time"] = max(1, int(time_limit))
-    options.update(extra)
-    reg = SymbolicRegressor(**options)
-    reg.fit(np.asarray(Z, float), np.asarray(y, float))
+    restarts = max(1, int(restarts))
+    candidates, chosen, gens = [], None, []
     names = [f"x{i}" for i in range(Z.shape[1])]
-    trees = [p["tree"] for p in reg.pareto_front_]
-    candidates = [reg.get_model_string(t, 8, names=names) for t in trees]
-    chosen = len(candidates)
-    candidates.append(reg.get_model_string(reg.model_, 8, names=names))
-    return candidates, chosen, {"generations": int(reg.stats_.get("generations", -1))}
+    for r in range(restarts):
+        rng = np.random.default_rng(seed + r)
+        Zr, yr = Z, y
+        if search_samples and search_samples < len(y):
+            idx = rng.choice(len(y), int(search_samples), replace=False)
+            Zr, yr = Z[idx], y[idx]
+        options = dict(allowed_symbols=OPERON_SYMBOLS, objectives=["r2", "length"], max_length=int(max_length),
+                       max_depth=int(max_depth), generations=int(generations), population_size=int(population_size),
+                       optimizer_iterations=int(optimizer_iterations), n_threads=int(n_threads),
+                       random_state=int(seed + r), max_evaluations=10**9)
+        if time_limit:
+            options["max_time"] = max(1, int(time_limit / restarts))
+        options.update(extra)
+        reg = SymbolicRegressor(**options)
+        reg.fit(np.asarray(Zr, float), np.asarray(yr, float))
+        candidates += [reg.get_model_string(p["tree"], 8, names=names) for p in reg.pareto_front_]
+        if r == 0:  # operon's own (MDL) pick of the first search
+            chosen = len(candidates)
+            candidates.append(reg.get_model_string(reg.model_, 8, names=names))
+        gens.append(int(reg.stats_.get("generations", -1)))
+    return candidates, chosen, {"generations": gens[0] if restarts == 1 else gens, "restarts": restarts}
+
+
+def skeleton(Z, y, *, seed=42, n_threads=1, time_limit=None, budget=20, **extra):
+    """Every product skeleton within ``budget`` nodes, constants by variable
+    projection (`satmd.explain.skeletons`): deterministic, no dependency beyond SciPy.
+    ``n_threads`` is accepted for a uniform interface (the pass is serial)."""
+    from .skeletons import search
+
+    found, info = search(Z, y, budget=int(budget), seed=int(seed), time_limit=time_limit, **extra)
+    return [text for _, text in found], None, info
+
+
+def hybrid(Z, y, *, seed=42, n_threads=1, time_limit=None, budget=20, operon_share=0.35, skeleton_options=None,
+           **operon_options):
+    """operon's searches (the simple end of the front and whatever shapes it
+    invents) pooled with the skeleton pass (the dense end, at the node budget).
+
+    ``time_limit`` is split: ``operon_share`` of it for operon, the rest for the skeletons.
+    """
+    share = float(operon_share)
+    op_cands, chosen, op_info = operon(Z, y, seed=seed, n_threads=n_threads,
+                                       time_limit=None if time_limit is None else share * time_limit,
+                                       **operon_options)
+    sk_cands, _, sk_info = skeleton(Z, y, seed=seed, time_limit=None if time_limit is None
+                                    else (1.0 - share) * time_limit, budget=budget, **(skeleton_options or {}))
+    return op_cands + sk_cands, chosen, {**op_info, **sk_info, "operon_candidates": len(op_cands)}
 
 
 def julia_runtime() -> str | None:
@@ -129,4 +163,4 @@ def sindy(Z, y, *, seed=42, n_threads=1, time_limit=None, degree=3, rational=Fal
     return candidates, None, {"library": f"polynomial degree {degree}" + (", rational" if rational else "")}
 
 
-BACKENDS = {"operon": operon, "pysr": pysr, "sindy": sindy}
+BACKENDS = {"operon": operon, "pysr": pysr, "sindy": sindy, "skeleton": skeleton, "hybrid": hybrid}

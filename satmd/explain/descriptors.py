@@ -171,6 +171,48 @@ def modal_descriptors(rig: Rig | None = None, freq=FINE_GRID_HZ) -> dict:
     return {k: v.reshape(batch) for k, v in out.items()}
 
 
+def modal_physics(rig: Rig | None = None) -> dict:
+    """What the undamped physics says the modal descriptors are (no fit).
+
+    - ``f_absorber_hz``: the absorber on its own spring, sqrt(kp/m2)/2π, where
+      textbook TMD theory puts the primary's anti-resonance;
+    - ``f_anti_roots_hz``: the anti-resonances of U1 with the shunt, the roots
+      ω² of det[[Z22, Z23], [Z32, Z33]] = 0 (damping dropped),
+      m2 L ω⁴ − (kp L + m2/Cp) ω² + (kp − e²/Cp)/Cp = 0, ascending (..., 2);
+      they interlace with the modes, so one lies between any two adjacent peaks;
+    - ``f_modes_hz``: the three undamped natural frequencies of
+      (K − ω² diag(m1, m2, L)) x = 0, ascending (..., 3).
+
+    Parameters
+    ----------
+    rig : Rig
+        Fields may be arrays (a batch); default: the paper's rig.
+
+    Returns
+    -------
+    dict
+        Arrays with the rig's batch shape (``f_modes_hz`` with a trailing 3).
+    """
+    rig = Rig() if rig is None else rig
+    b = np.broadcast_arrays(*(np.asarray(getattr(rig, n), float) for n in ("m1", "k1", "m2", "kp", "L", "e", "Cp")))
+    m1, k1, m2, kp, L, e, Cp = b
+    two_pi = 2 * np.pi
+    f_abs = np.sqrt(kp / m2) / two_pi
+    a, bb, c = m2 * L, kp * L + m2 / Cp, (kp - e * e / Cp) / Cp
+    disc = np.sqrt(np.maximum(bb * bb - 4 * a * c, 0.0))
+    with np.errstate(divide="ignore", invalid="ignore"):
+        roots = np.stack([(bb - disc) / (2 * a), (bb + disc) / (2 * a)], axis=-1)
+    f_roots = np.sqrt(np.maximum(roots, 0.0)) / two_pi
+    K = np.zeros(m1.shape + (3, 3))
+    K[..., 0, 0], K[..., 0, 1], K[..., 0, 2] = k1 + kp, -kp, e / Cp
+    K[..., 1, 1], K[..., 1, 2], K[..., 2, 2] = kp, -e / Cp, 1 / Cp
+    K = K + np.swapaxes(np.triu(K, 1), -1, -2)
+    s = 1 / np.sqrt(np.stack([m1, m2, np.maximum(L, 1e-300)], axis=-1))  # mass-normalised: symmetric eigenproblem
+    lam = np.linalg.eigvalsh(K * s[..., :, None] * s[..., None, :])
+    return {"f_absorber_hz": f_abs, "f_anti_roots_hz": f_roots,
+            "f_modes_hz": np.sqrt(np.maximum(lam, 0.0)) / two_pi}
+
+
 def _scalar(v):
     """A fixed parameter of a batch (its first value: fixed parameters are scalars in practice)."""
     return v if np.ndim(v) == 0 else float(np.asarray(v, float).ravel()[0])

@@ -139,18 +139,21 @@ def distill(X, y, backend: str = "operon", names=None, *, max_complexity: int | 
             test_size: float = 0.2, seed: int = 42, search_seed: int | None = None, zscore: bool = True,
             n_threads: int = 1,
             time_limit: float | None = None, polish: bool | None = None, prune: bool | None = None, digits: int = 4,
-            **options) -> DistillResult:
+            validation: float = 0.0, **options) -> DistillResult:
     """Fit a compact formula y ≈ f(z(X)).
 
     Parameters
     ----------
     X : (n, d) physical inputs
     y : (n,) target (non-finite rows are dropped)
-    backend : "operon" (default), "pysr" or "sindy"
+    backend : "operon" (default), "pysr", "sindy", "skeleton" (product skeletons
+        within the node budget, `satmd.explain.skeletons`) or "hybrid" (operon
+        and the skeletons pooled)
     names : names of the d inputs (default x0..)
-    max_complexity : return the most accurate (training R²) candidate with at
-        most this many nodes; None: the back end's own choice (operon: MDL;
-        sindy: best training R²)
+    max_complexity : return the most accurate candidate (training R², or
+        validation R² with ``validation``) with at most this many nodes; None:
+        the back end's own choice (operon: MDL; others: best training R²).
+        It is also the node budget of the skeleton and hybrid back ends (default 20)
     test_size : share of the test split
     seed : seed of the train/test split (SPEC §6: 42)
     search_seed : seed of the back end's search (default: ``seed``)
@@ -161,6 +164,10 @@ def distill(X, y, backend: str = "operon", names=None, *, max_complexity: int | 
     prune : drop the constants the others can absorb (`symbolic.prune`: the
         squared error may grow by 1e-4 relative); default: when polishing
     digits : significant digits the constants are rounded to (metrics use the rounded formula)
+    validation : share of the *training* rows held out to choose among the
+        candidates (0: choose on training R²). The search and the constants
+        see only the rest; the chosen formula's constants are then refitted
+        on all training rows. The test rows are never seen.
     **options : passed to the back end (e.g. max_length, generations, degree, rational)
 
     Returns
@@ -169,46 +176,71 @@ def distill(X, y, backend: str = "operon", names=None, *, max_complexity: int | 
     """
     if backend not in BACKENDS:
         raise SatmdError(f"unknown backend {backend!r}; choose from {', '.join(BACKENDS)}")
+    if not 0.0 <= validation < 0.9:
+        raise DataError(f"validation must be a share in [0, 0.9), got {validation}")
     symbolic = _symbolic()
     sp = symbolic.sp
     Ztr, Zte, ytr, yte, mean, std = split(X, y, test_size, seed, zscore)
     d = Ztr.shape[1]
     names = tuple(names) if names is not None else tuple(f"x{i}" for i in range(d))
+    if validation:
+        Zfit, Zval, yfit, yval = train_test_split(Ztr, ytr, test_size=validation, random_state=seed + 1)
+    else:
+        Zfit, yfit, Zval, yval = Ztr, ytr, None, None
+    if backend in ("skeleton", "hybrid"):
+        options.setdefault("budget", max_complexity if max_complexity is not None else 20)
     t0 = time.perf_counter()
     search_seed = seed if search_seed is None else search_seed
-    candidates, chosen, info = BACKENDS[backend](Ztr, ytr, seed=search_seed, n_threads=n_threads, time_limit=time_limit,
-                                                 **options)
+    candidates, chosen, info = BACKENDS[backend](Zfit, yfit, seed=search_seed, n_threads=n_threads,
+                                                 time_limit=time_limit, **options)
     search_s = time.perf_counter() - t0
     if polish is None:
         polish = not (backend == "sindy" and not options.get("rational", False))
     prune = polish if prune is None else prune
+
+    def finish(expr, Z, yy):
+        if polish:
+            expr = symbolic.polish(expr, Z, yy)
+        if prune:
+            expr = symbolic.prune(expr, Z, yy)
+        return symbolic.round_floats(symbolic.compact(symbolic.round_floats(expr, digits)), digits)
+
+    def entry(expr, is_chosen=False):
+        e = {"complexity": symbolic.node_count(expr), **metrics(expr, Ztr, Zte, ytr, yte), "expression": expr,
+             "_chosen": is_chosen}
+        if Zval is not None:
+            e["r2_val"] = metrics(expr, Zval, Zval, yval, yval)["r2_train"]
+        return e
+
     entries, seen = [], set()
     for i, text in enumerate(candidates):
         expr = symbolic.parse(text, d) if isinstance(text, str) else sp.sympify(text)
-        if polish:
-            expr = symbolic.polish(expr, Ztr, ytr)
-        if prune:
-            expr = symbolic.prune(expr, Ztr, ytr)
-        expr = symbolic.round_floats(symbolic.compact(symbolic.round_floats(expr, digits)), digits)
+        expr = finish(expr, Zfit, yfit)
         key = sp.srepr(expr)
         if key in seen:
             continue
         seen.add(key)
-        entries.append({"complexity": symbolic.node_count(expr), **metrics(expr, Ztr, Zte, ytr, yte),
-                        "expression": expr, "_chosen": i == chosen})
+        entries.append(entry(expr, i == chosen))
     if not entries:
         raise SatmdError(f"the {backend} backend returned no expression")
-    front = pareto_front(entries)
+    rank = "r2_val" if Zval is not None else "r2_train"
     if max_complexity is not None:
         pool = [e for e in entries if e["complexity"] <= max_complexity]
         pool = pool or [min(entries, key=lambda e: e["complexity"])]
-        pick = max(pool, key=lambda e: e["r2_train"])
+        pick = max(pool, key=lambda e: e[rank])
     else:
         own = [e for e in entries if e["_chosen"]]
-        pick = own[0] if own else max(entries, key=lambda e: e["r2_train"])
+        pick = own[0] if own else max(entries, key=lambda e: e[rank])
+    if Zval is not None:  # the chosen structure's constants from all training rows
+        refit = entry(finish(pick["expression"], Ztr, ytr), pick["_chosen"])
+        if max_complexity is None or refit["complexity"] <= max(max_complexity, pick["complexity"]):
+            entries.append(refit)
+            pick = refit
+    front = pareto_front(entries)
     seconds = time.perf_counter() - t0
     clean = tuple({k: v for k, v in e.items() if k != "_chosen"} for e in front)
-    info = {**info, "search_s": search_s, "n_candidates": len(entries)}
+    info = {**info, "search_s": search_s, "n_candidates": len(entries), "validation": validation,
+            "chosen_on": rank}
     return DistillResult(backend, pick["expression"], pick["complexity"], pick["mae_train"], pick["mae_test"],
                          pick["r2_train"], pick["r2_test"], clean, seconds, names, mean, std, len(ytr), len(yte),
                          info)

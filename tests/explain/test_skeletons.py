@@ -1,0 +1,108 @@
+"""The skeleton pass of symbolic distillation, the hybrid back end and the modal physics."""
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+pytest.importorskip("sympy")
+
+from satmd.errors import DataError  # noqa: E402
+from satmd.explain import distill, modal_physics  # noqa: E402
+from satmd.explain import skeletons as K  # noqa: E402
+from satmd.explain import symbolic as S  # noqa: E402
+from satmd.physics import Rig  # noqa: E402
+
+
+def planted(n=600, seed=0):
+    """y = 2 + 0.5 (x2 + 1.5 − 0.7 x0) exp(−0.4 x1): the skeleton A·exp with 15 nodes."""
+    rng = np.random.default_rng(seed)
+    Z = rng.standard_normal((n, 3))
+    y = 2.0 + 0.5 * (Z[:, 2] + 1.5 - 0.7 * Z[:, 0]) * np.exp(-0.4 * Z[:, 1])
+    return Z, y
+
+
+def test_node_count_of_a_skeleton_bounds_its_formula():
+    """The budget filter trusts ``Skeleton.nodes``: the written formula never has more."""
+    pool = K.skeletons(4, 20)
+    rng = np.random.default_rng(1)
+    exact = 0
+    for i in rng.choice(len(pool), 60, replace=False):
+        sk = pool[i]
+        p = np.linspace(0.31, 0.77, sk.n_inner)
+        expr = S.compact(S.parse(sk.text(p, [1.23, 0.45, 0.67]), 4))
+        assert S.node_count(expr) <= sk.nodes, (sk, expr)
+        exact += S.node_count(expr) == sk.nodes
+    assert exact > 30  # the count is the formula's, not a loose bound
+
+
+def test_the_paper_skeleton_is_in_the_pool_at_its_node_count():
+    """c0 + c1 (x1 + a + b x2 + c x3)((x1 + d)² + x0): the paper's formula, 20 nodes."""
+    pool = K.skeletons(4, 20)
+    paper = [sk for sk in pool if sk.a == K.Affine(1, (2, 3)) and sk.b == K.Square(K.Affine(1, ()), 0)
+             and sk.extra is None]
+    assert len(paper) == 1 and paper[0].nodes == 20 == S.paper_complexity()
+
+
+@settings(max_examples=25, deadline=None)
+@given(st.integers(0, 10**6), st.integers(1, 2))
+def test_projection_is_least_squares(seed, k):
+    rng = np.random.default_rng(seed)
+    cols = [rng.standard_normal(50) for _ in range(k)]
+    y = rng.standard_normal(50)
+    r, c = K._project(cols, y)
+    A = np.column_stack([np.ones(50)] + cols)
+    ref, *_ = np.linalg.lstsq(A, y, rcond=None)
+    np.testing.assert_allclose(c, ref, rtol=1e-9, atol=1e-12)
+    np.testing.assert_allclose(r, A @ ref - y, atol=1e-10)
+
+
+def test_search_recovers_a_planted_skeleton_exactly():
+    Z, y = planted()
+    found, info = K.search(Z, y, budget=15, seed=0, time_limit=None, subsample=300, keep=8)
+    assert info["skeletons_fitted"] == info["skeletons"] > 50
+    r2, text = found[0]
+    assert r2 > 1 - 1e-9
+    expr = S.compact(S.parse(text, 3))
+    assert S.node_count(expr) <= 15 and expr.has(S.sp.exp)
+
+
+def test_distill_skeleton_backend_chooses_on_validation_and_never_sees_test():
+    Z, y = planted(800)
+    res = distill(Z, y, backend="skeleton", zscore=False, max_complexity=15, validation=0.25, time_limit=None,
+                  subsample=300, keep=6)
+    assert res.info["chosen_on"] == "r2_val" and res.complexity <= 15
+    assert res.r2_test > 0.999999
+    assert all("r2_val" in p for p in res.pareto)
+
+
+def test_hybrid_pools_operon_and_the_skeletons():
+    pytest.importorskip("pyoperon")
+    Z, y = planted(400)
+    res = distill(Z, y, backend="hybrid", zscore=False, max_complexity=15, generations=10, population_size=100,
+                  max_length=10, time_limit=None, skeleton_options={"subsample": 200, "keep": 4})
+    assert res.info["operon_candidates"] > 0 and res.info["skeletons"] > 0
+    assert res.r2_test > 0.999
+
+
+def test_validation_share_is_checked():
+    Z, y = planted(100)
+    with pytest.raises(DataError, match="validation"):
+        distill(Z, y, backend="sindy", validation=0.95)
+
+
+@settings(max_examples=30, deadline=None)
+@given(st.floats(0.2, 1.0), st.floats(3e4, 3e5), st.floats(0.01, 0.6), st.floats(0.1, 1.0))
+def test_modal_physics_interlaces_modes_and_anti_resonances(m2, kp, L, e):
+    """A driving-point FRF of an undamped system: its zeros lie between its poles."""
+    out = modal_physics(Rig(m2=m2, kp=kp, L=L, e=e))
+    f, a = out["f_modes_hz"], out["f_anti_roots_hz"]
+    assert f[0] < a[0] < f[1] < a[1] < f[2]
+
+
+def test_modal_physics_uncoupled_limit_is_exact():
+    """e → 0: the anti-resonances are the absorber's own sqrt(kp/m2) and the shunt's 1/sqrt(L Cp)."""
+    rig = Rig(e=0.0, m2=0.5, kp=1e5, L=0.1)
+    out = modal_physics(rig)
+    expect = sorted([np.sqrt(1e5 / 0.5), 1 / np.sqrt(0.1 * rig.Cp)])
+    np.testing.assert_allclose(out["f_anti_roots_hz"], np.array(expect) / (2 * np.pi), rtol=1e-12)
+    np.testing.assert_allclose(out["f_absorber_hz"], np.sqrt(1e5 / 0.5) / (2 * np.pi), rtol=1e-15)
