@@ -183,6 +183,10 @@ def modal_physics(rig: Rig | None = None) -> dict:
     - ``f_modes_hz``: the three undamped natural frequencies of
       (K − ω² diag(m1, m2, L)) x = 0, ascending (..., 3).
 
+    For a stable rig (e² < kp Cp: the shorted piezo keeps a positive
+    stiffness) modes and anti-resonances interlace; beyond it the negative
+    roots are clipped to 0 Hz.
+
     Parameters
     ----------
     rig : Rig

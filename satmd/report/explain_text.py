@@ -187,7 +187,7 @@ def symbolic_markdown(s: SymbolicAnalysis, figure) -> str:
                "splitting, the anti-resonance between them and the attenuation of the worst peak against the host "
                f"alone. Formulas at ≤ {MODAL_CAP} nodes ({backend}), beside what the undamped physics says "
                "(`satmd.explain.modal_physics`, no fit: the natural frequency nearest each peak; the anti-resonance "
-               "root of the blocked absorber and shunt between the peaks), the share of rigs whose descriptor sits on "
+               "root of the blocked absorber and shunt nearest the middle of the peaks), the share of rigs whose descriptor sits on "
                "another mode than on most of the grid, and for scale the cubic-polynomial SINDy fit (35 terms).", "",
                "| descriptor | samples | formula | nodes | R² test | cubic SINDy R² test | physics R² | "
                "on another mode |", "|---|---|---|---|---|---|---|---|"]
@@ -201,6 +201,7 @@ def symbolic_markdown(s: SymbolicAnalysis, figure) -> str:
         md += ["", "As L sweeps the electrical resonance 1/(2π√(L Cp)) from 171 Hz down to 56 Hz through the band, "
                "it meets the mechanical modes and the two highest peaks change identity, so f1, f2 and the "
                "anti-resonance jump rather than vary smoothly with L; R, which sets the electrical damping, decides "
-               "which peak is higher. The undamped physics follows each branch closely where the branch is known.",
+               "which peak is higher. The physics column is what the undamped model explains with no fit at all; what "
+               "it misses is the damping, which moves the peaks and decides which two are highest.",
                ""]
     return "\n".join(md)

@@ -1,7 +1,7 @@
 """The skeleton pass of symbolic distillation, the hybrid back end and the modal physics."""
 import numpy as np
 import pytest
-from hypothesis import given, settings
+from hypothesis import assume, given, settings
 from hypothesis import strategies as st
 
 pytest.importorskip("sympy")
@@ -93,8 +93,11 @@ def test_validation_share_is_checked():
 @settings(max_examples=30, deadline=None)
 @given(st.floats(0.2, 1.0), st.floats(3e4, 3e5), st.floats(0.01, 0.6), st.floats(0.1, 1.0))
 def test_modal_physics_interlaces_modes_and_anti_resonances(m2, kp, L, e):
-    """A driving-point FRF of an undamped system: its zeros lie between its poles."""
-    out = modal_physics(Rig(m2=m2, kp=kp, L=L, e=e))
+    """A driving-point FRF of an undamped system: its zeros lie between its poles
+    (for a stable rig: e² < kp Cp, else the shorted piezo has a negative stiffness)."""
+    rig = Rig(m2=m2, kp=kp, L=L, e=e)
+    assume(e * e < 0.95 * kp * rig.Cp)
+    out = modal_physics(rig)
     f, a = out["f_modes_hz"], out["f_anti_roots_hz"]
     assert f[0] < a[0] < f[1] < a[1] < f[2]
 
@@ -106,3 +109,37 @@ def test_modal_physics_uncoupled_limit_is_exact():
     expect = sorted([np.sqrt(1e5 / 0.5), 1 / np.sqrt(0.1 * rig.Cp)])
     np.testing.assert_allclose(out["f_anti_roots_hz"], np.array(expect) / (2 * np.pi), rtol=1e-12)
     np.testing.assert_allclose(out["f_absorber_hz"], np.sqrt(1e5 / 0.5) / (2 * np.pi), rtol=1e-15)
+
+
+def test_block_extras_recover_a_planted_exponential_term():
+    """y = 1 + 0.3 (x1 + 2) exp(0.5 x0) + 0.8 exp(−0.7 x1): an extra term that is a block, 17 nodes."""
+    rng = np.random.default_rng(3)
+    Z = rng.standard_normal((300, 2))
+    y = 1 + 0.3 * (Z[:, 1] + 2) * np.exp(0.5 * Z[:, 0]) + 0.8 * np.exp(-0.7 * Z[:, 1])
+    plain, _ = K.search(Z, y, budget=17, seed=0, time_limit=None, subsample=300, keep=4)
+    found, info = K.search(Z, y, budget=17, seed=0, time_limit=None, subsample=300, keep=4, block_extras=True)
+    assert info["skeletons"] > len(K.skeletons(2, 17)) // 2
+    assert found[0][0] > 1 - 1e-9 > plain[0][0]
+
+
+def test_modal_reference_and_the_reason_a_formula_stops_short():
+    from satmd.explain.descriptors import grid_rig, modal_descriptors
+    from satmd.explain.run import ModalDistillation, modal_reference
+
+    grid = {"R": np.array([10.0, 40.0]), "L": np.linspace(0.032, 0.3, 6), "m2": np.array([0.3, 0.6]),
+            "kp": np.array([50e3, 120e3])}
+    rig, X = grid_rig(grid)
+    targets = modal_descriptors(rig)
+    physics = modal_physics(rig)
+    label, r2, switching = modal_reference("f1_hz", targets, physics)
+    assert "natural frequency" in label and r2 > 0.5 and 0.0 <= switching < 1.0
+    assert modal_reference("attenuation_db", targets, physics)[0] == ""
+    y = targets["f2_hz"]
+    keep = np.isfinite(y)
+    linear = distill(X[keep], y[keep], backend="sindy", degree=1)
+    cubic = distill(X[keep], y[keep], backend="sindy", degree=3)
+    m = ModalDistillation(samples=int(keep.sum()), formula=linear, cubic=cubic, ceiling_without_R=0.0,
+                          physics=label, physics_r2=r2, switching=0.3)
+    assert "30% of the grid" in m.reason() and "cubic" in m.reason()
+    assert m.reason(target=min(linear.r2_test, 0.0)) == ""
+    assert m.to_dict()["reason"] == m.reason()
