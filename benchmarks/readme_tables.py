@@ -211,7 +211,7 @@ def tuning_summary() -> str:
 
 def measured() -> str:
     ide, fwd, dis, st = load("identification"), load("forward"), load("discovery"), load("startup")
-    inv, dst, mem = load("inverse"), load("distill"), load("memory")
+    inv, dst, mem, fl = load("inverse"), load("distill"), load("memory"), load("fleet")
     runs = load("inverse_training")
     t1, ad, cov, gl = ide["table1"]["satmd"], ide["table1"]["adam"], ide["coverage"], ide["global"]
     ns = ide.get("coverage_no_std", {})
@@ -259,6 +259,11 @@ def measured() -> str:
            f"{fwd['machine']['load_average_1_5_15_before'][0]:.1f})"
            if fwd.get("machine", {}).get("load_average_1_5_15_before") else "")
         + " | `benchmarks/forward.py` |",
+        f"| fleet: {fl['n_frf']} FRFs through `identify_many`, 2 worker processes against 1 (same run) | "
+        f"process pool {fl['speedup_2_over_1_workers']['process_pool']:.2f}×, Dask LocalCluster "
+        f"{fl['speedup_2_over_1_workers']['dask_local']:.2f}×; results bit for bit identical: "
+        f"{'yes' if fl['all_runs_identical'] else 'NO'} ({fl['machine']['cpu_count']}-core CPU at load average "
+        f"{fl['machine']['load_average_1_5_15_before'][0]:.1f}) | `benchmarks/fleet.py` |",
         f"| discovery, shared acceptance files (`satmd discover --json`, shared scorer) | "
         f"{acc['score']}/{acc['n']}, median {acc['median_time_s']:.1f} s per CLI run | `benchmarks/discovery.py` |",
         f"| discovery, false positives on {n0['n']} null datasets (std given) / {n1['n']} (noise estimated) | "
