@@ -74,11 +74,15 @@ def hybrid(Z, y, *, seed=42, n_threads=1, time_limit=None, budget=20, operon_sha
     invents) pooled with the skeleton pass (the dense end, at the node budget).
 
     ``time_limit`` is split: ``operon_share`` of it for operon, the rest for the skeletons.
+    Without pyoperon installed the skeleton pass runs alone (``info["operon"]`` says so).
     """
     share = float(operon_share)
-    op_cands, chosen, op_info = operon(Z, y, seed=seed, n_threads=n_threads,
-                                       time_limit=None if time_limit is None else share * time_limit,
-                                       **operon_options)
+    if importlib.util.find_spec("pyoperon") is None:  # the skeleton pass needs only SciPy: go on without operon
+        op_cands, chosen, op_info, share = [], None, {"operon": "not installed (pip install 'satmd[symbolic]')"}, 0.0
+    else:
+        op_cands, chosen, op_info = operon(Z, y, seed=seed, n_threads=n_threads,
+                                           time_limit=None if time_limit is None else share * time_limit,
+                                           **operon_options)
     sk_cands, _, sk_info = skeleton(Z, y, seed=seed, time_limit=None if time_limit is None
                                     else (1.0 - share) * time_limit, budget=budget, **(skeleton_options or {}))
     return op_cands + sk_cands, chosen, {**op_info, **sk_info, "operon_candidates": len(op_cands)}

@@ -143,3 +143,15 @@ def test_modal_reference_and_the_reason_a_formula_stops_short():
     assert "30% of the grid" in m.reason() and "cubic" in m.reason()
     assert m.reason(target=min(linear.r2_test, 0.0)) == ""
     assert m.to_dict()["reason"] == m.reason()
+
+
+def test_hybrid_without_pyoperon_runs_the_skeletons_alone(monkeypatch):
+    import importlib.util
+
+    real = importlib.util.find_spec
+    monkeypatch.setattr(importlib.util, "find_spec", lambda name, *a: None if name == "pyoperon" else real(name, *a))
+    Z, y = planted(300)
+    res = distill(Z, y, backend="hybrid", zscore=False, max_complexity=15, time_limit=None,
+                  skeleton_options={"subsample": 200, "keep": 4})
+    assert "not installed" in res.info["operon"] and res.info["operon_candidates"] == 0
+    assert res.r2_test > 0.999
