@@ -5,8 +5,8 @@
 ξ: 6400 samples (R, L, m2, kp on the SPEC §6 grid), inputs z-scored, 80/20
 splits: SPEC's (seed 42) and five other seeds. On each split the search of
 `satmd reproduce` (`satmd.explain.run.XI_SEARCH`: two operon searches pooled
-with every product skeleton within 20 nodes, the formula chosen on a
-validation part of the training rows, one core) is run with the paper's node
+with every product skeleton within 20 nodes, shortlisted on a validation
+part of the training rows and picked by 5-fold CV, one core) is run with the paper's node
 count (20) as the budget, and compared with the paper's formula, constants as
 printed, scored on the same split's test rows. Target: test R² ≥ paper + 0.01
 on every split, ≤ 120 s per run. The Pareto front of every run is kept.

@@ -125,6 +125,31 @@ def metrics(expr, Ztr, Zte, ytr, yte) -> dict:
     return out
 
 
+def cv_r2(expr, Z, y, folds: int = 5, seed: int = 0) -> float:
+    """Mean R² of ``expr`` over ``folds``-fold cross-validation, constants refitted
+    (`symbolic.polish`) on each fold's training part.
+
+    Parameters
+    ----------
+    expr : sympy expression in x0..
+    Z, y : rows to cross-validate on (never the test rows).
+    folds : number of folds.
+    seed : seed of the fold assignment.
+
+    Returns
+    -------
+    float
+    """
+    from sklearn.model_selection import KFold
+
+    symbolic = _symbolic()
+    scores = []
+    for fit_rows, held in KFold(int(folds), shuffle=True, random_state=seed).split(Z):
+        e = symbolic.polish(expr, Z[fit_rows], y[fit_rows])
+        scores.append(metrics(e, Z[fit_rows], Z[held], y[fit_rows], y[held])["r2_test"])
+    return float(np.mean(scores))
+
+
 def pareto_front(entries: list, key: str = "r2_train") -> list:
     """Entries not dominated in (complexity low, ``key`` high), simplest first."""
     front, best = [], -np.inf
@@ -139,7 +164,7 @@ def distill(X, y, backend: str = "operon", names=None, *, max_complexity: int | 
             test_size: float = 0.2, seed: int = 42, search_seed: int | None = None, zscore: bool = True,
             n_threads: int = 1,
             time_limit: float | None = None, polish: bool | None = None, prune: bool | None = None, digits: int = 4,
-            validation: float = 0.0, **options) -> DistillResult:
+            validation: float = 0.0, finalists: int = 5, cv_folds: int = 5, **options) -> DistillResult:
     """Fit a compact formula y ≈ f(z(X)).
 
     Parameters
@@ -168,6 +193,10 @@ def distill(X, y, backend: str = "operon", names=None, *, max_complexity: int | 
         candidates (0: choose on training R²). The search and the constants
         see only the rest; the chosen formula's constants are then refitted
         on all training rows. The test rows are never seen.
+    finalists, cv_folds : with ``validation``, the ``finalists`` best on the
+        held-out part are compared by ``cv_folds``-fold cross-validation over
+        all training rows (constants refitted per fold), which a single
+        held-out part is too noisy to separate
     **options : passed to the back end (e.g. max_length, generations, degree, rational)
 
     Returns
@@ -228,6 +257,12 @@ def distill(X, y, backend: str = "operon", names=None, *, max_complexity: int | 
         pool = [e for e in entries if e["complexity"] <= max_complexity]
         pool = pool or [min(entries, key=lambda e: e["complexity"])]
         pick = max(pool, key=lambda e: e[rank])
+        if Zval is not None and finalists > 1:  # one held-out part is noisy: the finalists by K-fold CV
+            short = sorted(pool, key=lambda e: -e[rank])[:int(finalists)]
+            for e in short:
+                e["r2_cv"] = cv_r2(e["expression"], Ztr, ytr, folds=cv_folds, seed=seed)
+            pick = max(short, key=lambda e: e["r2_cv"])
+            rank = "r2_cv"
     else:
         own = [e for e in entries if e["_chosen"]]
         pick = own[0] if own else max(entries, key=lambda e: e[rank])
