@@ -62,7 +62,7 @@ def skeleton(Z, y, *, seed=42, n_threads=1, time_limit=None, budget=20, **extra)
     """Every product skeleton within ``budget`` nodes, constants by variable
     projection (`satmd.explain.skeletons`): deterministic, no dependency beyond SciPy.
     ``n_threads`` is accepted for a uniform interface (the pass is serial)."""
-    from .skeletons import search
+    from .skeleton_search import search
 
     found, info = search(Z, y, budget=int(budget), seed=int(seed), time_limit=time_limit, **extra)
     return [text for _, text in found], None, info

@@ -1,4 +1,4 @@
-"""Exhaustive pass over small product skeletons, constants fitted by variable projection.
+"""Small product skeletons for symbolic distillation, constants fitted by variable projection.
 
 Genetic searches such as operon's put a free weight on every variable leaf,
 so a formula they return pays three nodes (``Mul``, the weight, the symbol)
@@ -7,16 +7,23 @@ for each variable; the compact formulas a person writes, like the paper's
 affine form with a bare variable and reach the same accuracy with fewer
 nodes. This back end enumerates that family directly:
 
-    y ≈ c0 + c1 · A · B  [+ c2 · x_k]
+    y ≈ c0 + c1 · F1 [· F2 [· F3]]  + Σ_k c_k · x_k
 
-where ``A`` is an affine form ``x_i + a + Σ b_j x_j`` (its lead variable bare)
-and ``B`` is one of ``S`` (an affine form squared, optionally plus a bare
-variable), ``exp(Σ b_j x_j)``, ``1/S`` or ``1/A'``. Every skeleton whose node
-count (`symbolic.node_count`, the counting rule of the module) fits the budget
-is fitted: the outer constants c by linear least squares for each value of the
-inner ones, the inner ones by Levenberg-Marquardt on that projected residual
-(variable projection), on a subsample of the training rows. The best are then
-refitted on all training rows from several starts. Deterministic for a seed.
+with one to three factors ``F``: an affine form ``x_i + a + Σ b_j x_j`` (its
+lead variable bare), ``S`` (an affine form squared, optionally plus a bare
+variable), ``exp(Σ b_j x_j)``, ``1/S`` or ``1/A``, and as many linear terms
+``c_k x_k`` as the node budget leaves room for (every choice of variables).
+`skeletons` lists every skeleton whose node count (`symbolic.node_count`, the
+counting rule of the module) fits the budget; `fit` fits one: the outer
+constants c by linear least squares for each value of the inner ones, the
+inner ones by Levenberg-Marquardt on that projected residual (variable
+projection). `satmd.explain.skeleton_search` searches the family with a beam.
+
+A standalone affine factor is fitted scale-free, as ``1 + Σ w_j x_j`` (c1
+absorbs the scale): its offset ``a = 1/w_lead`` may lie far outside the data
+(a factor that only tilts the product, like ``(x2 − 6.5)``), where the offset
+form has almost no gradient. Inside a square the offset form is kept, since
+the square's centre is what the fit has to find.
 """
 from __future__ import annotations
 
@@ -33,7 +40,7 @@ class Affine:
     """``x_lead + a + Σ b_j x_j`` (``cv`` the variables with a free coefficient)."""
 
     lead: int
-    cv: tuple
+    cv: tuple = ()
 
     @property
     def n_params(self):
@@ -44,19 +51,37 @@ class Affine:
         return 3 + 3 * len(self.cv)
 
     def value(self, p, Zt):
+        """Scale-free: ``1 + w_lead x_lead + Σ w_j x_j``."""
+        out = 1.0 + p[0] * Zt[self.lead]
+        for w, j in zip(p[1:], self.cv):
+            out = out + w * Zt[j]
+        return out
+
+    def text(self, p):
+        """``(scale, text)`` with value = scale · text; the largest weight is written bare."""
+        vs = (self.lead, *self.cv)
+        k = int(np.argmax(np.abs(p)))
+        s = float(p[k])
+        if abs(s) < 1e-12:
+            return 1.0, "1"
+        terms = [f"x{vs[k]}", f"({1.0 / s:.10g})"] + [f"({p[i] / s:.10g})*x{v}" for i, v in enumerate(vs) if i != k]
+        return s, "(" + " + ".join(terms) + ")"
+
+    def offset_value(self, p, Zt):
+        """Offset form: ``x_lead + p0 + Σ p_j x_j`` (inside a square)."""
         out = Zt[self.lead] + p[0]
         for b, j in zip(p[1:], self.cv):
             out = out + b * Zt[j]
         return out
 
-    def text(self, p):
+    def offset_text(self, p):
         return "(" + " + ".join([f"x{self.lead}", f"({p[0]:.10g})"]
                                 + [f"({b:.10g})*x{j}" for b, j in zip(p[1:], self.cv)]) + ")"
 
 
 @dataclass(frozen=True)
 class Square:
-    """``A² [+ x_bare]``."""
+    """``A² [+ x_bare]`` (``A`` in its offset form)."""
 
     inner: Affine
     bare: int | None = None
@@ -70,12 +95,12 @@ class Square:
         return self.inner.nodes + 2 + (2 if self.bare is not None else 0)
 
     def value(self, p, Zt):
-        out = self.inner.value(p, Zt) ** 2
+        out = self.inner.offset_value(p, Zt) ** 2
         return out if self.bare is None else out + Zt[self.bare]
 
     def text(self, p):
-        sq = f"{self.inner.text(p)}**2"
-        return sq if self.bare is None else f"({sq} + x{self.bare})"
+        sq = f"{self.inner.offset_text(p)}**2"
+        return 1.0, sq if self.bare is None else f"({sq} + x{self.bare})"
 
 
 @dataclass(frozen=True)
@@ -96,7 +121,7 @@ class Exp:
         return np.exp(sum(b * Zt[j] for b, j in zip(p, self.vs)))
 
     def text(self, p):
-        return "exp(" + " + ".join(f"({b:.10g})*x{j}" for b, j in zip(p, self.vs)) + ")"
+        return 1.0, "exp(" + " + ".join(f"({b:.10g})*x{j}" for b, j in zip(p, self.vs)) + ")"
 
 
 @dataclass(frozen=True)
@@ -117,70 +142,68 @@ class Inverse:
         return 1.0 / self.inner.value(p, Zt)
 
     def text(self, p):
-        return f"1/{self.inner.text(p)}"
+        s, t = self.inner.text(p)
+        return 1.0 / s, f"1/{t}"
 
 
 @dataclass(frozen=True)
 class Skeleton:
-    """``c0 + c1 · A · B [+ c2 · E]``: ``E`` a variable (index) or a one-variable block."""
+    """``c0 + c1 · Π factors + Σ c_k · E_k``: each ``E`` a variable (index) or a one-variable block."""
 
-    a: Affine
-    b: object
-    extra: object = None
+    factors: tuple
+    extras: tuple = ()
 
     @property
     def nodes(self):
-        extra = 0 if self.extra is None else 3 if isinstance(self.extra, int) else 2 + self.extra.nodes
-        return 4 + self.a.nodes + self.b.nodes + extra
+        extras = sum(3 if isinstance(e, int) else 2 + e.nodes for e in self.extras)
+        return 4 + sum(f.nodes for f in self.factors) + extras
+
+    @property
+    def blocks(self):
+        """The blocks with inner constants, in the order of the parameter vector."""
+        return [*self.factors, *(e for e in self.extras if not isinstance(e, int))]
 
     @property
     def n_inner(self):
-        return self.a.n_params + self.b.n_params + self._n_extra
+        return sum(b.n_params for b in self.blocks)
 
-    @property
-    def _n_extra(self):
-        return 0 if self.extra is None or isinstance(self.extra, int) else self.extra.n_params
-
-    def product(self, p, Zt):
-        k = self.a.n_params
-        m = k + self.b.n_params
-        return self.a.value(p[:k], Zt) * self.b.value(p[k:m], Zt)
-
-    def _extra(self, p, Zt):
-        if isinstance(self.extra, int):
-            return Zt[self.extra]
-        return self.extra.value(p[self.n_inner - self._n_extra:], Zt)
+    def _split(self, p):
+        out, k = [], 0
+        for b in self.blocks:
+            out.append(p[k:k + b.n_params])
+            k += b.n_params
+        return out
 
     def columns(self, p, Zt):
-        """The columns multiplying c1 (and c2); c0 multiplies ones."""
-        cols = [self.product(p, Zt)]
-        if self.extra is not None:
-            cols.append(self._extra(p, Zt))
-        return cols
+        """The columns multiplying c1, c2, ...; c0 multiplies ones."""
+        parts = iter(self._split(p))
+        product = 1.0
+        for f in self.factors:
+            product = product * f.value(next(parts), Zt)
+        return [product] + [Zt[e] if isinstance(e, int) else e.value(next(parts), Zt) for e in self.extras]
 
     def text(self, p, c):
-        k = self.a.n_params
-        m = k + self.b.n_params
-        out = f"({c[0]:.10g}) + ({c[1]:.10g})*{self.a.text(p[:k])}*{self.b.text(p[k:m])}"
-        if self.extra is None:
-            return out
-        extra = f"x{self.extra}" if isinstance(self.extra, int) else self.extra.text(p[m:])
-        return out + f" + ({c[2]:.10g})*{extra}"
+        parts = iter(self._split(p))
+        scale, texts = 1.0, []
+        for f in self.factors:
+            s, t = f.text(next(parts))
+            scale, texts = scale * s, texts + [t]
+        out = f"({c[0]:.10g}) + ({c[1] * scale:.10g})*" + "*".join(texts)
+        for ck, e in zip(c[2:], self.extras):
+            if isinstance(e, int):
+                out += f" + ({ck:.10g})*x{e}"
+            else:
+                s, t = e.text(next(parts))
+                out += f" + ({ck * s:.10g})*{t}"
+        return out
 
 
-def skeletons(d: int, budget: int, order=None) -> list:
-    """Every skeleton in ``d`` variables with at most ``budget`` nodes, the largest
-    (most expressive) first: the simpler ones are what a genetic search finds well.
-
-    An affine form's scale is absorbed by c1 wherever it stands alone, so each
-    variable set gets one lead variable there; inside a square plus a bare
-    variable the lead sets the bare variable's weight, so every lead is tried.
-    ``order``: the variables by importance (`search` uses |correlation with y|);
-    a set's lead is its most important variable, which starts the fit nearest
-    the optimum (the others' coefficients start small).
-    """
+def _factor_pool(d: int, order: list) -> list:
+    """The blocks a product is made of. An affine form's scale is absorbed by c1
+    where it stands alone, so each variable set gets one lead variable there;
+    inside a square plus a bare variable the lead sets the bare variable's weight,
+    so every lead is tried. A set's lead is its most important variable (``order``)."""
     V = range(d)
-    order = list(V) if order is None else [int(v) for v in order]
     sets = [c for k in (1, 2, 3) for c in itertools.combinations(order, k)]
     canon = [Affine(c[0], c[1:]) for c in sets]
     leads = [Affine(lead, cv) for lead in V for k in (0, 1)
@@ -188,34 +211,63 @@ def skeletons(d: int, budget: int, order=None) -> list:
     squares = [Square(a) for a in canon if len(a.cv) <= 1]
     squares += [Square(a, bare) for a in leads for bare in V if bare != a.lead and bare not in a.cv]
     exps = [Exp(vs) for k in (1, 2) for vs in itertools.combinations(V, k)]
-    partners = squares + exps + [Inverse(s) for s in squares if s.bare is None] + [Inverse(a) for a in canon]
-    extras = [Exp((v,)) for v in V] + [Inverse(Affine(v, ())) for v in V] + [Square(Affine(v, ())) for v in V]
+    inverses = [Inverse(s) for s in squares if s.bare is None] + [Inverse(a) for a in canon]
+    return canon + squares + exps + inverses
+
+
+def _admissible(factors: tuple) -> bool:
+    """One exponential at most (a product of two is one exponential), no block
+    beside its own inverse, and not a lone affine form (the linear terms cover it)."""
+    if sum(isinstance(f, Exp) for f in factors) > 1:
+        return False
+    if any(isinstance(f, Inverse) and f.inner in factors for f in factors):
+        return False
+    return not (len(factors) == 1 and isinstance(factors[0], Affine))
+
+
+def skeletons(d: int, budget: int, order=None, max_factors: int = 3, block_extras: bool = False) -> list:
+    """Every skeleton in ``d`` variables with at most ``budget`` nodes, the largest
+    (most expressive) first: the simpler ones are what a genetic search finds well.
+
+    Each product gets as many linear terms as the budget leaves room for, in every
+    choice of variables (fewer never fit better). ``order``: the variables by
+    importance (`search` uses |correlation with y|); a set's lead is its most
+    important variable, which starts the fit nearest the optimum. ``block_extras``
+    also tries one term ``exp(b x_k)``, ``1/(x_k + a)`` or ``(x_k + a)²`` in place
+    of linear ones.
+    """
+    V = range(d)
+    order = list(V) if order is None else [int(v) for v in order]
+    pool = _factor_pool(d, order)
+    one_var = [Exp((v,)) for v in V] + [Inverse(Affine(v)) for v in V] + [Square(Affine(v)) for v in V]
     out = []
-    for a in canon:
-        for b in partners:
-            if isinstance(b, Inverse) and b.inner == a:
+    for k in range(1, max_factors + 1):
+        for factors in itertools.combinations_with_replacement(pool, k):
+            head = 4 + sum(f.nodes for f in factors)
+            if head > budget or not _admissible(factors):
                 continue
-            for extra in [None] + list(V) + extras:
-                sk = Skeleton(a, b, extra)
-                if sk.nodes <= budget:
-                    out.append(sk)
+            for block in [None] + (one_var if block_extras else []):
+                room = budget - head - (0 if block is None else 2 + block.nodes)
+                if room < 0:
+                    continue
+                for linear in itertools.combinations(V, min(d, room // 3)):
+                    out.append(Skeleton(factors, tuple(linear) + (() if block is None else (block,))))
     return sorted(out, key=lambda s: (-s.nodes, s.n_inner))
 
 
 def _initial(sk: Skeleton, start: int, rng) -> np.ndarray:
-    """Inner constants to start from: affine offsets spread over (and beyond) the
-    z-score range, where a square's centre or a pole may lie; small coefficients and exponents."""
+    """Inner constants to start from. Scale-free affine weights start small (the
+    factor near 1), a square's offset is spread over (and beyond) the z-score range
+    where its centre may lie, exponents start small."""
     offsets = (0.0, 3.0, -3.0, 1.5)
-    blocks = [sk.a, sk.b] + ([sk.extra] if sk._n_extra else [])
     p = []
-    for n, block in enumerate(blocks):
+    for n, block in enumerate(sk.blocks):
         inner = block.inner if isinstance(block, Inverse) else block
-        inner = inner.inner if isinstance(inner, Square) else inner
-        if isinstance(inner, Affine):
-            offset = offsets[(start + n) % 4] if isinstance(block, Affine) else offsets[(start + 1 + n) % 4]
-            if isinstance(block, Inverse) and offset == 0.0:
-                offset = 3.0  # start away from the pole
-            p += [offset + 0.1 * rng.standard_normal()] + list(0.3 * rng.standard_normal(len(inner.cv)))
+        if isinstance(inner, Square):
+            offset = offsets[(start + 1 + n) % 4] + 0.1 * rng.standard_normal()
+            p += [offset] + list(0.3 * rng.standard_normal(len(inner.inner.cv)))
+        elif isinstance(inner, Affine):
+            p += list((0.1 if start == 0 else 0.4) * rng.standard_normal(inner.n_params))
         else:
             p += list(0.5 * rng.standard_normal(inner.n_params))
     return np.asarray(p, float)
@@ -223,31 +275,29 @@ def _initial(sk: Skeleton, start: int, rng) -> np.ndarray:
 
 def _project(cols: list, y: np.ndarray):
     """Residual and coefficients of y on [1, cols...] by least squares, via the
-    centred normal equations (one or two columns: far cheaper than ``lstsq``)."""
-    n = y.size
-    ym = y.sum() / n
+    centred normal equations (a few columns: far cheaper than ``lstsq``);
+    rank-deficient columns get the minimum-norm answer."""
+    A = np.column_stack(cols)
+    means = A.mean(axis=0)
+    ym = y.mean()
+    C = A - means
     yc = y - ym
-    means = [c.sum() / n for c in cols]
-    C = [c - m for c, m in zip(cols, means)]
-    if len(C) == 1:
-        den = float(C[0] @ C[0])
-        b = (float(C[0] @ yc) / den,) if den > 0 else (0.0,)
-        r = b[0] * C[0] - yc
-    else:
-        g00, g01, g11 = float(C[0] @ C[0]), float(C[0] @ C[1]), float(C[1] @ C[1])
-        h0, h1 = float(C[0] @ yc), float(C[1] @ yc)
-        det = g00 * g11 - g01 * g01
-        if det <= 1e-12 * (g00 * g11 + 1e-300):
-            b = (h0 / g00 if g00 > 0 else 0.0, 0.0)
-        else:
-            b = ((g11 * h0 - g01 * h1) / det, (g00 * h1 - g01 * h0) / det)
-        r = b[0] * C[0] + b[1] * C[1] - yc
-    c0 = ym - sum(bi * m for bi, m in zip(b, means))
-    return r, np.array([c0, *b])
+    G = C.T @ C
+    h = C.T @ yc
+    try:
+        b = np.linalg.solve(G, h)
+        ok = np.all(np.isfinite(b)) and np.linalg.cond(G) < 1e12
+    except np.linalg.LinAlgError:
+        ok = False
+    if not ok:
+        b, *_ = np.linalg.lstsq(C, yc, rcond=None)
+    return C @ b - yc, np.array([ym - means @ b, *b])
 
 
-def fit(sk: Skeleton, Zt: np.ndarray, y: np.ndarray, starts: int = 2, seed: int = 0, max_nfev: int | None = None):
-    """Variable-projection fit of one skeleton: (R², inner constants, outer constants)."""
+def fit(sk: Skeleton, Zt: np.ndarray, y: np.ndarray, starts: int = 2, seed: int = 0, max_nfev: int | None = None,
+        p0=None):
+    """Variable-projection fit of one skeleton: (R², inner constants, outer constants).
+    ``p0``: inner constants for the first start (a warm start), else `_initial`'s."""
     rng = np.random.default_rng(seed)
     sst = float(np.sum((y - y.mean()) ** 2)) or 1.0
     bad = np.full(y.shape, 1e3)
@@ -262,7 +312,8 @@ def fit(sk: Skeleton, Zt: np.ndarray, y: np.ndarray, starts: int = 2, seed: int 
     best = None
     for s in range(starts):
         try:
-            sol = least_squares(residual, _initial(sk, s, rng), method="lm",
+            start = np.asarray(p0, float) if (p0 is not None and s == 0) else _initial(sk, s, rng)
+            sol = least_squares(residual, start, method="lm",
                                 max_nfev=max_nfev or 25 * (sk.n_inner + 1))
         except (ValueError, np.linalg.LinAlgError):
             continue
@@ -273,41 +324,3 @@ def fit(sk: Skeleton, Zt: np.ndarray, y: np.ndarray, starts: int = 2, seed: int 
     with np.errstate(all="ignore"):
         r, c = _project(sk.columns(best.x, Zt), y)
     return 1.0 - float(r @ r) / sst, best.x, c
-
-
-def search(Z, y, *, budget: int = 20, seed: int = 0, time_limit: float | None = 60.0, subsample: int = 500,
-           keep: int = 24, starts: int = 6, block_extras: bool = False) -> tuple:
-    """Fit every skeleton within ``budget`` on a subsample, refit the ``keep`` best on all rows.
-
-    Returns ``([(r2_train, text), ...], info)``, best first (infix strings in
-    x0..); ``info`` says how many skeletons were fitted of how many.
-    ``time_limit`` caps the first pass (the largest skeletons are visited first).
-    ``block_extras`` also tries ``exp(b x_k)``, ``1/(x_k + a)`` and ``(x_k + a)²``
-    as the extra term (slower; on the SPEC §6 data they never won).
-    """
-    Z = np.asarray(Z, float)
-    y = np.asarray(y, float)
-    rng = np.random.default_rng(seed)
-    rows = rng.choice(y.size, min(subsample, y.size), replace=False)
-    Zs, ys = Z[rows].T, y[rows]
-    t0 = time.perf_counter()
-    with np.errstate(all="ignore"):
-        corr = np.nan_to_num([abs(np.corrcoef(z, y)[0, 1]) for z in Z.T])
-    pool = [sk for sk in skeletons(Z.shape[1], budget, order=np.argsort(-corr, kind="stable"))
-            if block_extras or sk.extra is None or isinstance(sk.extra, int)]
-    scored, fitted = [], 0
-    for i, sk in enumerate(pool):
-        if time_limit is not None and time.perf_counter() - t0 > time_limit:
-            break
-        r2, _, _ = fit(sk, Zs, ys, starts=2, seed=seed + i)
-        fitted += 1
-        if np.isfinite(r2):
-            scored.append((r2, sk))
-    scored.sort(key=lambda t: -t[0])
-    out = []
-    for _, sk in scored[:keep]:
-        r2, p, c = fit(sk, Z.T, y, starts=starts, seed=seed, max_nfev=100 * (sk.n_inner + 1))
-        if p is not None and np.isfinite(r2):
-            out.append((r2, sk.text(p, c)))
-    info = {"skeletons": len(pool), "skeletons_fitted": fitted, "skeleton_s": time.perf_counter() - t0}
-    return sorted(out, key=lambda t: -t[0]), info

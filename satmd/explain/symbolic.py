@@ -52,6 +52,47 @@ def node_count(expr) -> int:
     return sum(1 for _ in sp.preorder_traversal(sp.sympify(expr)))
 
 
+def binary_node_count(expr) -> int:
+    """Nodes of the formula written as a binary tree, the way PySR counts
+    complexity: an n-ary sum or product costs n − 1 operators, ``a − b`` and
+    ``a / b`` one operator each, ``x²`` one (``square``), other powers two
+    (``pow`` and the exponent), a function one. `node_count`'s n-ary rule makes
+    long sums and products cheaper; both rules are reported so a comparison
+    can be read either way. Count the `compact` form (sympy distributes a
+    number over a sum as it parses).
+
+    Parameters
+    ----------
+    expr : sympy expression or a string sympy can parse.
+
+    Returns
+    -------
+    int
+    """
+    def count(e):
+        if e.is_Atom:
+            return 1
+        if e.is_Add or e.is_Mul:
+            args, negate = list(e.args), 0
+            if e.is_Mul:  # a unit coefficient is not written; −1 alone is a negation
+                units = [a for a in args if a.is_Number and float(abs(a)) == 1.0]
+                args = [a for a in args if a not in units] or [sp.Integer(1)]
+                negate = int(any(float(u) < 0 for u in units))
+            total = len(args) - 1 + negate
+            for a in args:
+                if e.is_Add and a.is_Mul and a.args[0].is_Number and a.args[0] < 0:  # a − b
+                    a = -a
+                elif e.is_Mul and a.is_Pow and a.exp == -1:  # a / b
+                    a = a.base
+                total += count(a)
+            return total
+        if e.is_Pow:
+            return count(e.base) + (1 if e.exp == 2 else 2 if e.exp == -1 else 1 + count(e.exp))
+        return 1 + sum(count(a) for a in e.args)
+
+    return count(sp.sympify(expr))
+
+
 def compact(expr: sp.Expr, max_nodes: int = 80) -> sp.Expr:
     """The smallest (by `node_count`) of a few algebraically identical forms.
 

@@ -9,6 +9,7 @@ pytest.importorskip("sympy")
 from satmd.errors import DataError  # noqa: E402
 from satmd.explain import distill, modal_physics  # noqa: E402
 from satmd.explain import skeletons as K  # noqa: E402
+from satmd.explain.skeleton_search import search  # noqa: E402
 from satmd.explain import symbolic as S  # noqa: E402
 from satmd.physics import Rig  # noqa: E402
 
@@ -29,7 +30,7 @@ def test_node_count_of_a_skeleton_bounds_its_formula():
     for i in rng.choice(len(pool), 60, replace=False):
         sk = pool[i]
         p = np.linspace(0.31, 0.77, sk.n_inner)
-        expr = S.compact(S.parse(sk.text(p, [1.23, 0.45, 0.67]), 4))
+        expr = S.compact(S.parse(sk.text(p, np.linspace(1.23, 0.45, 2 + len(sk.extras))), 4))
         assert S.node_count(expr) <= sk.nodes, (sk, expr)
         exact += S.node_count(expr) == sk.nodes
     assert exact > 30  # the count is the formula's, not a loose bound
@@ -38,13 +39,19 @@ def test_node_count_of_a_skeleton_bounds_its_formula():
 def test_the_paper_skeleton_is_in_the_pool_at_its_node_count():
     """c0 + c1 (x1 + a + b x2 + c x3)((x1 + d)² + x0): the paper's formula, 20 nodes."""
     pool = K.skeletons(4, 20)
-    paper = [sk for sk in pool if sk.a == K.Affine(1, (2, 3)) and sk.b == K.Square(K.Affine(1, ()), 0)
-             and sk.extra is None]
-    assert len(paper) == 1 and paper[0].nodes == 20 == S.paper_complexity()
+    paper = [sk for sk in pool if set(sk.factors) == {K.Affine(1, (2, 3)), K.Square(K.Affine(1, ()), 0)}]
+    assert len(paper) == 1 and paper[0].nodes == 20 == S.paper_complexity() and paper[0].extras == ()
+
+
+def test_the_budget_buys_linear_terms():
+    """What the factors leave of the budget goes to linear terms, in every choice of variables."""
+    pool = K.skeletons(4, 20)
+    m2lin = [sk for sk in pool if sk.factors == (K.Affine(2), K.Affine(3), K.Exp((1,)))]
+    assert len(m2lin) == 6 and {sk.nodes for sk in m2lin} == {20} and all(len(sk.extras) == 2 for sk in m2lin)
 
 
 @settings(max_examples=25, deadline=None)
-@given(st.integers(0, 10**6), st.integers(1, 2))
+@given(st.integers(0, 10**6), st.integers(1, 4))
 def test_projection_is_least_squares(seed, k):
     rng = np.random.default_rng(seed)
     cols = [rng.standard_normal(50) for _ in range(k)]
@@ -58,8 +65,8 @@ def test_projection_is_least_squares(seed, k):
 
 def test_search_recovers_a_planted_skeleton_exactly():
     Z, y = planted()
-    found, info = K.search(Z, y, budget=15, seed=0, time_limit=None, subsample=300, keep=8)
-    assert info["skeletons_fitted"] == info["skeletons"] > 50
+    found, info = search(Z, y, budget=15, seed=0, time_limit=None, subsample=300, keep=8)
+    assert info["products_scored"] > 50 and info["skeletons_fitted"] > 0
     r2, text = found[0]
     assert r2 > 1 - 1e-9
     expr = S.compact(S.parse(text, 3))
@@ -116,9 +123,10 @@ def test_block_extras_recover_a_planted_exponential_term():
     rng = np.random.default_rng(3)
     Z = rng.standard_normal((300, 2))
     y = 1 + 0.3 * (Z[:, 1] + 2) * np.exp(0.5 * Z[:, 0]) + 0.8 * np.exp(-0.7 * Z[:, 1])
-    plain, _ = K.search(Z, y, budget=17, seed=0, time_limit=None, subsample=300, keep=4)
-    found, info = K.search(Z, y, budget=17, seed=0, time_limit=None, subsample=300, keep=4, block_extras=True)
-    assert info["skeletons"] > len(K.skeletons(2, 17)) // 2
+    plain, _ = search(Z, y, budget=17, seed=0, time_limit=None, subsample=300, keep=4)
+    found, info = search(Z, y, budget=17, seed=0, time_limit=None, subsample=300, keep=4, block_extras=True,
+                           expand=200)  # every product: their ranking sees linear terms only
+    assert info["skeletons_fitted"] > 0
     assert found[0][0] > 1 - 1e-9 > plain[0][0]
 
 
@@ -155,3 +163,34 @@ def test_hybrid_without_pyoperon_runs_the_skeletons_alone(monkeypatch):
                   skeleton_options={"subsample": 200, "keep": 4})
     assert "not installed" in res.info["operon"] and res.info["operon_candidates"] == 0
     assert res.r2_test > 0.999
+
+
+def test_binary_node_count_is_pysr_style():
+    """A sum or product of n terms costs n − 1 operators; − and / one each; x² one; the paper's formula is 20 either way."""
+    cases = {"x0/x1": 3, "x0 - x1": 3, "x0**2": 2, "1/x0": 3, "-x0": 2, "exp(x0)": 2, "2*x0 - 3*x1": 7,
+             "x0*x1/(x0 + 1)": 7, "x0**3": 3}
+    for text, n in cases.items():
+        assert S.binary_node_count(S.parse(text, 2)) == n, text
+    paper = S.compact(S.parse(S.PAPER_FORMULA, 4))
+    assert S.binary_node_count(paper) == S.node_count(paper) == 20
+    total = S.parse("x0 + x1 + x2 + x3", 4)  # an n-ary sum is cheaper by the sympy rule
+    assert (S.binary_node_count(total), S.node_count(total)) == (7, 5)
+
+
+@settings(max_examples=40, deadline=None)
+@given(st.integers(0, 10**6))
+def test_written_formula_is_the_fitted_model(seed):
+    """The text of a skeleton (scale-free affine factors written with a bare lead) evaluates to
+    c0 + c1·Π factors + Σ c_k·extras, the model the constants were fitted for."""
+    rng = np.random.default_rng(seed)
+    pool = K.skeletons(3, 17, block_extras=True)
+    sk = pool[rng.integers(len(pool))]
+    p = rng.uniform(0.2, 0.6, sk.n_inner) * rng.choice([-1, 1], sk.n_inner)
+    c = rng.normal(size=2 + len(sk.extras))
+    Z = rng.uniform(-0.5, 0.5, (20, 3))
+    with np.errstate(all="ignore"):
+        cols = sk.columns(p, Z.T)
+    assume(all(np.all(np.isfinite(col)) for col in cols))
+    model = c[0] + sum(ck * col for ck, col in zip(c[1:], cols))
+    written = S.evaluate(S.parse(sk.text(p, c), 3), Z)
+    np.testing.assert_allclose(written, model, rtol=1e-8, atol=1e-8)
