@@ -9,7 +9,7 @@ from __future__ import annotations
 
 from ..explain.attributions import OUTPUTS, PAPER_TABLE3, TABLE3_LABELS
 from ..explain.run import AGREEMENT_KEYS, COMPLEXITY_CAP, MODAL_CAP, SPACES, NeuralAnalysis, SymbolicAnalysis
-from ..explain.symbolic import PAPER_METRICS
+from ..explain.symbolic import PAPER_FORMULA, PAPER_METRICS, binary_node_count, compact, parse
 
 
 def explain_model(model, figure, backend: str = "hybrid", quick: bool = False, symbolic: bool = True,
@@ -154,7 +154,9 @@ def symbolic_markdown(s: SymbolicAnalysis, figure) -> str:
           f"ξ = ‖U1 − U1_nom‖₂ / ‖U1_nom‖₂ on the paper grid, nominal (R, L, m2, kp) = (20, 0.05, 0.3, 50e3); "
           f"{len(s.y)} samples on the SPEC §6 grid, inputs z-scored (x0..x3 = R, L, m2, kp), 80/20 split "
           f"(seed 42). Complexity = nodes of the sympy expression tree (`satmd.explain.symbolic.node_count`); "
-          f"the paper's formula has {cap} nodes by the same rule.", "",
+          f"the paper's formula has {cap} nodes by the same rule. Written as a binary tree (PySR's count, "
+          f"`binary_node_count`), the {backend} formula below has {binary_node_count(res.expression)} nodes and the "
+          f"paper's {binary_node_count(compact(parse(PAPER_FORMULA, 4)))}.", "",
           "| formula | nodes | MAE train | MAE test | R² train | R² test |", "|---|---|---|---|---|---|",
           _row("paper (as printed), reported", cap, PAPER_METRICS),
           _row("paper formula on our data", s.paper["complexity"], s.paper),
