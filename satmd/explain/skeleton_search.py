@@ -7,27 +7,11 @@ are fitted in every budgeted form.
 """
 from __future__ import annotations
 
-import itertools
 import time
 
 import numpy as np
 
-from .skeletons import Affine, Exp, Inverse, Skeleton, Square, _admissible, _factor_pool, _initial, _project, fit
-
-
-def _budgeted(factors: tuple, d: int, budget: int, block_extras: bool) -> list:
-    """The skeletons of one product within ``budget``: as many linear terms as fit,
-    in every choice of variables (optionally one one-variable block among them)."""
-    head = 4 + sum(f.nodes for f in factors)
-    blocks = [None] + ([Exp((v,)) for v in range(d)] + [Inverse(Affine(v)) for v in range(d)]
-                       + [Square(Affine(v)) for v in range(d)] if block_extras else [])
-    out = []
-    for block in blocks:
-        room = budget - head - (0 if block is None else 2 + block.nodes)
-        if room >= 0:
-            out += [Skeleton(factors, lin + (() if block is None else (block,)))
-                    for lin in itertools.combinations(range(d), min(d, room // 3))]
-    return out
+from .skeletons import Skeleton, _admissible, _factor_pool, _initial, _project, budgeted, fit
 
 
 def _grow(parent: tuple, p_parent, new, factors: tuple, p_new) -> np.ndarray:
@@ -74,8 +58,7 @@ def search(Z, y, *, budget: int = 20, seed: int = 0, time_limit: float | None = 
         corr = np.nan_to_num([abs(np.corrcoef(z, y)[0, 1]) for z in Z.T])
     pool = _factor_pool(d, [int(v) for v in np.argsort(-corr, kind="stable")])
     everything = tuple(range(d))
-    sst = float(np.sum((ys - ys.mean()) ** 2)) or 1.0
-    budgeted, fitted, level, n_fit = {}, {(): np.zeros(0)}, [()], 0
+    ranked, fitted, level, n_fit = {}, {(): np.zeros(0)}, [()], 0
     for width in (*beam, 0):
         grown = {}
         for product in level:
@@ -87,7 +70,7 @@ def search(Z, y, *, budget: int = 20, seed: int = 0, time_limit: float | None = 
         for factors, (parent, new) in grown.items():
             if time_limit is not None and time.perf_counter() - t0 > time_limit:
                 break
-            choices = _budgeted(factors, d, budget, block_extras=False)
+            choices = budgeted(factors, d, budget, block_extras=False)
             if not choices:
                 continue
             warm = _grow(parent, fitted[parent], new, factors, _initial(Skeleton((new,)), 1, rng))
@@ -106,11 +89,11 @@ def search(Z, y, *, budget: int = 20, seed: int = 0, time_limit: float | None = 
                 sk = min(choices, key=projected)
                 best = (fit(sk, Zs, ys, starts=1, seed=seed + n_fit, p0=p)[0], sk)
             if np.isfinite(best[0]):
-                budgeted[factors] = best
-        level = sorted((f for f in grown if f in budgeted), key=lambda f: -budgeted[f][0])[:width]
-    best_products = sorted(budgeted, key=lambda f: -budgeted[f][0])[:expand]
+                ranked[factors] = best
+        level = sorted((f for f in grown if f in ranked), key=lambda f: -ranked[f][0])[:width]
+    best_products = sorted(ranked, key=lambda f: -ranked[f][0])[:expand]
     scored = []
-    for i, (f, sk) in enumerate((f, sk) for f in best_products for sk in _budgeted(f, d, budget, block_extras)):
+    for i, (f, sk) in enumerate((f, sk) for f in best_products for sk in budgeted(f, d, budget, block_extras)):
         warm = np.concatenate([fitted[f], _initial(sk, 0, rng)[len(fitted[f]):]])  # a block term starts fresh
         r2, p, _ = fit(sk, Zs, ys, starts=2, seed=seed + i, p0=warm)
         if np.isfinite(r2):

@@ -28,7 +28,6 @@ the square's centre is what the fit has to find.
 from __future__ import annotations
 
 import itertools
-import time
 from dataclasses import dataclass
 
 import numpy as np
@@ -236,23 +235,43 @@ def skeletons(d: int, budget: int, order=None, max_factors: int = 3, block_extra
     also tries one term ``exp(b x_k)``, ``1/(x_k + a)`` or ``(x_k + a)²`` in place
     of linear ones.
     """
-    V = range(d)
-    order = list(V) if order is None else [int(v) for v in order]
+    order = list(range(d)) if order is None else [int(v) for v in order]
     pool = _factor_pool(d, order)
-    one_var = [Exp((v,)) for v in V] + [Inverse(Affine(v)) for v in V] + [Square(Affine(v)) for v in V]
     out = []
     for k in range(1, max_factors + 1):
         for factors in itertools.combinations_with_replacement(pool, k):
-            head = 4 + sum(f.nodes for f in factors)
-            if head > budget or not _admissible(factors):
-                continue
-            for block in [None] + (one_var if block_extras else []):
-                room = budget - head - (0 if block is None else 2 + block.nodes)
-                if room < 0:
-                    continue
-                for linear in itertools.combinations(V, min(d, room // 3)):
-                    out.append(Skeleton(factors, tuple(linear) + (() if block is None else (block,))))
+            if _admissible(factors):
+                out += budgeted(factors, d, budget, block_extras)
     return sorted(out, key=lambda s: (-s.nodes, s.n_inner))
+
+
+def budgeted(factors: tuple, d: int, budget: int, block_extras: bool = False) -> list:
+    """The skeletons of one product within ``budget``: as many linear terms as fit,
+    in every choice of variables (fewer never fit better); with ``block_extras``
+    also one one-variable block (``exp(b x_k)``, ``1/(x_k + a)``, ``(x_k + a)²``) among them.
+
+    Parameters
+    ----------
+    factors : the product's blocks.
+    d : number of variables.
+    budget : node budget.
+    block_extras : also try one block term.
+
+    Returns
+    -------
+    list of Skeleton (empty when the product alone exceeds the budget)
+    """
+    head = 4 + sum(f.nodes for f in factors)
+    V = range(d)
+    blocks = [None] + ([Exp((v,)) for v in V] + [Inverse(Affine(v)) for v in V] + [Square(Affine(v)) for v in V]
+                       if block_extras else [])
+    out = []
+    for block in blocks:
+        room = budget - head - (0 if block is None else 2 + block.nodes)
+        if room >= 0:
+            out += [Skeleton(factors, lin + (() if block is None else (block,)))
+                    for lin in itertools.combinations(V, min(d, room // 3))]
+    return out
 
 
 def _initial(sk: Skeleton, start: int, rng) -> np.ndarray:
