@@ -18,17 +18,21 @@ Physics (NumPy only):
 - `xi_frf`, `xi_dataset` (eq. 27 and the SPEC §6 grid), `modal_descriptors`
   (resonances, splitting, anti-resonance, peak attenuation);
 - `grid_anova(X, y)`: main-effect and two-way shares of a descriptor over a
-  full-factorial grid, i.e. what additive or pairwise formulas can reach.
+  full-factorial grid, i.e. what additive or pairwise formulas can reach;
+  `structure_ceiling(X, y, products, linear)`: the most any formula of a given
+  sum-of-products structure can reach, whatever the shapes of its factors.
 
 The contract a model must follow is `ExplainableModel` (a typing.Protocol;
 `satmd.inverse.InverseModel` follows it). `satmd.explain.run` computes the
 whole use case as typed results; `satmd.report.explain_text` formats them.
 
-Symbolic distillation: `distill(X, y, backend="operon"|"pysr"|"sindy")`
+Symbolic distillation: `distill(X, y, backend="hybrid"|"skeleton"|"operon"|"pysr"|"sindy")`
 (needs sympy; its names are imported on first use, so ``import
-satmd.explain`` works with NumPy/SciPy alone).
+satmd.explain`` works with NumPy/SciPy alone). The skeleton pass is
+`satmd.explain.skeletons` (the family), `skeleton_search` (the beam) and
+`varpro` (the constants).
 """
-from .anova import GridAnova, grid_anova
+from .anova import GridAnova, grid_anova, structure_ceiling
 from .attributions import BLIND_CASES, PAPER_TABLE3, Attribution, attribution, peak_frequencies, table3_stats
 from .contract import ExplainableModel
 from .descriptors import NOMINAL, XI_GRID, DescriptorData, modal_descriptors, modal_physics, xi_dataset, xi_frf
@@ -52,5 +56,5 @@ __all__ = [
     "latent_map", "LatentMap", "attribution", "Attribution", "table3_stats", "peak_frequencies", "PAPER_TABLE3",
     "BLIND_CASES", "physical_sensitivity", "PhysicalSensitivity", "agreement", "chain_rule_check", "xi_frf",
     "xi_dataset", "modal_descriptors", "modal_physics", "DescriptorData", "NOMINAL", "XI_GRID", "distill", "DistillResult",
-    "paper_formula_result", "grid_anova", "GridAnova", "ExplainableModel", "node_count", "paper_complexity", "PAPER_FORMULA", "PAPER_METRICS",
+    "paper_formula_result", "grid_anova", "GridAnova", "structure_ceiling", "ExplainableModel", "node_count", "paper_complexity", "PAPER_FORMULA", "PAPER_METRICS",
 ]

@@ -136,3 +136,76 @@ def grid_ceiling(X, y, columns) -> float:
     cell = cell.ravel()
     means = np.bincount(cell, y) / np.bincount(cell)
     return float(1.0 - np.sum((y - means[cell]) ** 2) / np.sum((y - y.mean()) ** 2))
+
+
+def structure_ceiling(X, y, products, linear=(), names=None, iters: int = 300, starts: int = 3) -> float:
+    """R² of the best formula of a given structure, with every shape left free.
+
+    The structure is ``c0 + Σ_k a_k x_k + Σ_P Π_{i∈P} g_{P,i}(x_i)``, each g a
+    free value per grid level of its input. On grid data no formula of that
+    structure, whatever its factors' shapes, explains more (up to the
+    alternating least squares finding the optimum: the best of ``starts``
+    starts is returned).
+
+    Example: ``structure_ceiling(X, y, [("L", "m2", "kp")], ("R", "L"), names)``
+    bounds every ``c0 + a R + b L + F(L) G(m2) H(kp)``.
+
+    Parameters
+    ----------
+    X : (n, d) inputs on a full-factorial grid.
+    y : (n,) target.
+    products : the products, each a tuple of input indices or names.
+    linear : the inputs with a linear term.
+    names : names of the d inputs (default x0..).
+    iters : sweeps of the alternating least squares.
+    starts : random starts of the shapes.
+
+    Returns
+    -------
+    float
+    """
+    _cube(X, y)  # a full-factorial grid with a finite target, or a one-line error
+    X = np.asarray(X, float)
+    y = np.asarray(y, float).ravel()
+    d = X.shape[1]
+    names = list(names) if names is not None else [f"x{i}" for i in range(d)]
+
+    def index(v):
+        if isinstance(v, str):
+            if v not in names:
+                raise DataError(f"structure_ceiling: unknown input {v!r} (inputs: {', '.join(names)})")
+            return names.index(v)
+        return int(v)
+
+    products = [tuple(index(v) for v in p) for p in products]
+    linear = [index(v) for v in linear]
+    level = [np.unique(X[:, j], return_inverse=True)[1].ravel() for j in range(d)]
+    sizes = [int(lv.max()) + 1 for lv in level]
+    A = np.column_stack([np.ones(y.size)] + [X[:, j] for j in linear])
+    total = np.sum((y - y.mean()) ** 2)
+    best = -np.inf
+    for start in range(starts):
+        rng = np.random.default_rng(start)
+        shapes = [[1.0 + 0.3 * rng.standard_normal(sizes[j]) for j in p] for p in products]
+
+        def term(k):
+            out = np.ones(y.size)
+            for g, j in zip(shapes[k], products[k]):
+                out = out * g[level[j]]
+            return out
+
+        for _ in range(iters):
+            for k, p in enumerate(products):
+                others = sum((term(m) for m in range(len(products)) if m != k), np.zeros(y.size))
+                for i, j in enumerate(p):
+                    coef = np.linalg.lstsq(A, y - others - term(k), rcond=None)[0]
+                    r = y - A @ coef - others
+                    rest = np.ones(y.size)
+                    for g, jj in zip(shapes[k][:i] + shapes[k][i + 1:], p[:i] + p[i + 1:]):
+                        rest = rest * g[level[jj]]
+                    den = np.bincount(level[j], rest * rest, sizes[j])
+                    shapes[k][i] = np.bincount(level[j], r * rest, sizes[j]) / np.where(den > 0, den, 1.0)
+        fit = sum((term(k) for k in range(len(products))), np.zeros(y.size))
+        coef = np.linalg.lstsq(A, y - fit, rcond=None)[0]
+        best = max(best, float(1.0 - np.sum((y - A @ coef - fit) ** 2) / total))
+    return best

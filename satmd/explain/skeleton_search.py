@@ -7,11 +7,17 @@ are fitted in every budgeted form.
 """
 from __future__ import annotations
 
+import itertools
 import time
 
 import numpy as np
 
-from .skeletons import Skeleton, _admissible, _factor_pool, _initial, _project, budgeted, fit
+from .skeletons import ShiftedPower, Skeleton, UnitPower, admissible, budgeted, factor_pool, initial
+from .varpro import fit, project
+
+#: Tolerance of the fits on the subsample, which only rank products and skeletons (the
+#: finalists are refitted on all rows at `varpro.fit`'s default tolerance).
+RANK_TOL = 1e-5
 
 
 def _grow(parent: tuple, p_parent, new, factors: tuple, p_new) -> np.ndarray:
@@ -29,7 +35,8 @@ def _grow(parent: tuple, p_parent, new, factors: tuple, p_new) -> np.ndarray:
 
 
 def search(Z, y, *, budget: int = 20, seed: int = 0, time_limit: float | None = 60.0, subsample: int = 500,
-           keep: int = 24, starts: int = 6, beam: tuple = (20, 12), expand: int = 40, block_extras: bool = False) -> tuple:
+           keep: int = 24, starts: int = 6, beam: tuple = (20, 12), expand: int = 40, block_extras: bool = False,
+           curved: int | None = None) -> tuple:
     """Beam search over products, then every budgeted skeleton of the best products.
 
     A product (one to three factors from the pool of `skeletons`) is fitted on a
@@ -40,6 +47,9 @@ def search(Z, y, *, budget: int = 20, seed: int = 0, time_limit: float | None = 
     starting from its parent's constants. The ``expand`` best products of all
     sizes are then fitted in every budgeted form, and the ``keep`` best of those
     refitted on all rows (from their subsample constants, then ``starts`` - 1 fresh starts).
+    In the ``curved`` best (None: all of them), linear terms are then made curved
+    (`_curved_variants`: a unit power ``B^x``, the same three nodes; a shifted power
+    ``(x + a)^m`` that may stand in for c0 too), each fit starting from the linear one's constants.
 
     Returns ``([(r2_train, text), ...], info)``, best first (infix strings in
     x0..); ``info`` says how many products and skeletons were fitted.
@@ -56,7 +66,7 @@ def search(Z, y, *, budget: int = 20, seed: int = 0, time_limit: float | None = 
     t0 = time.perf_counter()
     with np.errstate(all="ignore"):
         corr = np.nan_to_num([abs(np.corrcoef(z, y)[0, 1]) for z in Z.T])
-    pool = _factor_pool(d, [int(v) for v in np.argsort(-corr, kind="stable")])
+    pool = factor_pool(d, [int(v) for v in np.argsort(-corr, kind="stable")])
     everything = tuple(range(d))
     ranked, fitted, level, n_fit = {}, {(): np.zeros(0)}, [()], 0
     for width in (*beam, 0):
@@ -65,7 +75,7 @@ def search(Z, y, *, budget: int = 20, seed: int = 0, time_limit: float | None = 
             for f in pool:
                 factors = tuple(sorted(product + (f,), key=repr))
                 if (factors not in fitted and factors not in grown and 4 + sum(g.nodes for g in factors) <= budget
-                        and (_admissible(factors) or len(factors) == 1)):
+                        and (admissible(factors) or len(factors) == 1)):
                     grown[factors] = (product, f)
         for factors, (parent, new) in grown.items():
             if time_limit is not None and time.perf_counter() - t0 > time_limit:
@@ -73,9 +83,9 @@ def search(Z, y, *, budget: int = 20, seed: int = 0, time_limit: float | None = 
             choices = budgeted(factors, d, budget, block_extras=False)
             if not choices:
                 continue
-            warm = _grow(parent, fitted[parent], new, factors, _initial(Skeleton((new,)), 1, rng))
+            warm = _grow(parent, fitted[parent], new, factors, initial(Skeleton((new,)), 1, rng))
             first = choices[0] if len(choices) == 1 else Skeleton(factors, everything)
-            r2, p, _ = fit(first, Zs, ys, starts=2, seed=seed + n_fit, p0=warm if parent else None)
+            r2, p, _ = fit(first, Zs, ys, starts=2, seed=seed + n_fit, p0=warm if parent else None, tol=RANK_TOL)
             n_fit += 1
             if not np.isfinite(r2):
                 continue
@@ -84,18 +94,18 @@ def search(Z, y, *, budget: int = 20, seed: int = 0, time_limit: float | None = 
                 # the inner constants kept, each choice of linear terms re-projected (cheap), the best refitted
                 def projected(sk, p=p):
                     with np.errstate(all="ignore"):
-                        r = _project(sk.columns(p, Zs), ys)[0]
+                        r = project(sk.columns(p, Zs), ys - sk.offset(p, Zs), sk.intercept)[0]
                     return float(r @ r) if np.isfinite(r).all() else np.inf
                 sk = min(choices, key=projected)
-                best = (fit(sk, Zs, ys, starts=1, seed=seed + n_fit, p0=p)[0], sk)
+                best = (fit(sk, Zs, ys, starts=1, seed=seed + n_fit, p0=p, tol=RANK_TOL)[0], sk)
             if np.isfinite(best[0]):
                 ranked[factors] = best
         level = sorted((f for f in grown if f in ranked), key=lambda f: -ranked[f][0])[:width]
     best_products = sorted(ranked, key=lambda f: -ranked[f][0])[:expand]
     scored = []
     for i, (f, sk) in enumerate((f, sk) for f in best_products for sk in budgeted(f, d, budget, block_extras)):
-        warm = np.concatenate([fitted[f], _initial(sk, 0, rng)[len(fitted[f]):]])  # a block term starts fresh
-        r2, p, _ = fit(sk, Zs, ys, starts=2, seed=seed + i, p0=warm)
+        warm = np.concatenate([fitted[f], initial(sk, 0, rng)[len(fitted[f]):]])  # a block term starts fresh
+        r2, p, _ = fit(sk, Zs, ys, starts=2, seed=seed + i, p0=warm, tol=RANK_TOL)
         if np.isfinite(r2):
             scored.append((r2, sk, p))
     scored.sort(key=lambda t: -t[0])
@@ -103,7 +113,62 @@ def search(Z, y, *, budget: int = 20, seed: int = 0, time_limit: float | None = 
     for _, sk, p0 in scored[:keep]:
         r2, p, c = fit(sk, Z.T, y, starts=starts, seed=seed, max_nfev=100 * (sk.n_inner + 1), p0=p0)
         if p is not None and np.isfinite(r2):
-            out.append((r2, sk.text(p, c)))
-    info = {"products_scored": n_fit, "skeletons": len(scored) + n_fit, "skeletons_fitted": len(scored),
-            "skeleton_s": time.perf_counter() - t0}
-    return sorted(out, key=lambda t: -t[0]), info
+            out.append((r2, sk, p, c))
+    out.sort(key=lambda t: -t[0])
+    n_curved = 0
+    for _, sk, p, c in list(out[:curved]):
+        for variant, p0 in _curved_variants(sk, p, c, Z.T, budget):
+            r2, pv, cv = fit(variant, Z.T, y, starts=2, seed=seed, max_nfev=100 * (variant.n_inner + 1), p0=p0)
+            n_curved += 1
+            if pv is not None and np.isfinite(r2):
+                out.append((r2, variant, pv, cv))
+    info = {"products_scored": n_fit, "skeletons": len(scored) + n_fit + n_curved, "skeletons_fitted": len(scored),
+            "curved_variants": n_curved, "skeleton_s": time.perf_counter() - t0}
+    return sorted(((r2, sk.text(p, c)) for r2, sk, p, c in out), key=lambda t: -t[0]), info
+
+
+def _curved_variants(sk: Skeleton, p, c, Zt, budget: int) -> list:
+    """``sk`` (fitted: inner ``p``, outer ``c``) with linear terms ``c_k x_k`` made curved, every
+    choice within ``budget``: a unit power ``B^x_k`` (same nodes; starts with ``ln B = c_k``, the
+    same slope at 0) and at most one shifted power ``(x_k + a)^m`` (`ShiftedPower`), which
+    either replaces c0 too (one node more; starts with the level c0 and the slope c_k at 0)
+    or keeps it (two more). Returns ``[(skeleton, start), ...]``."""
+    linear = [i for i, e in enumerate(sk.extras) if isinstance(e, int)]
+    coef = dict(zip([i for i, e in enumerate(sk.extras) if not getattr(e, "unit_weight", False)], c[2:]))
+    parts = sk.parts(p)
+    nf = len(sk.factors)
+    block_p = dict(zip([i for i, e in enumerate(sk.extras) if not isinstance(e, int)], parts[nf:]))
+    out = []
+    for kinds in itertools.product(("linear", "unit", "shifted"), repeat=len(linear)):
+        if all(k == "linear" for k in kinds) or kinds.count("shifted") > 1:
+            continue
+        kind = dict(zip(linear, kinds))
+        make = {"linear": lambda v: v, "unit": UnitPower, "shifted": ShiftedPower}
+        extras = tuple(make[kind[i]](e) if i in kind else e for i, e in enumerate(sk.extras))
+        for intercept in ((False, True) if "shifted" in kinds else (True,)):
+            variant = Skeleton(sk.factors, extras, intercept)
+            if variant.nodes > budget:
+                continue
+            p0 = list(parts[:nf])
+            for i, e in enumerate(sk.extras):
+                if kind.get(i) == "unit":
+                    p0.append([coef[i]])
+                elif kind.get(i) == "shifted":
+                    p0.append(_shifted_start(Zt[e], coef[i], None if intercept else c[0]))
+                elif not isinstance(e, int):
+                    p0.append(block_p[i])
+            out.append((variant, np.concatenate(p0) if p0 else np.zeros(0)))
+    return out
+
+
+def _shifted_start(x, slope: float, level: float | None) -> list:
+    """``[a, m]`` for ``(x + a)^m`` with the given slope at x = 0 and, when ``level`` is given
+    (and positive), that value there (``a^m = level``, ``m a^(m-1) = slope``); the shift stays
+    beyond the data (``x + a > 0``)."""
+    a = -float(np.min(x)) + np.geomspace(0.05, 50.0, 400)
+    if level is not None and level > 0:
+        m = slope * a / level
+        best = int(np.argmin(np.abs(m * np.log(a) - np.log(level))))
+        return [float(a[best]), float(m[best])]
+    a0 = float(a[np.searchsorted(a, -np.min(x) + 1.5)])
+    return [a0, float(slope * a0)]

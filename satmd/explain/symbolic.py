@@ -7,8 +7,8 @@ sympy.preorder_traversal(expr)))``. Every operator node (n-ary ``Add`` and
 node. Subtraction is ``Add`` with a negative coefficient, division is ``Pow``
 with exponent -1 and ``square`` is ``Pow`` with exponent 2. Of the algebraically
 identical forms tried by `compact` (as given, expanded, common factors pulled
-out, over a common denominator, a coefficient pulled out of a sum in a product) the
-smallest count is used, for the paper's
+out, over a common denominator, a coefficient pulled out of a sum in a product,
+``exp(a x)`` as the power ``(e^a)^x``) the smallest count is used, for the paper's
 formula exactly as for ours.
 """
 from __future__ import annotations
@@ -107,7 +107,27 @@ def compact(expr: sp.Expr, max_nodes: int = 80) -> sp.Expr:
             forms.append(f(expr))
         except Exception:  # pragma: no cover - sympy corner cases
             pass
+    forms += [_exp_as_powers(f) for f in forms]
     return _monic(min(forms, key=node_count))
+
+
+def _exp_as_powers(expr: sp.Expr) -> sp.Expr:
+    """``exp(a x + b y + k + f)`` -> ``e^k (e^a)^x (e^b)^y exp(f)`` wherever that is no longer:
+    a power of a number costs three nodes, a weighted term inside ``exp`` three
+    plus the ``exp`` and the sum."""
+    reps = {}
+    for e in expr.atoms(sp.exp):
+        parts, rest = [], []
+        for term in sp.Add.make_args(sp.expand(e.args[0])):
+            coeff, var = term.as_coeff_Mul()
+            if var == 1 or var.is_Symbol:
+                parts.append(sp.Pow(sp.Float(np.exp(float(coeff))), var))
+            else:
+                rest.append(term)
+        power = sp.Mul(*parts, sp.exp(sp.Add(*rest)))
+        if parts and node_count(power) <= node_count(e):
+            reps[e] = power
+    return expr.xreplace(reps) if reps else expr
 
 
 def _monic(expr: sp.Expr) -> sp.Expr:
@@ -125,7 +145,7 @@ def _monic(expr: sp.Expr) -> sp.Expr:
                     continue
                 for term in inner.args:
                     coeff, rest = term.as_coeff_Mul()
-                    if not isinstance(coeff, sp.Float) or coeff == 0:
+                    if not coeff.is_Number or coeff == 0 or coeff == 1:
                         continue
                     monic = sp.Add(*(rest if t is term else t / coeff for t in inner.args))
                     others = prod.args[:k] + prod.args[k + 1:]
@@ -171,8 +191,10 @@ def evaluate(expr: sp.Expr, Z: np.ndarray) -> np.ndarray:
 
 
 def _sse(expr: sp.Expr, Z: np.ndarray, y: np.ndarray) -> float:
-    r = evaluate(expr, Z) - y
-    return float(np.sum(r * r)) if np.all(np.isfinite(r)) else np.inf
+    with np.errstate(over="ignore"):
+        r = evaluate(expr, Z) - y
+        sse = float(np.sum(r * r))
+    return sse if np.isfinite(sse) else np.inf
 
 
 def _neutral_values(expr: sp.Expr) -> list:
@@ -241,7 +263,7 @@ def polish(expr: sp.Expr, Z: np.ndarray, y: np.ndarray, max_nfev: int = 200) -> 
     def residual(p):
         with np.errstate(all="ignore"):
             r = np.broadcast_to(np.asarray(fn(p, Zt), float), y.shape) - y
-        return np.where(np.isfinite(r), r, 1e6)
+        return np.clip(np.where(np.isfinite(r), r, 1e6), -1e6, 1e6)  # a huge value counts as a failed one
 
     p0 = np.array([float(c) for c in consts])
     try:

@@ -2,7 +2,7 @@ import numpy as np
 import pytest
 
 from satmd.errors import DataError
-from satmd.explain.anova import grid_anova, grid_ceiling
+from satmd.explain.anova import grid_anova, grid_ceiling, structure_ceiling
 
 
 def _grid(*levels):
@@ -49,3 +49,26 @@ def test_rejects_what_is_not_a_full_grid():
         grid_anova(X, np.array([1.0, 2, 3, np.nan, 5, 6]))
     with pytest.raises(DataError, match="constant"):
         grid_anova(X, np.ones(6))
+
+
+def test_structure_ceiling_of_main_effects_is_the_additive_anova():
+    """Free one-variable shapes, summed: exactly the ANOVA's additive R²."""
+    rng = np.random.default_rng(1)
+    X = _grid(np.linspace(-1, 1, 5), np.linspace(0, 2, 4), np.linspace(-2, 1, 3))
+    y = np.sin(2 * X[:, 0]) * X[:, 1] + np.exp(X[:, 2]) + 0.3 * rng.standard_normal(len(X))
+    ceiling = structure_ceiling(X, y, [(0,), (1,), (2,)])
+    assert ceiling == pytest.approx(grid_anova(X, y).r2_main, abs=1e-9)
+
+
+def test_structure_ceiling_is_one_on_its_own_structure_and_lower_without_it():
+    """y = 1 + 0.5 a + F(b) G(c) H(a), arbitrary shapes: reached exactly by that structure only."""
+    rng = np.random.default_rng(2)
+    la, lb, lc = np.linspace(-1, 1, 5), np.linspace(0, 1, 4), np.linspace(-1, 2, 4)
+    X = _grid(la, lb, lc)
+    F, G, H = (dict(zip(lv, rng.uniform(0.5, 2.0, lv.size))) for lv in (lb, lc, la))
+    y = 1 + 0.5 * X[:, 0] + np.array([F[b] * G[c] * H[a] for a, b, c in X])
+    names = ("a", "b", "c")
+    assert structure_ceiling(X, y, [("b", "c", "a")], ("a",), names) == pytest.approx(1.0, abs=1e-9)
+    assert structure_ceiling(X, y, [("b", "c")], ("a",), names) < 0.99
+    with pytest.raises(DataError, match="unknown input 'd'"):
+        structure_ceiling(X, y, [("d",)], (), names)

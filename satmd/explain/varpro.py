@@ -1,0 +1,139 @@
+"""Variable projection: fitting the constants of one product skeleton (`satmd.explain.skeletons`).
+
+A skeleton ``c0 + c1·Π F + Σ c_k·E_k + Σ U`` (c0 optional) is linear in its outer constants
+c and nonlinear in the inner ones p (the factors' offsets, weights and rates;
+``U`` the unit-weight powers). For each p the best c is a linear least-squares
+solve, so only p is searched (Golub & Pereyra 1973): Levenberg-Marquardt on
+the projected residual ``r(p) = -P⊥(p) (y - U(p))``, where P⊥ projects out
+``[1, columns(p)]``. Its Jacobian is Kaufman's (1975)
+``J ≈ P⊥ (∂A/∂p · c + ∂U/∂p)``, built from the derivatives each block declares:
+one projection per Jacobian where finite differences cost one residual per
+constant. Kaufman's form drops a term that vanishes at a zero residual; it
+converges like the full Jacobian (Ruhe & Wedin 1980).
+"""
+from __future__ import annotations
+
+import numpy as np
+from scipy.linalg import cho_solve
+from scipy.optimize import least_squares
+
+from .skeletons import Skeleton, initial
+
+#: Columns whose scaled normal matrix has a Cholesky pivot below this (squared) are
+#: treated as rank-deficient and solved by ``lstsq`` (minimum norm).
+_PIVOT = 1e-12
+
+
+def _solve(C: np.ndarray, V: np.ndarray) -> np.ndarray:
+    """``B`` minimising ``‖C B − V‖`` for centred columns C (n, m), right-hand sides V (n, k).
+
+    The normal equations of the column-scaled C (a few columns: far cheaper than
+    ``lstsq``); nearly dependent columns get ``lstsq``'s minimum-norm answer."""
+    norms = np.sqrt(np.einsum("ij,ij->j", C, C))
+    if np.all(norms > 0) and np.all(np.isfinite(norms)):
+        Cs = C / norms
+        G = Cs.T @ Cs
+        try:
+            chol = np.linalg.cholesky(G)
+        except np.linalg.LinAlgError:
+            chol = None
+        if chol is not None and np.min(np.diag(chol)) ** 2 > _PIVOT:
+            return cho_solve((chol, True), Cs.T @ V, check_finite=False) / norms[:, None]
+    return np.linalg.lstsq(C, V, rcond=None)[0]
+
+
+def project(cols: list, y: np.ndarray, intercept: bool = True):
+    """Residual ``A c − y`` and coefficients c of y on ``A = [1, cols...]`` by least squares.
+
+    Parameters
+    ----------
+    cols : the non-constant columns, each (n,).
+    y : (n,) target.
+    intercept : with the column of ones (else its coefficient is 0).
+
+    Returns
+    -------
+    (ndarray, ndarray)
+        The residual (n,) and the coefficients (intercept first).
+    """
+    A = np.column_stack(cols)
+    means, ym = (A.mean(axis=0), y.mean()) if intercept else (np.zeros(A.shape[1]), 0.0)
+    C = A - means
+    yc = y - ym
+    b = _solve(C, yc[:, None])[:, 0]
+    return C @ b - yc, np.array([ym - means @ b, *b])
+
+
+def _kaufman(cols: list, target: np.ndarray, derivatives: list, intercept: bool = True) -> np.ndarray:
+    """Kaufman's Jacobian ``P⊥ (∂A/∂p · c + ∂U/∂p)`` of the projected residual (module docstring):
+    ``derivatives`` as `Skeleton.derivatives` gives them. One solve gives c and the projections."""
+    C = np.column_stack(cols)
+    D = np.column_stack([target] + [g for _, g in derivatives])
+    if intercept:
+        C = C - C.mean(axis=0)
+        D = D - D.mean(axis=0)
+    B = _solve(C, D)
+    c = B[:, 0]  # the outer constants (but c0)
+    R = D[:, 1:] - C @ B[:, 1:]  # P⊥ of each derivative
+    scale = np.array([1.0 if col is None else c[col] for col, _ in derivatives])
+    return R * scale
+
+
+def fit(sk: Skeleton, Zt: np.ndarray, y: np.ndarray, starts: int = 2, seed: int = 0, max_nfev: int | None = None,
+        p0=None, tol: float = 1e-8):
+    """Variable-projection fit of one skeleton.
+
+    Parameters
+    ----------
+    sk : the skeleton.
+    Zt : (d, n) inputs, one row a variable.
+    y : (n,) target.
+    starts : starts of Levenberg-Marquardt (the best is kept).
+    seed : seed of the starts after the first.
+    max_nfev : evaluation cap per start (default 25 per inner constant + 25).
+    p0 : inner constants of the first start (a warm start); else `skeletons.initial`'s.
+    tol : relative tolerance on the cost and the constants (``ftol``, ``xtol``): a search
+        that only ranks skeletons can stop earlier than a final fit.
+
+    Returns
+    -------
+    (float, ndarray | None, ndarray | None)
+        Training R², inner constants, outer constants (``(-inf, None, None)`` when no start succeeds).
+    """
+    rng = np.random.default_rng(seed)
+    sst = float(np.sum((y - y.mean()) ** 2)) or 1.0
+    bad = np.full(y.shape, 1e3)
+
+    def parts(p):
+        cols, target = sk.columns(p, Zt), y - sk.offset(p, Zt)
+        ok = all(np.isfinite(c.sum()) for c in cols) and np.isfinite(np.sum(target))
+        return cols, target, ok
+
+    def residual(p):
+        with np.errstate(all="ignore"):
+            cols, target, ok = parts(p)
+            return project(cols, target, sk.intercept)[0] if ok else bad
+
+    def jacobian(p):
+        with np.errstate(all="ignore"):
+            cols, target, ok = parts(p)
+            if not ok:
+                return np.zeros((y.size, p.size))
+            J = _kaufman(cols, target, sk.derivatives(p, Zt), sk.intercept)
+        return J if np.all(np.isfinite(J)) else np.zeros((y.size, p.size))
+
+    best = None
+    for s in range(starts):
+        try:
+            start = np.asarray(p0, float) if (p0 is not None and s == 0) else initial(sk, s, rng)
+            sol = least_squares(residual, start, jac=jacobian, method="lm", ftol=tol, xtol=tol,
+                                max_nfev=max_nfev or 25 * (sk.n_inner + 1))
+        except (ValueError, np.linalg.LinAlgError):
+            continue
+        if best is None or sol.cost < best.cost:
+            best = sol
+    if best is None:
+        return -np.inf, None, None
+    with np.errstate(all="ignore"):
+        r, c = project(sk.columns(best.x, Zt), y - sk.offset(best.x, Zt), sk.intercept)
+    return 1.0 - float(r @ r) / sst, best.x, c
