@@ -12,7 +12,7 @@ import time
 
 import numpy as np
 
-from .skeletons import ShiftedPower, Skeleton, UnitPower, admissible, budgeted, factor_pool, initial
+from .skeletons import ShiftedPower, Skeleton, UnitPower, admissible, budgeted, factor_pool, initial, unit_weight
 from .varpro import fit, project
 
 #: Tolerance of the fits on the subsample, which only rank products and skeletons (the
@@ -134,16 +134,16 @@ def _curved_variants(sk: Skeleton, p, c, Zt, budget: int) -> list:
     either replaces c0 too (one node more; starts with the level c0 and the slope c_k at 0)
     or keeps it (two more). Returns ``[(skeleton, start), ...]``."""
     linear = [i for i, e in enumerate(sk.extras) if isinstance(e, int)]
-    coef = dict(zip([i for i, e in enumerate(sk.extras) if not getattr(e, "unit_weight", False)], c[2:]))
+    coef = dict(zip([i for i, e in enumerate(sk.extras) if not unit_weight(e)], c[2:]))
     parts = sk.parts(p)
     nf = len(sk.factors)
     block_p = dict(zip([i for i, e in enumerate(sk.extras) if not isinstance(e, int)], parts[nf:]))
+    make = {"linear": lambda v: v, "unit": UnitPower, "shifted": ShiftedPower}
     out = []
-    for kinds in itertools.product(("linear", "unit", "shifted"), repeat=len(linear)):
+    for kinds in itertools.product(make, repeat=len(linear)):
         if all(k == "linear" for k in kinds) or kinds.count("shifted") > 1:
             continue
         kind = dict(zip(linear, kinds))
-        make = {"linear": lambda v: v, "unit": UnitPower, "shifted": ShiftedPower}
         extras = tuple(make[kind[i]](e) if i in kind else e for i, e in enumerate(sk.extras))
         for intercept in ((False, True) if "shifted" in kinds else (True,)):
             variant = Skeleton(sk.factors, extras, intercept)

@@ -40,10 +40,10 @@ import numpy as np
 from .skeleton_blocks import Affine, Exp, Inverse, ShiftedPower, Square, UnitPower
 
 __all__ = ["Affine", "Exp", "Inverse", "ShiftedPower", "Square", "UnitPower", "Skeleton", "admissible", "budgeted",
-           "factor_pool", "initial", "skeletons"]
+           "factor_pool", "initial", "skeletons", "unit_weight"]
 
 
-def _unit(e) -> bool:
+def unit_weight(e) -> bool:
     """A term added with weight one (no outer constant): `UnitPower`, `ShiftedPower`."""
     return getattr(e, "unit_weight", False)
 
@@ -60,7 +60,7 @@ class Skeleton:
 
     @property
     def nodes(self):
-        extras = sum(3 if isinstance(e, int) else e.nodes if _unit(e) else 2 + e.nodes for e in self.extras)
+        extras = sum(3 if isinstance(e, int) else e.nodes if unit_weight(e) else 2 + e.nodes for e in self.extras)
         return (4 if self.intercept else 3) + sum(f.nodes for f in self.factors) + extras
 
     @property
@@ -87,13 +87,13 @@ class Skeleton:
         for f in self.factors:
             product = product * f.value(next(parts), Zt)
         extras = [Zt[e] if isinstance(e, int) else e.value(next(parts), Zt) for e in self.extras]
-        return [product] + [col for col, e in zip(extras, self.extras) if not _unit(e)]
+        return [product] + [col for col, e in zip(extras, self.extras) if not unit_weight(e)]
 
     def offset(self, p, Zt):
         """The sum of the unit-weight terms (0 without any)."""
         parts = self.parts(p)[len(self.factors):]
         blocks = [e for e in self.extras if not isinstance(e, int)]
-        return sum((b.value(q, Zt) for b, q in zip(blocks, parts) if _unit(b)), 0.0)
+        return sum((b.value(q, Zt) for b, q in zip(blocks, parts) if unit_weight(b)), 0.0)
 
     def derivatives(self, p, Zt) -> list:
         """For each inner constant, ``(column, d)``: the derivative ``d`` of the `columns` entry
@@ -112,7 +112,7 @@ class Skeleton:
         for e in self.extras:
             if isinstance(e, int):
                 column += 1
-            elif _unit(e):
+            elif unit_weight(e):
                 out += [(None, g) for g in e.grad(next(blocks), Zt)]
             else:
                 column += 1
@@ -130,7 +130,7 @@ class Skeleton:
         for e in self.extras:
             if isinstance(e, int):
                 out += f" + ({next(coefs):.10g})*x{e}"
-            elif _unit(e):
+            elif unit_weight(e):
                 out += " + " + e.text(next(parts))[1]
             else:
                 s, t = e.text(next(parts))
