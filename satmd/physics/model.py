@@ -67,7 +67,7 @@ def terms(omega, rig: Rig, effects: Sequence[Effect] = ()) -> Terms:
     rig : Rig
         Parameter values (fields may be arrays, tensors or duals).
     effects : sequence of Effect
-        Applied in order: rig changes first, then host, capacitance, shunt and sensor hooks.
+        Applied in order: rig changes first, then host, capacitance, piezo-branch, shunt and sensor hooks.
 
     Returns
     -------
@@ -80,17 +80,19 @@ def terms(omega, rig: Rig, effects: Sequence[Effect] = ()) -> Terms:
     K1 = rig.k1 - rig.m1 * w2 + 1j * omega * rig.c1
     Cp = rig.Cp
     Zs = rig.R + 1j * omega * rig.L
+    Kp = rig.kp + 1j * omega * rig.cp
     s1 = s2 = None
     for eff in effects:
         K1 = eff.host(omega, rig, K1)
         Cp = eff.capacitance(omega, rig, Cp)
+        Kp = eff.branch(omega, rig, Kp)
         Zs = eff.shunt(omega, rig, Zs)
         s1 = eff.sensor(omega, "a1", s1)
         s2 = eff.sensor(omega, "a2", s2)
     return Terms(
         omega=omega,
         K1=K1,
-        Kp=rig.kp + 1j * omega * rig.cp,
+        Kp=Kp,
         b=rig.e / Cp,
         Z33=1.0 / Cp + 1j * omega * Zs,
         M2=rig.m2 * w2,

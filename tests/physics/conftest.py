@@ -24,13 +24,14 @@ def explicit_Z(f_hz, p, eta=0.0, tan_delta=0.0, Cs=0.0, mode=None):
     """
     w = 2.0 * math.pi * f_hz
     Cp = p["Cp"] * (1.0 - 1j * tan_delta)
+    kp = p["kp"] + p["e"] ** 2 * (1.0 / Cp - 1.0 / p["Cp"])  # SPEC §8: kp - e²/Cp stays real
     Zs = p["R"] + 1j * w * p["L"]
     Zs = Zs / (1.0 + 1j * w * Cs * Zs)
     n = 3 if mode is None else 4
     Z = np.zeros((n, n), dtype=complex)
-    Z[0, 0] = p["k1"] * (1.0 + 1j * eta) + p["kp"] - p["m1"] * w**2 + 1j * w * (p["c1"] + p["cp"])
-    Z[0, 1] = Z[1, 0] = -p["kp"] - 1j * w * p["cp"]
-    Z[1, 1] = p["kp"] - p["m2"] * w**2 + 1j * w * p["cp"]
+    Z[0, 0] = p["k1"] * (1.0 + 1j * eta) + kp - p["m1"] * w**2 + 1j * w * (p["c1"] + p["cp"])
+    Z[0, 1] = Z[1, 0] = -kp - 1j * w * p["cp"]
+    Z[1, 1] = kp - p["m2"] * w**2 + 1j * w * p["cp"]
     Z[0, 2] = Z[2, 0] = p["e"] / Cp
     Z[1, 2] = Z[2, 1] = -p["e"] / Cp
     Z[2, 2] = 1.0 / Cp + 1j * w * Zs

@@ -129,7 +129,7 @@ def test_structural_damping_uses_the_offset_k1():
 
 
 def test_dielectric_loss_equals_a_complex_capacitance():
-    """Cp -> Cp(1 - i tanδ) wherever Cp appears: the same as a complex Cp in the rig."""
+    """SPEC §8: Cp -> Cp(1 - i tanδ) wherever Cp appears and kp -> kp + e²(1/Cp_c - 1/Cp) wherever kp appears."""
     t = 0.07
     a = frf(FREQ, NOMINAL, [effect("dielectric_loss", tan_delta=t)])
     # Rig.validate would refuse a complex Cp, so compare with the hook-free formula
@@ -137,7 +137,8 @@ def test_dielectric_loss_equals_a_complex_capacitance():
     Cp = 27e-6 * (1 - 1j * t)
     b = 0.65 / Cp
     Z33 = 1 / Cp + 1j * w * (22.0 + 1j * w * 0.064)
-    K = 111e3 + 1j * w * 4.0 - b * b / Z33
+    kp = 111e3 + 0.65**2 * (1 / Cp - 1 / 27e-6)
+    K = kp + 1j * w * 4.0 - b * b / Z33
     K1 = 194e3 - 0.85 * w**2 + 1j * w * 10.0
     M2 = 0.518 * w**2
     det = K1 * (K - M2) - K * M2

@@ -9,6 +9,7 @@ or more hooks (identity by default):
 - ``rig(rig)``                       -> a rig with a fixed parameter replaced
 - ``host(omega, rig, K1)``           -> the primary (host) dynamic stiffness Z11 - kp - iω cp
 - ``capacitance(omega, rig, Cp)``    -> the piezo capacitance, wherever Cp appears
+- ``branch(omega, rig, Kp)``         -> the piezo's mechanical branch kp + iω cp, wherever kp appears
 - ``shunt(omega, rig, Zs)``          -> the shunt impedance
 - ``sensor(omega, channel, factor)`` -> the factor the sensor applies to a1 or a2
 
@@ -216,6 +217,9 @@ class Effect:
 
     def capacitance(self, omega, rig, Cp):
         return Cp
+
+    def branch(self, omega, rig, Kp):
+        return Kp
 
     def shunt(self, omega, rig, Zs):
         return Zs

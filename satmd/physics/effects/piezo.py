@@ -5,24 +5,28 @@ from .base import Effect, Parameter
 
 
 class DielectricLoss(Effect):
-    """SPEC §8 form: Cp -> Cp (1 - i tanδ) in Z13, Z23 and Z33 (where Cp appears).
+    """SPEC §8 (revised) passive form of a lossy clamped capacitance.
 
-    Kept exactly as the SPEC defines it (measured data and the shared
-    acceptance files use this form). Note that it is not strictly passive:
-    Im(Z) gets an indefinite block, and for large tanδ (≳ 0.5) the input
-    power can turn negative near the first resonance (tests/physics record
-    this). A passive variant would also add e²(1/Cp' - 1/Cp) to the
-    mechanical block.
+    ``Cp -> Cp_c = Cp (1 - i tanδ)`` wherever Cp appears (Z13, Z23, Z33) and
+    ``kp -> kp + e² (1/Cp_c - 1/Cp)`` wherever kp appears, so the short-circuit
+    stiffness ``kp - e²/Cp`` stays real: the element only dissipates
+    (½ ω Cp tanδ |V|² ≥ 0), whatever the rig. The earlier form (Cp alone) fed
+    energy in at large tanδ or with c1 = cp = 0.
     """
 
     name = "dielectric_loss"
     parameter_specs = (Parameter("tan_delta", default=0.0, neutral=0.0, hard=(0.0, 10.0), search=(0.0, 0.5),
                                  starts=(0.003, 0.01, 0.03, 0.1)),)
-    description = "lossy piezo dielectric (Cp -> Cp (1 - i tanδ) wherever Cp appears)"
+    description = "lossy piezo dielectric (Cp -> Cp (1 - i tanδ), short-circuit stiffness kept real)"
     acts_on = "piezo"
 
     def capacitance(self, omega, rig, Cp):
         return Cp * (1.0 - 1j * self.params["tan_delta"])
+
+    def branch(self, omega, rig, Kp):
+        # e² (1/Cp_c - 1/Cp) = (e²/Cp) · i tanδ / (1 - i tanδ)
+        t = self.params["tan_delta"]
+        return Kp + (rig.e * rig.e / rig.Cp) * (1j * t) / (1.0 - 1j * t)
 
     def explain(self, rig) -> str:
         return f"the piezo's dielectric is lossy: tan δ = {self.params['tan_delta']:.3g}"
