@@ -20,3 +20,64 @@ class FormatError(DataError):
             where += f", column {column}"
         super().__init__(f"{where}: {message}")
         self.path, self.line, self.column = str(path), line, column
+
+
+# --- warnings: by type, never by text ------------------------------------------------------------
+
+class DataWarning(UserWarning):
+    """Something in the data is suspicious but usable (clipping, dropped points, a poor fit).
+
+    The CLI prints these as one line each; library users can filter them with
+    ``warnings.simplefilter("error", DataWarning)``, or one kind by its subclass.
+    """
+
+
+class PoorFitWarning(DataWarning):
+    """The fitted model reproduces the data poorly (large error, χ² beyond the noise, structured residuals)."""
+
+
+class PinnedParameterWarning(DataWarning):
+    """A fitted parameter ended on a bound: the data push it beyond the model's range."""
+
+
+class IdentifiabilityWarning(DataWarning):
+    """A parameter is not identifiable, two are strongly correlated, or the problem is ill-conditioned."""
+
+
+class WarningRecord(str):
+    """A warning kept on a result: its one-line text (a ``str``) with its ``category`` (a `DataWarning` class).
+
+    Results store these instead of emitting them, so that callers decide by type (``issubclass(
+    w.category, PoorFitWarning)``) whether to show or raise them; the text is what ``to_dict`` and
+    the reports print.
+
+    Parameters
+    ----------
+    message : the one-line text
+    category : the warning class
+    """
+
+    category: type
+
+    def __new__(cls, message: str, category: type = DataWarning):
+        self = super().__new__(cls, message)
+        self.category = category
+        return self
+
+    def __reduce__(self):
+        return WarningRecord, (str(self), self.category)
+
+    def emit(self, stacklevel: int = 2) -> None:
+        """Emit the record as a Python warning of its category.
+
+        Parameters
+        ----------
+        stacklevel : as `warnings.warn` (counted from the caller of `emit`)
+
+        Returns
+        -------
+        None
+        """
+        import warnings
+
+        warnings.warn(str(self), self.category, stacklevel=stacklevel + 1)

@@ -8,18 +8,10 @@ from pathlib import Path
 
 import numpy as np
 
-from ..errors import FormatError
+from ..errors import DataWarning, FormatError  # noqa: F401 - DataWarning is io's since before satmd.errors had it
 from .atomic import all_or_none, atomic_write  # noqa: F401 - io modules import them from here too
 
 G0 = 9.80665  # standard gravity, for accelerations in g
-
-
-class DataWarning(UserWarning):
-    """Something in a file is suspicious but usable (clipping, dropped points, unknown units).
-
-    The CLI prints these as one line each; library users can filter them with
-    ``warnings.simplefilter("error", DataWarning)``.
-    """
 
 
 def warn(path, message: str):
@@ -31,18 +23,47 @@ def short_error(exc) -> str:
     return " ".join(str(exc).split())[:120] or type(exc).__name__
 
 
-def read_bytes(path) -> bytes:
-    """The whole file, refusing missing, unreadable and empty files with a one-line FormatError."""
+def read_bytes(path, limit: int | None = None) -> bytes:
+    """The whole file, refusing missing, unreadable, empty, oversized and non-regular files (one-line FormatError).
+
+    ``limit`` is the largest size read (default `limits.MAX_BINARY_BYTES`); a
+    FIFO or a device is refused before it is opened (`limits.check_file`).
+    """
+    from .limits import MAX_BINARY_BYTES, check_file
+
     path = Path(path)
+    limit = MAX_BINARY_BYTES if limit is None else limit
+    check_file(path, limit)
     try:
-        raw = path.read_bytes()
+        with open(path, "rb") as fh:
+            raw = fh.read(limit + 1)  # a file that grew since the check is still bounded
     except IsADirectoryError:
         raise FormatError(path, "is a directory, not a file") from None
     except OSError as exc:
         raise FormatError(path, f"cannot read file ({exc.strerror or exc})") from None
+    if len(raw) > limit:
+        raise FormatError(path, "file grew past the size satmd reads while it was read")
     if not raw.strip():
         raise FormatError(path, "empty file")
     return raw
+
+
+def read_text(path) -> str:
+    """A text file (UTF-8), bounded by `limits.MAX_TEXT_BYTES`; see `read_bytes` and `decode_text`."""
+    from .limits import MAX_TEXT_BYTES
+
+    return decode_text(path, read_bytes(path, MAX_TEXT_BYTES))
+
+
+def text_lines(text: str) -> list[str]:
+    """Lines split at '\\n' only (a '\\r' before it dropped).
+
+    `str.splitlines` also splits at U+2028, U+0085, form feeds and other
+    separators, which would shift line numbers and break a comment in two.
+    """
+    if "\n" not in text and "\r" in text:  # old Mac line ends
+        return text.split("\r")
+    return [line[:-1] if line.endswith("\r") else line for line in text.split("\n")]
 
 
 def decode_text(path, raw: bytes) -> str:
@@ -178,7 +199,7 @@ def split_csv(path, text: str, magic: str):
     Returns (header cells, header line number, [(line number, cells)], meta).
     """
     header, header_line, rows, meta = None, None, [], {}
-    for lineno, line in enumerate(text.splitlines(), start=1):
+    for lineno, line in enumerate(text_lines(text), start=1):
         stripped = line.strip()
         if not stripped:
             continue

@@ -1,0 +1,23 @@
+"""Facts every package shares, written once (issue 25): parameter and channel names, SPEC ranges, constants.
+
+This module sits at the floor of the import graph beside `satmd.physics` and imports nothing from
+satmd, so every package may take its names from here. A fact that appears in two packages belongs
+here; ``tests/test_structure.py`` refuses the literals of the default free set and of the
+acceleration channels anywhere else.
+"""
+from __future__ import annotations
+
+#: Parameters fitted by default (SPEC §9): absorber mass, absorber spring, shunt resistance, inductance.
+DEFAULT_FREE = ("m2", "kp", "R", "L")
+
+#: The measured channels: accelerations of the primary (a1) and absorber (a2) mass per unit force.
+ACCEL_CHANNELS = ("a1", "a2")
+
+#: Recording signal name -> FRF channel it gives when divided by the force.
+RECORDING_CHANNELS = {"acc1": "a1", "acc2": "a2"}
+
+#: SPEC §9: where the true values of the default free parameters may lie.
+SPEC_RANGES = {"m2": (0.3, 0.8), "kp": (5e4, 2e5), "R": (5.0, 100.0), "L": (0.02, 0.5)}
+
+#: A positive floor for divisions and logarithms (far below any physical quantity, above 0).
+TINY = 1e-300
