@@ -13,6 +13,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..conventions import DEFAULT_FREE
 from ..errors import FormatError, SatmdError
 from ..physics import Rig, effect
 
@@ -252,12 +253,12 @@ def parse_names(text: str, allowed, what: str) -> tuple[str, ...]:
     return names
 
 
-def add_rig_options(parser: argparse.ArgumentParser, names=("m2", "kp", "R", "L")):
+def add_rig_options(parser: argparse.ArgumentParser, names=DEFAULT_FREE):
     for n in names:
         parser.add_argument(f"--{n}", type=real(), default=None, help=f"{n} (default {getattr(Rig(), n):g})")
 
 
-def rig_from_args(args, names=("m2", "kp", "R", "L")) -> Rig:
+def rig_from_args(args, names=DEFAULT_FREE) -> Rig:
     changes = {n: getattr(args, n) for n in names if getattr(args, n, None) is not None}
     return Rig().replace(**changes).validate()
 

@@ -1,6 +1,7 @@
 """satmd discover: locate the mismatch, name the missing physics, model it."""
 from __future__ import annotations
 
+from ..conventions import DEFAULT_FREE
 from ..physics.effects import registered_names
 from ._common import add_data_options, add_model_options, dumps_json, load_data, parse_list, parse_names, real
 
@@ -24,7 +25,7 @@ def run(args):
     from ..discovery import discover
 
     data = load_data(args)
-    free = parse_list(args.free) or ("m2", "kp", "R", "L")
+    free = parse_list(args.free) or DEFAULT_FREE
     candidates = parse_names(args.candidates, registered_names(), "--candidates") if args.candidates else None
     channels = parse_list(args.channels)
     rep = discover(data, free=free, candidates=candidates, channels=channels, alpha=args.alpha)

@@ -1,6 +1,7 @@
 """satmd identify: grey-box fit of m2, kp, R, L (or any free parameters) to an FRF file."""
 from __future__ import annotations
 
+from ..conventions import DEFAULT_FREE
 from ._common import (add_data_options, add_model_options, dumps_json, load_data, one_line_warnings, parse_effect,
                       parse_kv, parse_list, real)
 
@@ -27,7 +28,7 @@ def run(args):
     from ..identification.intervals import describe_interval, intervals_to_dict
 
     data = load_data(args)
-    free = parse_list(args.free) or ("m2", "kp", "R", "L")
+    free = parse_list(args.free) or DEFAULT_FREE
     channels = parse_list(args.channels)
     effects = [parse_effect(e) for e in args.effect]
     start = parse_kv(args.init, "--init") if args.init else None

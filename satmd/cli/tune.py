@@ -6,6 +6,7 @@ import sys
 import warnings
 from pathlib import Path
 
+from ..conventions import DEFAULT_FREE
 from ..errors import DataError
 from ._common import (check_outputs, dumps_json, load_data, one_line_warnings, parse_effect, parse_kv, parse_list,
                       parse_number, plot_suffixes)
@@ -72,7 +73,7 @@ def run(args):
         if len(series) > 1:
             if args.robust is not None:
                 raise DataError("--robust applies to one FRF, not to a series")
-            free = parse_list(args.free) or ("m2", "kp", "R", "L")
+            free = parse_list(args.free) or DEFAULT_FREE
             options = {k: v for k, v in options.items() if k not in ("robust", "quantile", "n_draws", "uncertainty")}
             with one_line_warnings("tune"):
                 result = retune(series, free=free, labels=[f.stem for f in files], **options)
@@ -160,7 +161,7 @@ def _load(args, path):
 
 def _identified(args, data):
     """The model to tune: the discovery report (augmented model when a mismatch is found) or the fit."""
-    free = parse_list(args.free) or ("m2", "kp", "R", "L")
+    free = parse_list(args.free) or DEFAULT_FREE
     channels = parse_list(args.channels)
     if args.no_discover:
         from ..identification import identify

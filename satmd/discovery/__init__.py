@@ -25,6 +25,7 @@ import time
 from functools import partial
 from typing import Sequence
 
+from ..conventions import DEFAULT_FREE
 from .._fleet import fleet_map
 from ..identification import identify
 from ..io.frfdata import FRFData
@@ -45,7 +46,7 @@ __all__ = ["discover", "discover_many", "DiscoveryReport", "EffectFinding", "Une
 def discover(
     data,
     rig: Rig | None = None,
-    free: Sequence[str] = ("m2", "kp", "R", "L"),
+    free: Sequence[str] = DEFAULT_FREE,
     candidates: Sequence[str] | None = None,
     channels: Sequence[str] | None = None,
     alpha: float = 1e-3,

@@ -10,6 +10,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..conventions import SPEC_RANGES
 from ..physics import Rig
 from ..physics.effects import VOCABULARY_NAMES, effect
 from ..simulation import simulate
@@ -35,7 +36,7 @@ class Scenario:
 
 def random_rig(rng) -> Rig:
     """Free parameters anywhere in the SPEC §9 ranges."""
-    return Rig(m2=rng.uniform(0.3, 0.8), kp=rng.uniform(5e4, 2e5), R=rng.uniform(5, 100), L=rng.uniform(0.02, 0.5))
+    return Rig(**{name: rng.uniform(lo, hi) for name, (lo, hi) in SPEC_RANGES.items()})
 
 
 def random_effect(name: str, rng, freq_hz):

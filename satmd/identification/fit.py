@@ -7,6 +7,7 @@ from typing import Sequence
 
 import numpy as np
 
+from ..conventions import DEFAULT_FREE
 from ..errors import DataError
 from ..io.frfdata import FRFData
 from ..physics import Rig
@@ -24,7 +25,7 @@ SEARCH_POINTS = 512
 def identify(
     data: FRFData,
     rig: Rig | None = None,
-    free: Sequence[str] = ("m2", "kp", "R", "L"),
+    free: Sequence[str] = DEFAULT_FREE,
     channels: Sequence[str] | None = None,
     effects: Sequence[Effect] = (),
     start: dict | Sequence[dict] | None = None,

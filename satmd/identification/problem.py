@@ -22,6 +22,7 @@ from typing import Sequence
 
 import numpy as np
 
+from ..conventions import DEFAULT_FREE
 from ..errors import DataError
 from ..io.frfdata import FRFData
 from ..physics import Rig, frf
@@ -60,7 +61,7 @@ class Problem:
         self,
         data: FRFData,
         rig: Rig | None = None,
-        free: Sequence[str] = ("m2", "kp", "R", "L"),
+        free: Sequence[str] = DEFAULT_FREE,
         channels: Sequence[str] | None = None,
         effects: Sequence[Effect] = (),
         bounds: dict | None = None,

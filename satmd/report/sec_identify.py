@@ -3,16 +3,18 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..conventions import DEFAULT_FREE, SPEC_RANGES
+
 ORDER = 20
 TITLE = "Use case I: identification (paper Table 1)"
 
-NAMES = ("m2", "kp", "R", "L")
+NAMES = DEFAULT_FREE
 START = {"m2": 0.300, "kp": 50000.0, "R": 20.0, "L": 0.050}
 PAPER = {"m2": 0.517999, "kp": 110999.797, "R": 21.999981, "L": 0.064000}
 PAPER_ERROR = 2.35e-6
 STATE = ("u1", "u2", "q")
 # SPEC §9: where the true values of a rig may lie
-RANGES = {"m2": (0.3, 0.8), "kp": (5e4, 2e5), "R": (5.0, 100.0), "L": (0.02, 0.5)}
+RANGES = SPEC_RANGES
 
 
 def build(ctx) -> str:

@@ -6,6 +6,7 @@ from typing import Sequence
 
 import numpy as np
 
+from ..conventions import DEFAULT_FREE
 from ..errors import DataError
 from ..physics.effects import Effect
 from ..physics.rig import Rig
@@ -16,7 +17,7 @@ from .result import TuneResult, db
 from .robust import Draws, draws_from_covariance, draws_from_std, robust_optimum
 
 DEFAULT_BAND = (20.0, 200.0)
-RIG_FREE = ("m2", "kp", "R", "L")  # what a Rig reports as its model parameters
+RIG_FREE = DEFAULT_FREE  # what a Rig reports as its model parameters
 
 
 def tune(

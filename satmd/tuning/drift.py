@@ -14,6 +14,7 @@ from typing import Sequence
 
 import numpy as np
 
+from ..conventions import DEFAULT_FREE
 from ..errors import DataError
 from ..physics.rig import Rig
 from .laws import OPEN_CIRCUIT_R
@@ -110,7 +111,7 @@ class RetuneResult:
 def retune(
     series: Sequence,
     rig: Rig | None = None,
-    free: Sequence[str] = ("m2", "kp", "R", "L"),
+    free: Sequence[str] = DEFAULT_FREE,
     labels: Sequence[str] | None = None,
     objective: str = "hinf",
     output: str = "u1",
