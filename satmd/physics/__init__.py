@@ -28,10 +28,25 @@ from .effects import (
 )
 from .model import CHANNELS, STATES, Response, frf, parameter_names, solve, terms
 from .rig import PAPER_GRID_HZ, PARAMETER_INFO, Rig
+from .nonlinear import (
+    NONLINEAR,
+    AbsorberFriction,
+    CubicAbsorberSpring,
+    CubicHostSpring,
+    InductorSaturation,
+    NonlinearElement,
+    QuadraticDamping,
+    equivalent_rig,
+    integrate,
+    nonlinear_names,
+)
+from .nonlinear import element as nonlinear_element
 
 __all__ = [
     "CHANNELS", "STATES", "OFFSET_PARAMETERS", "VOCABULARY", "VOCABULARY_NAMES", "PAPER_GRID_HZ",
     "PARAMETER_INFO", "Rig", "Response", "frf", "parameter_names", "solve", "terms", "effect", "Effect",
     "SensorGain", "TimeDelay", "StructuralDamping", "DielectricLoss", "ShuntCapacitance", "ExtraMode",
     "ParameterOffset", "Parameter", "MatchedFilter", "register", "unregister", "registered_names",
+    "NONLINEAR", "NonlinearElement", "CubicAbsorberSpring", "CubicHostSpring", "AbsorberFriction",
+    "QuadraticDamping", "InductorSaturation", "nonlinear_element", "nonlinear_names", "integrate", "equivalent_rig",
 ]
