@@ -11,6 +11,8 @@ from dataclasses import asdict, dataclass
 
 import numpy as np
 
+from ..conventions import TINY
+
 
 @dataclass(frozen=True)
 class MeasurementFinding:
@@ -71,14 +73,14 @@ def welch_findings(freq_hz, channels: dict, std: dict, resolution_hz: float, seg
         f0, width = sharp
         bias = 4.0 / 3.0 * (resolution_hz / width) ** 2  # Bendat & Piersol, B_e = 2Δf for Hann
         i = int(np.argmin(np.abs(freq_hz - f0)))
-        rel_std = min(std[c][i] / max(abs(channels[c][i]), 1e-300) for c in channels)
+        rel_std = min(std[c][i] / max(abs(channels[c][i]), TINY) for c in channels)
         if bias > 0.5 * rel_std:
             need = 2 ** int(np.ceil(np.log2(resolution_hz / (width * np.sqrt(0.75 * 0.1 * rel_std)))))
             found.append(MeasurementFinding(
                 "resolution_bias", corrected=True, explanation=
                 f"the {estimator} estimate's resolution ({resolution_hz:.3g} Hz) smears the resonance at "
                 f"{f0:.1f} Hz (half-power width {width:.2f} Hz): its peak is about {100 * bias:.2g} % low, "
-                f"{bias / max(rel_std, 1e-300):.1f}× the noise there. satmd compares the model through the same "
+                f"{bias / max(rel_std, TINY):.1f}× the noise there. satmd compares the model through the same "
                 f"window (its power kernel, to second order), so the smearing is not taken for physics",
                 remedy=f"use the local polynomial estimator (the default), or nperseg at least {need}× longer"))
     if segments < 16:
@@ -90,8 +92,11 @@ def welch_findings(freq_hz, channels: dict, std: dict, resolution_hz: float, seg
 
 
 def lpm_findings(freq_hz, channels: dict, std: dict, settings: dict, force_noise_bias: np.ndarray,
-                 requested_band=None) -> list[MeasurementFinding]:
-    """Short record for the resonances, force-noise bias, unexcited band, for an LPM estimate."""
+                 requested_band=None, bias_bound=None) -> list[MeasurementFinding]:
+    """Short record for the resonances, force-noise bias (corrected, or not told), unexcited band (LPM).
+
+    ``bias_bound``: per point, the relative force-noise bias that may remain (`satmd.io.lpm.LPMEstimate`).
+    """
     found = []
     sharp = sharpest_resonance(freq_hz, channels)
     window = settings["window_hz"]
@@ -104,14 +109,15 @@ def lpm_findings(freq_hz, channels: dict, std: dict, settings: dict, force_noise
             f"record at least {need:.0f} s"))
     bias = float(np.max(force_noise_bias)) if np.size(force_noise_bias) else 0.0
     if bias > 0:
-        rel = min(float(np.median(std[c] / np.maximum(np.abs(channels[c]), 1e-300))) for c in channels)
+        rel = min(float(np.median(std[c] / np.maximum(np.abs(channels[c]), TINY))) for c in channels)
         if bias > 0.1 * rel:
             found.append(MeasurementFinding(
                 "force_noise_bias",
                 f"noise on the force sensor pulls the FRF towards zero by up to {100 * bias:.2g} % "
-                f"({bias / max(rel, 1e-300):.1f}× the typical noise); estimated from the force's noise floor "
+                f"({bias / max(rel, TINY):.1f}× the typical noise); estimated from the force's noise floor "
                 f"outside the excited band and removed",
                 "a cleaner force signal (higher excitation level or a quieter load cell)", corrected=True))
+    found += _unseen_floor(channels, std, settings, bias_bound)
     lo, hi = settings["band_hz"]
     req_lo, req_hi = requested_band or (None, None)
     cut = [f"{a:g}–{b:g} Hz" for a, b in ((req_lo, lo), (hi, req_hi))
@@ -123,6 +129,36 @@ def lpm_findings(freq_hz, channels: dict, std: dict, settings: dict, force_noise
             f"force and were left out",
             "widen the excitation band of the shaker signal"))
     return found
+
+
+def _unseen_floor(channels, std, settings, bias_bound) -> list[MeasurementFinding]:
+    """No force-noise floor could be told from the force: nothing corrected; say how large the bias may be."""
+    status = settings.get("force_noise_status")
+    if status in (None, "estimated"):
+        return []
+    why = {"no_region": "the force is excited up to (nearly) the Nyquist frequency, so no band above it shows "
+                        "the force sensor's noise alone",
+           "not_below_excitation": "the flat stretch above the excited band is not 30 dB under the excitation, so "
+                                   "it may be force, not noise"}.get(status)
+    if why is None:
+        slope = settings.get("force_noise_slope_db_per_octave")
+        span = settings.get("force_noise_span_hz") or [float("nan")] * 2
+        why = (f"above the excited band the force spectrum keeps falling ({slope:.1f} dB/octave up to "
+               f"{span[1]:.0f} Hz) and never levels off: a roll-off is excitation, not noise")
+    if bias_bound is not None and np.size(bias_bound) and settings.get("force_noise_bound") is not None:
+        rel = np.concatenate([std[c] / np.maximum(np.abs(channels[c]), TINY) for c in channels])
+        worst = float(np.max(np.asarray(bias_bound)))
+        ratio = float(np.max(np.tile(bias_bound, len(channels)) / np.maximum(rel, TINY)))
+        size = (f"the bias it may cause (H pulled towards zero by the noise-to-force power ratio) is at most "
+                f"{100 * worst:.2g} %, {ratio:.2g}× the noise at its worst point")
+    else:
+        size = "its bias on the FRF cannot be bounded from this record"
+    return [MeasurementFinding(
+        "force_noise_floor_unseen",
+        f"no force-noise floor can be told from the force spectrum: {why}. No force-noise correction was made; "
+        f"{size}",
+        "record at a higher sample rate (so the force's noise floor shows above the shaker's roll-off), or "
+        "measure the load cell's noise with the shaker off", corrected=False)]
 
 
 def clipping_findings(recording) -> list[MeasurementFinding]:

@@ -106,7 +106,7 @@ def _estimate_lpm(recording: Recording, band, width_hz) -> FRFData:
     est = lpm(recording, band=band, width_hz=width_hz)
     s = est.settings
     findings = clipping_findings(recording) + lpm_findings(est.freq_hz, est.frf, est.std, s,
-                                                           est.force_noise_bias, band)
+                                                           est.force_noise_bias, band, est.force_noise_bias_bound)
     floor = 1e-10 * max(np.max(np.abs(h)) for h in est.frf.values())
     std = {c: np.maximum(v, floor) for c, v in est.std.items()}
     info = {"method": "lpm", "reference": "Pintelon et al. 2010, local polynomial method",
@@ -115,6 +115,8 @@ def _estimate_lpm(recording: Recording, band, width_hz) -> FRFData:
             "degree": s["degree"], "points": int(est.freq_hz.size), "noise_dof": round(s["noise_dof"], 1),
             "force_noise_floor_detected": s["force_noise_floor"] is not None,
             "max_force_noise_bias": float(np.max(est.force_noise_bias)),
+            "force_noise_status": s["force_noise_status"],
+            "max_force_noise_bias_bound": float(np.max(est.force_noise_bias_bound)),
             "measurement": [f.to_dict() for f in findings]}
     meta = {"source": str(source), "estimator": "lpm", "resolution_hz": f"{s['window_hz']:.6g}",
             "band_hz": f"{s['band_hz'][0]:.6g}:{s['band_hz'][1]:.6g}", "noise_dof": f"{s['noise_dof']:.0f}",

@@ -37,9 +37,10 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..conventions import RECORDING_CHANNELS
 from ..errors import DataError
 
-_RESPONSES = {"acc1": "a1", "acc2": "a2"}
+_RESPONSES = RECORDING_CHANNELS
 
 
 @dataclass(frozen=True)
@@ -55,6 +56,8 @@ class LPMEstimate:
     force_noise_bias : (M,) relative bias removed (0 where no force-noise floor was seen)
     settings : dict of what was done (bins per window, degree, band, dof)
     correlation : {"a1,a2": (M,) complex} correlation of the two channels' errors (force noise)
+    force_noise_bias_bound : (M,) relative bias that may remain: the bound when no floor could be told
+        from the force (nothing corrected), else the uncertainty of the correction
     """
 
     freq_hz: np.ndarray
@@ -64,6 +67,7 @@ class LPMEstimate:
     force_noise_bias: np.ndarray
     settings: dict = field(default_factory=dict)
     correlation: dict = field(default_factory=dict)
+    force_noise_bias_bound: np.ndarray | None = None
 
 
 def excited_band(force: np.ndarray, fs_hz: float, smooth_hz: float = 1.0, drop_db: float = 20.0):
@@ -72,17 +76,33 @@ def excited_band(force: np.ndarray, fs_hz: float, smooth_hz: float = 1.0, drop_d
     The force power, smoothed over ``smooth_hz``, is compared with its typical
     level in the excited region (95th percentile): bins within ``drop_db`` of it
     are excited; the band is the widest run of them (gaps under ``smooth_hz``
-    bridged). ``floor`` is the per-bin noise power E|N_k|² of the force outside
-    the band when the band is clearly limited (None otherwise).
+    bridged). ``floor`` is the per-bin noise power E|N_k|² of the force, or None
+    when no noise floor can be told from the spectrum (`force_noise_floor`).
     """
+    band = _excited(force, fs_hz, smooth_hz, drop_db)
+    return band["lo"], band["hi"], band["floor"]["floor"]
+
+
+def _excited(force, fs_hz, smooth_hz=1.0, drop_db=20.0) -> dict:
+    """The excited band (bins and Hz) and the force-noise floor verdict (`force_noise_floor`)."""
+    force = np.asarray(force, dtype=float)
     n = force.size
+    if not np.isfinite(fs_hz) or fs_hz <= 0:
+        raise DataError(f"sample rate {fs_hz!r} Hz is not a positive number")
+    if n < 64:
+        raise DataError(f"the force has {n} samples: too few to find the band it excites (need at least 64)")
     X = np.fft.rfft(force - force.mean())
     f = np.fft.rfftfreq(n, 1.0 / fs_hz)
     power = np.abs(X) ** 2
     k = max(1, int(round(smooth_hz * n / fs_hz)))
+    if k > f.size // 8:
+        raise DataError(f"{n} samples at {fs_hz:g} Hz give {f.size} frequency lines of {fs_hz / n:.3g} Hz: "
+                        f"too coarse to find the band the force excites (record at least {8 * smooth_hz:g} s)")
     smoothed = np.convolve(power, np.ones(k) / k, mode="same")
     smoothed[0] = 0.0
     level = np.percentile(smoothed[1:], 95)
+    if not level > 0:
+        raise DataError("the force is constant: it excites no frequency band")
     excited = smoothed > level * 10 ** (-drop_db / 10)
     runs = _runs(excited, bridge=k)
     if not runs:
@@ -90,15 +110,73 @@ def excited_band(force: np.ndarray, fs_hz: float, smooth_hz: float = 1.0, drop_d
     i0, i1 = max(runs, key=lambda r: r[1] - r[0])
     # stay clear of the filter's edges: the smoothing spreads them over k bins
     i0, i1 = min(i0 + k, i1), max(i1 - k, i0)
-    outside = np.ones(f.size, bool)
-    outside[max(0, i0 - 4 * k): i1 + 4 * k] = False
-    outside[0] = False
-    floor = None
-    if outside.sum() > 100:
-        median = np.median(power[outside])
-        if median * np.log(2) * 1e3 < level:  # 30 dB below the excitation: a noise floor, not excitation
-            floor = float(median / np.log(2))  # |N_k|² is exponential: mean = median / ln 2
-    return float(f[i0]), float(f[i1]), floor
+    verdict = force_noise_floor(power, f, i1 + 4 * k, level)
+    return {"lo": float(f[i0]), "hi": float(f[i1]), "i0": i0, "i1": i1, "level": float(level), "floor": verdict}
+
+
+def force_noise_floor(power: np.ndarray, f: np.ndarray, start: int, level: float) -> dict:
+    """The force sensor's noise floor above the excited band, only where the spectrum shows one.
+
+    A shaker's force does not stop at the band edge: it rolls off (gently or
+    steeply, with the shaker's own resonance, pink or coloured), and a roll-off
+    is not noise. The noise floor is where the spectrum stops falling: above
+    ``start`` the periodogram is cut into blocks whose level is the block median
+    / ln 2 (the mean of exponential bins, robust to hum lines); the floor is the
+    longest run of blocks that is flat within their scatter, ends in the lowest
+    levels, spans at least half an octave and lies 30 dB under the excitation.
+    Otherwise the floor cannot be told from the signal: no floor, and
+    ``bound`` = the lowest block level, an upper bound on it (signal + noise ≥
+    noise), from which the bias that was *not* corrected can be bounded.
+
+    Parameters
+    ----------
+    power : |X_k|² of the force (rfft bins).
+    f : frequencies of the bins [Hz].
+    start : first bin clear of the excited band.
+    level : the excitation's typical per-bin power.
+
+    Returns
+    -------
+    dict
+        ``floor`` (per-bin E|N_k|², or None), ``bound`` (per-bin upper bound or None), ``status``
+        (``estimated``, ``no_plateau``, ``not_below_excitation`` or ``no_region``), ``slope_db_per_octave``
+        (of the spectrum's last stretch, when there is no floor) and ``span_hz``.
+    """
+    region = power[start:]
+    m = max(32, region.size // 48)
+    n_blocks = region.size // m
+    if n_blocks < 6:
+        return {"floor": None, "bound": None, "status": "no_region", "slope_db_per_octave": None, "span_hz": None}
+    blocks = region[: n_blocks * m].reshape(n_blocks, m)
+    fb = f[start: start + n_blocks * m].reshape(n_blocks, m).mean(axis=1)
+    lev = np.median(blocks, axis=1) / np.log(2)
+    db = 10 * np.log10(np.maximum(lev, 1e-300))
+    sd = 10 / np.log(10) * 1.25 / np.sqrt(m)  # scatter of a block median's level [dB]
+    tol = max(1.0, 3.0 * sd)
+    bound = float(lev.min() * (1 + 3 * 1.25 / np.sqrt(m)))
+    ref = np.percentile(db, 10)
+    near = db <= ref + tol
+    best = max(_runs(near, bridge=1), key=lambda r: r[1] - r[0])
+    r0, r1 = best
+    run = slice(r0, r1 + 1)
+    octaves = np.log2(fb[r1] / max(fb[r0], 1e-300))
+    slope = None
+    flat = False
+    if r1 - r0 + 1 >= 6 and octaves >= 0.5:
+        x = np.log2(fb[run])
+        slope = float(np.polyfit(x, db[run], 1)[0])
+        flat = abs(slope) * octaves <= tol
+    out = {"bound": bound, "span_hz": [float(fb[r0]), float(fb[r1])], "slope_db_per_octave": slope}
+    if not flat:
+        tail = slice(max(0, n_blocks - max(6, n_blocks // 4)), n_blocks)
+        x = np.log2(fb[tail])
+        out["slope_db_per_octave"] = float(np.polyfit(x, db[tail], 1)[0]) if np.ptp(x) > 0 else None
+        return {**out, "floor": None, "status": "no_plateau"}
+    floor = float(np.median(blocks[run]) / np.log(2))
+    out["floor_rel_std"] = float(1.25 / np.sqrt(blocks[run].size))
+    if floor * 1e3 >= level:  # not 30 dB below the excitation: a flat stretch of force, not noise
+        return {**out, "floor": None, "status": "not_below_excitation"}
+    return {**out, "floor": floor, "status": "estimated"}
 
 
 def _runs(mask, bridge):
@@ -150,7 +228,8 @@ def lpm(recording, band=None, width_hz: float | None = None, degree: int = 2, sm
         raise DataError(f"width_hz must be > 0, got {width_hz}")
     fs, n = recording.fs_hz, recording.n_samples
     x = recording["force"]
-    excited_lo, excited_hi, floor = excited_band(x, fs)
+    found = _excited(x, fs)
+    excited_lo, excited_hi, floor = found["lo"], found["hi"], found["floor"]  # floor: the verdict dict
     lo, hi = excited_lo, excited_hi
     band_lo, band_hi = (band or (None, None))
     if band_lo is not None:
@@ -175,8 +254,12 @@ def lpm(recording, band=None, width_hz: float | None = None, degree: int = 2, sm
     return est
 
 
-def _local_fits(spectra, fs, n, lo, hi, width_hz, degree, smooth, floor) -> LPMEstimate:
-    """One LPM pass with windows of ``width_hz`` over lo..hi Hz (see the module docstring)."""
+def _local_fits(spectra, fs, n, lo, hi, width_hz, degree, smooth, verdict) -> LPMEstimate:
+    """One LPM pass with windows of ``width_hz`` over lo..hi Hz (see the module docstring).
+
+    ``verdict``: `force_noise_floor`'s answer; the force-noise bias is removed only where it found a floor.
+    """
+    floor = verdict["floor"]
     p = 2 * (degree + 1)
     half = max(p // 2, int(round(width_hz * n / fs / 2)))  # window 2·half+1 bins, > p
     width = 2 * half + 1
@@ -200,8 +283,12 @@ def _local_fits(spectra, fs, n, lo, hi, width_hz, degree, smooth, floor) -> LPME
     freq = centres * df
     sxx = np.mean(np.abs(Xw) ** 2, axis=1)
     bias = np.zeros(centres.size)
+    bound = np.zeros(centres.size)
     if floor is not None:
         bias = floor / np.maximum(sxx - floor, 1e-300 * sxx + 1e-300)
+        bound = bias * verdict["floor_rel_std"]  # what the floor's own scatter leaves
+    elif verdict["bound"] is not None:
+        bound = np.minimum(verdict["bound"] / np.maximum(sxx - verdict["bound"], 1e-300 * sxx + 1e-300), 1.0)
     out_h, out_std, out_coh, dof = {}, {}, {}, None
     raw_h, resid, var = {}, {}, {}
     for name, ch in _RESPONSES.items():
@@ -223,8 +310,11 @@ def _local_fits(spectra, fs, n, lo, hi, width_hz, degree, smooth, floor) -> LPME
         correlation["a1,a2"] = _channel_correlation(resid, raw_h, var, q, smooth)
     settings = {"method": "lpm", "record_s": n / fs, "bins_per_window": width, "window_hz": width * df,
                 "degree": degree, "noise_dof_per_window": q, "noise_dof": dof, "smooth_windows": 2 * smooth + 1,
-                "band_hz": [float(lo), float(hi)], "force_noise_floor": floor}
-    return LPMEstimate(freq, out_h, out_std, out_coh, bias, settings, correlation)
+                "band_hz": [float(lo), float(hi)], "force_noise_floor": floor,
+                "force_noise_status": verdict["status"], "force_noise_bound": verdict["bound"],
+                "force_noise_slope_db_per_octave": verdict["slope_db_per_octave"],
+                "force_noise_span_hz": verdict["span_hz"]}
+    return LPMEstimate(freq, out_h, out_std, out_coh, bias, settings, correlation, bound)
 
 
 def _channel_correlation(resid, h, var, q, half):
