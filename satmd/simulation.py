@@ -11,6 +11,7 @@ from typing import Sequence
 
 import numpy as np
 
+from .conventions import ACCEL_CHANNELS
 from .errors import DataError
 from .io.frfdata import FRFData
 from .physics import PAPER_GRID_HZ, Rig, frf
@@ -27,7 +28,7 @@ def simulate(
     freq_hz=PAPER_GRID_HZ,
     rig: Rig | None = None,
     effects: Sequence[Effect] = (),
-    channels: Sequence[str] = ("a1", "a2"),
+    channels: Sequence[str] = ACCEL_CHANNELS,
     noise: float | tuple[float, float] | None = None,
     seed: int | None = None,
     meta: dict | None = None,

@@ -5,6 +5,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..conventions import TINY
 from ..errors import FormatError, SatmdError
 from ._common import one_line_warnings
 
@@ -170,7 +171,7 @@ def frf_lines(data) -> list[str]:
         text = (f"  {ch}  [{UNITS.get(ch, '')}]  |H| {mag.min():.3g}..{mag.max():.3g} "
                 f"(peak at {f[np.argmax(mag)]:.5g} Hz)")
         if ch in data.std:
-            text += f"; std median {100 * np.median(data.std[ch] / np.maximum(mag, 1e-300)):.3g} % of |H|"
+            text += f"; std median {100 * np.median(data.std[ch] / np.maximum(mag, TINY)):.3g} % of |H|"
         if ch in data.coherence:
             g = data.coherence[ch]
             text += f"; coherence min {g.min():.3f}, median {np.median(g):.3f}"

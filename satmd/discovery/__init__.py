@@ -25,7 +25,7 @@ import time
 from functools import partial
 from typing import Sequence
 
-from ..conventions import DEFAULT_FREE
+from ..conventions import ACCEL_CHANNELS, DEFAULT_FREE
 from .._fleet import fleet_map
 from ..identification import identify
 from ..io.frfdata import FRFData
@@ -123,7 +123,7 @@ def _discover_frf(data: FRFData, rig, free, candidates, channels, alpha, max_eff
     t0 = time.perf_counter()
     rig = Rig() if rig is None else rig
     free = tuple(free)
-    channels = tuple(channels) if channels else tuple(c for c in ("a1", "a2") if c in data.channels) or data.names
+    channels = tuple(channels) if channels else tuple(c for c in ACCEL_CHANNELS if c in data.channels) or data.names
     data = data.select(channels)
     candidates = tuple(candidates) if candidates else default_candidates()
 

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..conventions import TINY
 from ..physics import frf
 from ..physics.effects import registered_names
 
@@ -51,7 +52,7 @@ def matched_filter(new, fit) -> list[dict]:
         J = r.jac[c][..., 0] / sigma[c]  # (N, F)
         num += np.real(np.sum(np.conj(J) * (-resid[c] / sigma[c]), axis=-1))  # against data - model
         den += np.sum(np.abs(J) ** 2, axis=-1)
-    amp = np.clip(base + num / np.maximum(den, 1e-300), *scan.amplitude_range)
-    gain = np.where(num > 0, num**2 / np.maximum(den, 1e-300), 0.0)
+    amp = np.clip(base + num / np.maximum(den, TINY), *scan.amplitude_range)
+    gain = np.where(num > 0, num**2 / np.maximum(den, TINY), 0.0)
     order = np.argsort(-gain)[: scan.keep]
     return [{**{n: float(m[i]) for n, m in zip(names, mesh)}, scan.amplitude: float(amp[i])} for i in order]

@@ -15,6 +15,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..conventions import TINY
+
 MAX_DEGREE = 12
 
 
@@ -30,7 +32,7 @@ class Discrepancy:
     @property
     def structured_fraction(self) -> float:
         """Share of the excess χ² (above its expectation) removed by the correction."""
-        return float(max(0.0, self.chi2_before - self.chi2_after) / max(self.chi2_before, 1e-300))
+        return float(max(0.0, self.chi2_before - self.chi2_after) / max(self.chi2_before, TINY))
 
 
 def fit_discrepancy(freq_hz, residual: dict, sigma: dict) -> Discrepancy:
@@ -54,7 +56,7 @@ def fit_discrepancy(freq_hz, residual: dict, sigma: dict) -> Discrepancy:
                 A = basis[:, active] * w[:, None]
                 theta, *_ = np.linalg.lstsq(A, rw, rcond=None)
                 cov = np.linalg.pinv(A.conj().T @ A)
-                z = np.abs(theta) / np.sqrt(np.maximum(np.real(np.diag(cov)), 1e-300))
+                z = np.abs(theta) / np.sqrt(np.maximum(np.real(np.diag(cov)), TINY))
                 keep = z > 2.0
                 if keep.all() or not keep.any():
                     break

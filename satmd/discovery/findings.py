@@ -20,7 +20,7 @@ class EffectFinding:
     ----------
     name : effect name as in SPEC §8, e.g. ``"extra_mode"``.
     parameters : fitted values of the effect's own parameters.
-    equivalent : other effects that explain the data as well (|ΔBIC| < 10).
+    equivalent : other effects that explain the data as well (|ΔBIC| < `MIN_DELTA_BIC`).
     delta_bic : how much BIC rises when the effect is removed.
     explanation : the finding in plain words (written by ``report.py`` from the numbers here).
     shifts : relative change of each free parameter when the effect is accounted for.

@@ -15,6 +15,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..numerics import lag1_autocorrelation
+
 WIDTHS = (1, 3, 7, 15)
 
 
@@ -81,8 +83,4 @@ def _lag1(v: np.ndarray) -> float:
     """Lag-1 autocorrelation across frequency (≈ 0 for white residuals)."""
     if v.size < 3:
         return 0.0
-    x = np.concatenate([v.real - v.real.mean(), v.imag - v.imag.mean()])
-    lagged = np.concatenate([v.real[:-1] - v.real.mean(), v.imag[:-1] - v.imag.mean()])
-    ahead = np.concatenate([v.real[1:] - v.real.mean(), v.imag[1:] - v.imag.mean()])
-    power = np.sum(x * x)
-    return float(np.sum(lagged * ahead) / power) if power > 0 else 0.0
+    return lag1_autocorrelation(np.stack([v.real - v.real.mean(), v.imag - v.imag.mean()]))  # each part about its mean

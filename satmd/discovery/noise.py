@@ -16,6 +16,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..conventions import TINY
+
 
 def second_difference(r: np.ndarray) -> np.ndarray:
     return (r[:-2] - 2 * r[1:-1] + r[2:]) / np.sqrt(6.0)
@@ -46,7 +48,7 @@ def estimate_channel_std(residual: np.ndarray, magnitude: np.ndarray, nu: float 
         # bivariate t: -log density ∝ log v + (ν+2)/2 log(1 + q/(ν v))
         return np.sum(np.log(v) + 0.5 * (nu + 2) * np.log1p(q / (nu * v)))
 
-    scale = np.sqrt(np.median(d.real**2 + d.imag**2) / 2) + 1e-300
+    scale = np.sqrt(np.median(d.real**2 + d.imag**2) / 2) + TINY
     rel0 = np.log(max(scale / np.sqrt(np.mean(m2)), 1e-12))
     best = None
     for x0 in ([rel0, rel0 - 2.3], [rel0 - 2.3, np.log(scale / peak)], [rel0 - 4.6, np.log(scale / peak)]):

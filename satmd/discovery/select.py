@@ -16,6 +16,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..numerics import distinct_best
 from ..identification import identify
 from ..identification.problem import Problem
 from ..physics.effects import at_rest
@@ -102,17 +103,7 @@ def _with_values(effect, values):
 def _distinct_best(thetas, cost, names, effect, k):
     """Indices of the k lowest-cost starts whose own effect parameters differ."""
     own = [i for i, n in enumerate(names) if n.startswith(effect.name + ".")]
-    order = np.argsort(cost)
-    picked = []
-    for i in order:
-        if not np.isfinite(cost[i]):
-            continue
-        z = np.log(np.abs(thetas[i, own]) + 1e-30)
-        if all(np.max(np.abs(z - np.log(np.abs(thetas[j, own]) + 1e-30))) > 0.02 for j in picked):
-            picked.append(i)
-        if len(picked) == k:
-            break
-    return picked
+    return distinct_best(cost, np.log(np.abs(thetas[:, own]) + 1e-30), k, 0.02)
 
 
 def select(search: Search, nominal: Model, still_significant, max_effects: int = 3, beam: int = 3):
@@ -183,7 +174,7 @@ def _swaps(search, model, nominal):
 
 
 def equivalents(search, model, nominal, limit: int = 3) -> dict:
-    """For each effect of ``model``: other candidates explaining the data as well (|ΔBIC| < 10)."""
+    """For each effect of ``model``: other candidates explaining the data as well (|ΔBIC| < MIN_DELTA_BIC)."""
     out = {}
     for name in model.names:
         rest = search.remove(model, name, nominal)

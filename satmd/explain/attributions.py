@@ -36,6 +36,7 @@ PAPER_TABLE3 = {
 }
 #: Where the paper finds the peaks of the sensitivity curves (Hz).
 PAPER_PEAK_BANDS_HZ = ((50.0, 52.0), (103.0, 110.0))
+PEAK_BAND_TOLERANCE_HZ = 3.0  # a peak this close to a paper band counts as inside (one grid step is 1.5 Hz)
 TABLE3_LABELS = {
     "mean": "Mean normalized sensitivity",
     "std": "Standard deviation of normalized sensitivity",
@@ -190,6 +191,6 @@ def peak_frequencies(curve: np.ndarray, freq_hz: np.ndarray, n: int = 2, min_sep
     return picked
 
 
-def in_paper_bands(peaks_hz, tolerance_hz: float = 3.0) -> list:
+def in_paper_bands(peaks_hz, tolerance_hz: float = PEAK_BAND_TOLERANCE_HZ) -> list:
     """For each paper band, whether some peak falls inside it (± tolerance, one grid step is 1.5 Hz)."""
     return [any(lo - tolerance_hz <= p <= hi + tolerance_hz for p in peaks_hz) for lo, hi in PAPER_PEAK_BANDS_HZ]

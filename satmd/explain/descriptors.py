@@ -26,6 +26,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..conventions import TINY
 from ..physics import PAPER_GRID_HZ, Rig, frf
 
 #: Reference point of ξ (SPEC §6).
@@ -211,7 +212,7 @@ def modal_physics(rig: Rig | None = None) -> dict:
     K[..., 0, 0], K[..., 0, 1], K[..., 0, 2] = k1 + kp, -kp, e / Cp
     K[..., 1, 1], K[..., 1, 2], K[..., 2, 2] = kp, -e / Cp, 1 / Cp
     K = K + np.swapaxes(np.triu(K, 1), -1, -2)
-    s = 1 / np.sqrt(np.stack([m1, m2, np.maximum(L, 1e-300)], axis=-1))  # mass-normalised: symmetric eigenproblem
+    s = 1 / np.sqrt(np.stack([m1, m2, np.maximum(L, TINY)], axis=-1))  # mass-normalised: symmetric eigenproblem
     lam = np.linalg.eigvalsh(K * s[..., :, None] * s[..., None, :])
     return {"f_absorber_hz": f_abs, "f_anti_roots_hz": f_roots,
             "f_modes_hz": np.sqrt(np.maximum(lam, 0.0)) / two_pi}

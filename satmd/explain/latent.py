@@ -20,6 +20,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..conventions import ACCEL_CHANNELS
 from ..errors import DataError
 from ..inverse.dataset import complex_to_features
 from ..physics import frf
@@ -106,7 +107,7 @@ def sweep(model, anchor, n: int = 11, half_width=None) -> dict:
     R = np.concatenate([Rs, np.full(n, R0)])
     L = np.concatenate([np.full(n, L0), Ls])
     rig = contract.model_rig(model).replace(R=R, L=L)
-    r = frf(model.freq_hz, rig, outputs=("a1", "a2"))
+    r = frf(model.freq_hz, rig, outputs=ACCEL_CHANNELS)
     Z = contract.latent(model, complex_to_features(np.stack([r.a1, r.a2], axis=1)))
     span = contract.bounds_span(model)
     dR = _direction(Z[:n], Rs / span[0])

@@ -11,6 +11,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..conventions import ACCEL_CHANNELS
 from ..physics import frf
 from . import contract
 from .anova import GridAnova, grid_anova, grid_ceiling
@@ -54,7 +55,7 @@ def blind_frfs(model, cases=BLIND_CASES) -> np.ndarray:
     """Noise-free (n, 2, F) accelerations of the blind pairs on the model's grid (as the paper's)."""
     cases = np.asarray(cases, float)
     rig = contract.model_rig(model).replace(R=cases[:, 0], L=cases[:, 1])
-    r = frf(model.freq_hz, rig, outputs=("a1", "a2"))
+    r = frf(model.freq_hz, rig, outputs=ACCEL_CHANNELS)
     return np.stack([r.a1, r.a2], axis=1)
 
 

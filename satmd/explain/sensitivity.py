@@ -23,6 +23,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.stats import spearmanr
 
+from ..conventions import ACCEL_CHANNELS
 from ..physics import PAPER_GRID_HZ, Rig, frf
 from .attributions import OUTPUTS, normalise_max, per_frequency
 
@@ -68,7 +69,7 @@ def physical_sensitivity(rig: Rig | None = None, freq=PAPER_GRID_HZ, params=OUTP
     """
     rig = Rig() if rig is None else rig
     freq = np.asarray(freq, float)
-    r = frf(freq, rig, effects, wrt=list(params), outputs=("a1", "a2"))
+    r = frf(freq, rig, effects, wrt=list(params), outputs=ACCEL_CHANNELS)
     ja1, ja2 = r.jac["a1"], r.jac["a2"]  # (*batch, F, P)
     z = np.concatenate([ja1, ja2], axis=-2)  # (*batch, 2F, P): [A1 over f, A2 over f]
     jac = np.concatenate([z.real, z.imag], axis=-2)  # raw-feature ordering

@@ -15,6 +15,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..conventions import TINY
+
 try:
     import sympy as sp
 except ImportError as exc:  # pragma: no cover - exercised only without sympy
@@ -236,7 +238,7 @@ def prune(expr: sp.Expr, Z: np.ndarray, y: np.ndarray, rtol: float = 1e-4, max_r
                 continue
             trial = polish(trial, Zs, ys, max_nfev=max_nfev)
             sse = _sse(trial, Zs, ys)
-            if sse <= best_sse * (1.0 + rtol) + 1e-300:
+            if sse <= best_sse * (1.0 + rtol) + TINY:
                 best, best_sse, changed = trial, min(best_sse, sse), True
                 break
     return expr if best is expr else polish(best, Z, y, max_nfev=max_nfev)

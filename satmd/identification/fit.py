@@ -7,6 +7,7 @@ from typing import Sequence
 
 import numpy as np
 
+from ..numerics import distinct_best
 from ..conventions import DEFAULT_FREE
 from ..errors import DataError
 from ..io.frfdata import FRFData
@@ -191,14 +192,8 @@ def _search(problem: Problem, n_search, n_refine, seed, starts) -> list[np.ndarr
     thetas = np.repeat(starts[0][None, :], u.shape[0], axis=0)
     thetas[:, idx] = np.exp(lo + u * (hi - lo))
     cost = problem.batch_cost(thetas)
-    order = np.argsort(cost)
-    picked = []
-    for k in order:  # distinct basins: at least 10 % apart in some log-parameter
-        z = np.log(thetas[k, idx])
-        if all(np.max(np.abs(z - np.log(thetas[j, idx]))) > 0.1 for j in picked):
-            picked.append(k)
-        if len(picked) == n_refine:
-            break
+    # distinct basins: at least 10 % apart in some log-parameter
+    picked = distinct_best(cost, np.log(thetas[:, idx]), n_refine, 0.1, finite_only=False)
     return [thetas[k] for k in picked]
 
 

@@ -22,7 +22,7 @@ from typing import Sequence
 
 import numpy as np
 
-from ..conventions import DEFAULT_FREE
+from ..conventions import ACCEL_CHANNELS, DEFAULT_FREE
 from ..errors import DataError
 from ..io.frfdata import FRFData
 from ..physics import Rig, frf
@@ -305,6 +305,6 @@ def _typical(lo, hi):
 
 
 def _default_channels(data: FRFData):
-    acc = tuple(c for c in ("a1", "a2") if c in data.channels)
+    acc = tuple(c for c in ACCEL_CHANNELS if c in data.channels)
     return acc or tuple(data.channels)
 

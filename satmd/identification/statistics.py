@@ -5,6 +5,8 @@ import warnings as _warnings
 
 import numpy as np
 
+from ..numerics import lag1_autocorrelation
+from ..conventions import TINY
 from .covariance import parameter_covariance
 from .result import FitResult
 
@@ -32,7 +34,7 @@ def build_result(problem, theta, nominal, nfev, wall, opt, reg) -> FitResult:
     if problem.weighted:
         aic, bic = chi2 + 2 * k, chi2 + k * np.log(n)
     else:
-        base = n * np.log(max(chi2, 1e-300) / n)
+        base = n * np.log(max(chi2, TINY) / n)
         aic, bic = base + 2 * k, base + k * np.log(n)
     if problem.pair is None:
         half = r.size // 2  # r = [Re, Im] of (model - data)/σ: the prediction without another model call
@@ -110,9 +112,7 @@ def _pinned(problem, theta, nominal) -> tuple:
 
 def _lag1(r, n_series) -> float:
     """Pooled lag-1 autocorrelation along frequency of the weighted residual (≈ 0 for noise)."""
-    z = r.reshape(n_series, -1)
-    den = float(np.sum(z * z))
-    return float(np.sum(z[:, 1:] * z[:, :-1]) / den) if den > 0 and z.shape[1] > 2 else 0.0
+    return lag1_autocorrelation(r.reshape(n_series, -1))  # about 0, the residual's expectation
 
 
 def _fit_warnings(problem, theta, r, rel, chi2_red, dof, pinned) -> list:

@@ -27,6 +27,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..conventions import ACCEL_CHANNELS
 from ..errors import SatmdError
 from ..physics import PAPER_GRID_HZ, Rig, frf
 
@@ -159,7 +160,7 @@ def simulate_pairs(R, L, freq_hz=PAPER_GRID_HZ, rig: Rig | None = None):
     rig = Rig() if rig is None else rig
     R = np.asarray(R, float)
     L = np.asarray(L, float)
-    r = frf(freq_hz, rig.replace(R=R, L=L), outputs=("a1", "a2"))
+    r = frf(freq_hz, rig.replace(R=R, L=L), outputs=ACCEL_CHANNELS)
     return r.a1, r.a2
 
 

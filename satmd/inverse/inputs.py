@@ -24,6 +24,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..conventions import ACCEL_CHANNELS
 from ..errors import DataError
 from ..physics import Rig, frf
 from .dataset import InverseDataset, features_to_complex
@@ -111,11 +112,11 @@ def _check_same_grid(f, grid, what):
 def _from_frfs(datas, grid, rig):
     a, s, raw, notes = [], [], [], []
     for i, d in enumerate(datas):
-        missing = [c for c in ("a1", "a2") if c not in d.channels]
+        missing = [c for c in ACCEL_CHANNELS if c not in d.channels]
         if missing:
             raise DataError(f"the inverse model needs channels a1 and a2; the data lack {', '.join(missing)}")
         ai = np.stack([d["a1"], d["a2"]])
-        si = np.stack([d.std["a1"], d.std["a2"]]) if all(c in d.std for c in ("a1", "a2")) else None
+        si = np.stack([d.std["a1"], d.std["a2"]]) if all(c in d.std for c in ACCEL_CHANNELS) else None
         on_grid = d.freq_hz.shape == grid.shape and np.allclose(d.freq_hz, grid, rtol=1e-9, atol=1e-9)
         if not on_grid:
             label = d.meta.get("source") or (f"FRF {i + 1}" if len(datas) > 1 else "input")
@@ -167,7 +168,7 @@ def to_grid(freq, a, std, grid, rig=None, label="input"):
                      f"({np.median(np.diff(grid)):.3g} Hz): values between them are interpolated")
     if not inside.all():
         R, L = _least_squares_RL(f, z, None if std is None else std[:, near], rig)
-        model = frf(grid[~inside], (rig or Rig()).replace(R=R, L=L), outputs=("a1", "a2"))
+        model = frf(grid[~inside], (rig or Rig()).replace(R=R, L=L), outputs=ACCEL_CHANNELS)
         out[:, ~inside] = np.stack([model.a1, model.a2])
         notes.append(f"{label}: data cover {freq[0]:g}..{freq[-1]:g} Hz, not the model's {grid[0]:g}..{grid[-1]:g} Hz: "
                      f"{int((~inside).sum())} of {grid.size} grid points were filled from the forward model fitted "
@@ -207,7 +208,7 @@ def forward_check(inputs: Inputs, R, L, rig: Rig | None, residual_ref: float, no
     rig = Rig() if rig is None else rig
     res, exp = [], []
     for (f, a, s), r, l in zip(inputs.raw, np.asarray(R, float), np.asarray(L, float)):
-        model = frf(f, rig.replace(R=r, L=max(l, 1e-9)), outputs=("a1", "a2"))
+        model = frf(f, rig.replace(R=r, L=max(l, 1e-9)), outputs=ACCEL_CHANNELS)
         norm2 = float(np.sum(np.abs(a) ** 2))
         res.append(np.linalg.norm(np.stack([model.a1, model.a2]) - a) / np.sqrt(norm2))
         sd = np.abs(a) * noise if s is None else s

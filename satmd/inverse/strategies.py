@@ -19,6 +19,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..conventions import ACCEL_CHANNELS
 from .dataset import InverseDataset, complex_to_features
 
 
@@ -123,7 +124,7 @@ def residual_ref(model, ds: InverseDataset) -> float:
 
     a = np.stack([ds.a1, ds.a2], axis=1)
     mean, _ = net_predict(model, a, None)
-    rec = frf(ds.freq_hz, model.rig_or_default.replace(R=mean[:, 0], L=np.maximum(mean[:, 1], 1e-9)), outputs=("a1", "a2"))
+    rec = frf(ds.freq_hz, model.rig_or_default.replace(R=mean[:, 0], L=np.maximum(mean[:, 1], 1e-9)), outputs=ACCEL_CHANNELS)
     err = np.linalg.norm((np.stack([rec.a1, rec.a2], axis=1) - a).reshape(len(a), -1), axis=1)
     return float(max(np.quantile(err / np.linalg.norm(a.reshape(len(a), -1), axis=1), 0.99), 1e-4))
 

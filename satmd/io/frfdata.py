@@ -5,6 +5,7 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
+from ..conventions import ACCEL_CHANNELS
 from ..errors import DataError
 
 CHANNELS = ("a1", "a2", "u1", "u2", "q")
@@ -126,7 +127,7 @@ class FRFData:
         return replace(self, std=std)
 
     @classmethod
-    def from_response(cls, response, channels=("a1", "a2"), std=None, meta=None) -> "FRFData":
+    def from_response(cls, response, channels=ACCEL_CHANNELS, std=None, meta=None) -> "FRFData":
         """Wrap a single (unbatched) `satmd.physics.Response`."""
         chans = {c: np.asarray(response.channel(c)) for c in channels}
         if any(v.ndim != 1 for v in chans.values()):

@@ -13,13 +13,14 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..conventions import RECORDING_CHANNELS
 from ..errors import DataError, FormatError
 from ._common import warn
 
 ROLES = ("force", "acc1", "acc2")
 MAX_ABS_SAMPLE = 1e100  # no sensor reads this; beyond it spectra overflow
 SI_UNITS = {"force": "N", "acc1": "m/s^2", "acc2": "m/s^2"}
-MAP_ALIASES = {"a1": "acc1", "a2": "acc2"}
+MAP_ALIASES = {ch: name for name, ch in RECORDING_CHANNELS.items()}
 
 
 @dataclass(frozen=True)

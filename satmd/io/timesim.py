@@ -30,13 +30,14 @@ from typing import Sequence
 
 import numpy as np
 
+from ..conventions import ACCEL_CHANNELS, RECORDING_CHANNELS
 from ..errors import DataError
 from ..physics import Rig, frf
 from .recording import Recording
 
 EXCITATIONS = ("random", "sweep", "multisine")
 MAX_SAMPLES = 50_000_000  # ~1.2 GB of float64 per channel set: longer records are refused up front
-_RESPONSES = (("a1", "acc1"), ("a2", "acc2"))
+_RESPONSES = tuple((ch, name) for name, ch in RECORDING_CHANNELS.items())
 
 
 def simulate_recording(duration_s: float = 60.0, fs_hz: float = 1000.0, rig: Rig | None = None,
@@ -184,7 +185,7 @@ def _frf_with_dc(f, rig, effects, pass_hz) -> dict:
     Nyquist that step rings through the whole impulse response. The raised-cosine
     roll-off keeps the impulse response short and leaves the excited band untouched.
     """
-    r = frf(f[1:], rig, effects, outputs=("a1", "a2"))
+    r = frf(f[1:], rig, effects, outputs=ACCEL_CHANNELS)
     nyquist = f[-1]
     start = max(0.6 * nyquist, pass_hz)
     x = np.clip((f - start) / max(nyquist - start, 1e-9 * nyquist), 0.0, 1.0)
@@ -203,7 +204,7 @@ def _steady_state_multisine(n, fs_hz, rig, effects, lo, hi, rng) -> dict:
     band = (f >= lo) & (f <= hi)
     F = np.zeros(f.size, dtype=complex)
     F[band] = np.exp(2j * np.pi * rng.random(band.sum()))
-    response = frf(f[band], rig, effects, outputs=("a1", "a2"))
+    response = frf(f[band], rig, effects, outputs=ACCEL_CHANNELS)
     spectra = {"force": F}
     for ch, name in _RESPONSES:
         A = np.zeros_like(F)

@@ -6,6 +6,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..conventions import ACCEL_CHANNELS
 from ._common import atomic_write
 from .recording import Recording
 from .welch import _FLOOR, _check_estimator, _frf_from_spectra, _usable, spectra
@@ -52,7 +53,7 @@ def model_transmissibility(freq_hz, rig=None, effects=()) -> np.ndarray:
     """
     from ..physics import frf
 
-    r = frf(freq_hz, rig, effects, outputs=("a1", "a2"))
+    r = frf(freq_hz, rig, effects, outputs=ACCEL_CHANNELS)
     return r.a2 / r.a1
 
 

@@ -27,6 +27,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..conventions import ACCEL_CHANNELS
 from ..errors import DataError, FormatError
 from ._common import channel_map_of, parse_frf_unit, parse_quantity_unit, warn
 from .frfdata import CHANNELS, FRFData
@@ -130,7 +131,7 @@ def _map_channels(path, frfs, channel_map) -> dict:
                                         f"({', '.join(r.describe() for r in hits)}); choose one with {ch}=#N")
             chosen[ch] = (hits[0], _sign(hits[0]) * (-1 if b < 0 else 1))
     elif len(frfs) == 2:
-        names = ("u1", "u2") if all(_power(path, r)[0] == 0 for r in frfs) else ("a1", "a2")
+        names = ("u1", "u2") if all(_power(path, r)[0] == 0 for r in frfs) else ACCEL_CHANNELS
         chosen = {names[0]: (frfs[0], _sign(frfs[0])), names[1]: (frfs[1], _sign(frfs[1]))}
     elif len(frfs) == 1:
         warn(path, f"one FRF record ({listing}): read as a1, the primary mass; give a channel_map to say otherwise")

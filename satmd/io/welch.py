@@ -26,11 +26,12 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..conventions import RECORDING_CHANNELS
 from ..errors import DataError
 from ._common import warn
 from .recording import Recording
 
-_RESPONSES = {"acc1": "a1", "acc2": "a2"}
+_RESPONSES = RECORDING_CHANNELS
 _FLOOR = 1e-10
 
 

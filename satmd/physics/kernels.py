@@ -18,6 +18,7 @@ from typing import Sequence
 
 import numpy as np
 
+from ..conventions import ACCEL_CHANNELS
 from . import dual
 
 
@@ -121,7 +122,7 @@ def solve_with_tangents(t, wrt: Sequence[str], outputs: Sequence[str], out_value
     mw2 = -(v["omega"] * v["omega"])
     gain = {"a1": full("g1", mw2 if v["s1"] is None else mw2 * v["s1"]),
             "a2": full("g2", mw2 if v["s2"] is None else mw2 * v["s2"])}
-    for ch in ("a1", "a2"):
+    for ch in ACCEL_CHANNELS:
         if ch in outputs:
             np.multiply(gain[ch], u["u" + ch[1]], out=out_values[ch])
     shared = {}  # products every parameter acting through b or Z33 uses
@@ -154,7 +155,7 @@ def solve_with_tangents(t, wrt: Sequence[str], outputs: Sequence[str], out_value
             d1, d2 = du(key)
             if ch == "q":
                 coefs[key, ch] = -bz * (d1 - d2)
-            elif ch in ("a1", "a2"):
+            elif ch in ACCEL_CHANNELS:
                 coefs[key, ch] = gain[ch] * (d1 if ch == "a1" else d2)
             else:
                 coefs[key, ch] = d1 if ch == "u1" else d2
@@ -183,7 +184,7 @@ def solve_with_tangents(t, wrt: Sequence[str], outputs: Sequence[str], out_value
                     col = _acc(col, (q / b) * d["b"])
                 if d["Z33"] is not None:
                     col = _acc(col, (-q / Z33) * d["Z33"])
-            elif ch in ("a1", "a2") and d["s" + ch[1]] is not None:
+            elif ch in ACCEL_CHANNELS and d["s" + ch[1]] is not None:
                 col = _acc(col, (mw2 * d["s" + ch[1]]) * u["u" + ch[1]])
             cols.append(col)
         for j, col in enumerate(cols):  # the columns back to back: the chunk's (rows, F, P) block stays in cache

@@ -18,6 +18,7 @@ import os
 import warnings
 from typing import Sequence
 
+from ..conventions import ACCEL_CHANNELS
 from ..errors import DataError
 
 try:
@@ -101,7 +102,7 @@ def _compiled_closed_form(omega, rig, effects):
     return _closed_form(omega, rig, effects)
 
 
-def features(out: dict, channels: Sequence[str] = ("a1", "a2")) -> torch.Tensor:
+def features(out: dict, channels: Sequence[str] = ACCEL_CHANNELS) -> torch.Tensor:
     """Real network features [Re(channels) flattened, Im(channels) flattened] (SPEC §1)."""
     z = torch.cat([out[c] for c in channels], dim=-1)
     return torch.cat([z.real, z.imag], dim=-1)

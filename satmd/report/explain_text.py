@@ -7,7 +7,7 @@ Used by ``satmd explain``, the ``satmd reproduce`` section and
 """
 from __future__ import annotations
 
-from ..explain.attributions import OUTPUTS, PAPER_TABLE3, TABLE3_LABELS
+from ..explain.attributions import OUTPUTS, PAPER_PEAK_BANDS_HZ, PAPER_TABLE3, PEAK_BAND_TOLERANCE_HZ, TABLE3_LABELS
 from ..explain.run import AGREEMENT_KEYS, COMPLEXITY_CAP, MODAL_CAP, SPACES, NeuralAnalysis, SymbolicAnalysis
 from ..explain.symbolic import PAPER_FORMULA, PAPER_METRICS, binary_node_count, compact, parse
 
@@ -58,7 +58,7 @@ def _table3_rows(t3s: dict) -> list:
         md.append(f"| {label} | " + " | ".join(cells) + " |")
     cells = []
     for o in OUTPUTS:
-        cells += [_fmt_peaks(t3s[sp][o]["peaks_hz"]) for sp in spaces] + ["50–52, 103–110"]
+        cells += [_fmt_peaks(t3s[sp][o]["peaks_hz"]) for sp in spaces] + [", ".join(f"{lo:g}–{hi:g}" for lo, hi in PAPER_PEAK_BANDS_HZ)]
     md.append("| Peaks of the mean curve [Hz] | " + " | ".join(cells) + " |")
     return md
 
@@ -85,7 +85,8 @@ def neural_markdown(a: NeuralAnalysis, figure) -> str:
           "through the model's input standardisation; satmd's default), **scaled** = the standardised network "
           "inputs (raw gradient × each feature's training std).", "",
           *_table3_rows(a.table3), ""]
-    md += [f"Peaks inside the paper's bands (50–52 Hz, 103–110 Hz, ± 3 Hz): raw {a.in_bands['raw']}, "
+    bands = ", ".join(f"{lo:g}–{hi:g} Hz" for lo, hi in PAPER_PEAK_BANDS_HZ)
+    md += [f"Peaks inside the paper's bands ({bands}, ± {PEAK_BAND_TOLERANCE_HZ:g} Hz): raw {a.in_bands['raw']}, "
            f"scaled {a.in_bands['scaled']}.", ""]
     for sp in SPACES:
         md += [figure(attribution_curves(att[sp], k), f"explain_attribution_{o}_{sp}.png")

@@ -19,6 +19,7 @@ def _row(label, truth, rep):
 def build(ctx) -> str:
     from ..discovery import discover
     from ..discovery.scenarios import concealed_case
+    from ..discovery.select import MIN_DELTA_BIC
     from ..physics import Rig, effect
     from ..simulation import simulate
 
@@ -26,7 +27,7 @@ def build(ctx) -> str:
         "`satmd discover` fits the nominal model globally, tests the mismatch against the noise "
         "(χ² globally and in frequency windows, Bonferroni-corrected, α = 1e-3), and explains a significant "
         "mismatch with the vocabulary of SPEC §8 by BIC model selection (greedy steps, backward elimination, "
-        "swaps; alternatives within |ΔBIC| < 10 are reported as equivalent). The data below are simulated "
+        f"swaps; alternatives within |ΔBIC| < {MIN_DELTA_BIC:g} are reported as equivalent). The data below are simulated "
         "with 1 % noise (+0.2 % floor); the tool is not told what was hidden. *Concealed* means the refitted "
         "nominal model is within a few times the noise (relative error column).", "",
         "| case | hidden truth | found | χ²_red before → after | nominal rel. error | time |",

@@ -7,6 +7,8 @@ from pathlib import Path
 
 import numpy as np
 
+from ..conventions import ACCEL_CHANNELS
+
 ORDER = 30
 TITLE = "Use case II: amortized inverse (paper Table 2) and ablation"
 
@@ -116,7 +118,7 @@ def _loss_sensitivity(R, L, dR, dL):
     """Eq. 22 loss caused by small errors dR, dL at (R, L) (first order, analytic Jacobian)."""
     from ..physics import PAPER_GRID_HZ, Rig, frf
 
-    r = frf(PAPER_GRID_HZ, Rig(R=R, L=L), wrt=["R", "L"], outputs=("a1", "a2"))
+    r = frf(PAPER_GRID_HZ, Rig(R=R, L=L), wrt=["R", "L"], outputs=ACCEL_CHANNELS)
     s = max(np.abs(r.a1).max(), np.abs(r.a2).max())
     g = (np.abs(r.jac["a1"]) ** 2 + np.abs(r.jac["a2"]) ** 2).mean(axis=0) / s ** 2
     return g[0] * dR ** 2, g[1] * dL ** 2

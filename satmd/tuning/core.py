@@ -162,6 +162,7 @@ def _is_augmented(model) -> bool:
 def resolve_model(model, effects=()):
     """(rig, effects, source, reported parameters, uncertainty (names, values, cov) or None, notes,
     measured frequency span or None)."""
+    from ..discovery.findings import UNEXPLAINED
     from ..discovery.report import DiscoveryReport
     from ..identification.result import FitResult
 
@@ -176,7 +177,7 @@ def resolve_model(model, effects=()):
         raise DataError("effects= is for a Rig model; a fit or discovery report carries its own effects")
     if isinstance(model, DiscoveryReport):
         fit = model.final_fit if model.final_fit is not None else model.nominal_fit
-        found = [e["name"] for e in model.effects if e["name"] != "unexplained"]
+        found = [e["name"] for e in model.effects if e["name"] != UNEXPLAINED]
         if model.significant_mismatch and found:
             source = f"augmented model (nominal + {', '.join(found)}): discovery found a significant mismatch"
             notes.append(f"tuned on the augmented model: {source.split(': ', 1)[1]} and modelled it with "
@@ -185,7 +186,7 @@ def resolve_model(model, effects=()):
             fit, source = model.nominal_fit, "nominal model (a significant mismatch was found but not explained)"
         else:
             source = "nominal model (discovery found no significant mismatch)"
-        if "unexplained" in model.effect_names:
+        if UNEXPLAINED in model.effect_names:
             notes.append("part of the mismatch is unexplained by the vocabulary: the tuning cannot account for it")
         model = fit
         source_prefix = source

@@ -23,6 +23,7 @@ from typing import Sequence
 
 import numpy as np
 
+from ..conventions import TINY
 from ..errors import DataError
 from ..physics.effects import Effect
 from ..physics.model import solve, terms
@@ -229,7 +230,7 @@ def half_power_width(grid, mag, fpk, vpk) -> np.ndarray:
     widths = []
     for side in (j - 1, j):
         df = np.abs(grid[side] - fpk)
-        ratio = (vpk / np.maximum(np.take_along_axis(mag, side, 1), 1e-300)) ** 2 - 1.0
+        ratio = (vpk / np.maximum(np.take_along_axis(mag, side, 1), TINY)) ** 2 - 1.0
         with np.errstate(divide="ignore", invalid="ignore"):
             widths.append(np.where(ratio > 1e-12, df / np.sqrt(np.maximum(ratio, 1e-12)), span))
     w = np.minimum(widths[0], widths[1])

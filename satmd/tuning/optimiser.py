@@ -17,6 +17,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .. import numerics
 from ..errors import DataError
 from ..physics.rig import Rig
 
@@ -109,15 +110,7 @@ def sobol(dim: int, n: int, seed: int) -> np.ndarray:
 
 def distinct_best(points: np.ndarray, values: np.ndarray, n: int, min_dist: float = 0.1) -> list:
     """Up to ``n`` lowest points, each at least ``min_dist`` (max-norm) from those picked."""
-    picked = []
-    for i in np.argsort(values):
-        if not np.isfinite(values[i]):
-            break
-        if all(np.max(np.abs(points[i] - points[j])) > min_dist for j in picked):
-            picked.append(i)
-        if len(picked) == n:
-            break
-    return [points[i] for i in picked]
+    return [points[i] for i in numerics.distinct_best(values, points, n, min_dist)]
 
 
 def minimise(batch_fun, fun, dim: int, n_search: int = 1024, n_starts: int = 3, seed: int = 0,
