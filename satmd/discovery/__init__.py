@@ -129,8 +129,8 @@ def _discover_frf(data: FRFData, rig, free, candidates, channels, alpha, max_eff
 
     nominal_fit = identify(data, rig, free, channels)
     noise, noise_dof = "given", None
-    if str(data.estimator.get("method", "")).startswith("welch"):
-        noise_dof = data.estimator.get("noise_dof")  # a Welch std rests on a few dozen averages: F tests
+    if data.estimator.get("noise_dof"):  # an estimated std (Welch averages, LPM residuals): F tests keep α
+        noise_dof = data.estimator.get("noise_dof")
     if not data.has_std:
         noise = "estimated"
         data = data.with_std(estimate_std(data, nominal_fit))
