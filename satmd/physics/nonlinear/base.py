@@ -100,8 +100,9 @@ class NonlinearElement(Effect):
     Subclasses declare ``name``, ``parameter_specs``, ``description``, ``acts``
     (``absorber``: equal and opposite on u1 and u2, positive on u2; ``host``: on
     u1; ``shunt``: the shunt current), ``reads`` (a tuple from ``d = u2 - u1``,
-    ``v = d'``, ``u1``, ``v1``, ``i``), ``linear_parameter`` and implement
-    ``force`` and ``equivalent_value``.
+    ``v = d'``, ``u1``, ``v1``, ``i``; one signal, so that the integrator's Newton
+    step is scalar), ``linear_parameter`` and implement ``force``, ``slope`` and
+    ``equivalent_value``.
     """
 
     acts_on: ClassVar[str] = "nonlinear"
@@ -124,6 +125,21 @@ class NonlinearElement(Effect):
             For ``absorber``/``host``: a restoring force [N] (added to the left side of
             the equation of motion, positive on u2 for the absorber); for ``shunt``:
             the true current minus the small-signal current [A].
+        """
+        raise NotImplementedError
+
+    def slope(self, y: dict, rig):
+        """Derivative of `force` with respect to the (single) signal the element reads.
+
+        Parameters
+        ----------
+        y : dict of arrays, as for `force`.
+        rig : Rig.
+
+        Returns
+        -------
+        ndarray
+            d force / d reading (used by the integrator's Newton step on the implicit force).
         """
         raise NotImplementedError
 

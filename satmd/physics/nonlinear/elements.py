@@ -35,6 +35,9 @@ class CubicAbsorberSpring(NonlinearElement):
         d = y["d"]
         return self.params["k3"] * d * d * d
 
+    def slope(self, y, rig):
+        return 3.0 * self.params["k3"] * y["d"] ** 2
+
     def equivalent_value(self, rig, rms):
         return rig.kp + 3.0 * self.params["k3"] * np.asarray(rms["d"], float) ** 2
 
@@ -58,6 +61,9 @@ class CubicHostSpring(NonlinearElement):
     def force(self, y, rig):
         u = y["u1"]
         return self.params["k3"] * u * u * u
+
+    def slope(self, y, rig):
+        return 3.0 * self.params["k3"] * y["u1"] ** 2
 
     def equivalent_value(self, rig, rms):
         return rig.k1 + 3.0 * self.params["k3"] * np.asarray(rms["u1"], float) ** 2
@@ -84,6 +90,10 @@ class AbsorberFriction(NonlinearElement):
     def force(self, y, rig):
         return self.params["Fc"] * np.tanh(y["v"] / self.params["v0"])
 
+    def slope(self, y, rig):
+        v0 = self.params["v0"]
+        return self.params["Fc"] / v0 / np.cosh(np.clip(y["v"] / v0, -350, 350)) ** 2
+
     def equivalent_value(self, rig, rms):
         fc, v0 = self.params["Fc"], self.params["v0"]
         # E[f'(v)] = Fc / v0 E[sech²(v / v0)]
@@ -108,6 +118,9 @@ class QuadraticDamping(NonlinearElement):
     def force(self, y, rig):
         v = y["v"]
         return self.params["c2"] * np.abs(v) * v
+
+    def slope(self, y, rig):
+        return 2.0 * self.params["c2"] * np.abs(y["v"])
 
     def equivalent_value(self, rig, rms):
         return rig.cp + self.params["c2"] * SQRT_8_OVER_PI * np.asarray(rms["v"], float)
@@ -137,6 +150,10 @@ class InductorSaturation(NonlinearElement):
         a = self.params["isat"]
         x = np.clip(y["i"] / a, -0.999 * math.pi / 2, 0.999 * math.pi / 2)
         return a * np.tan(x) - y["i"]
+
+    def slope(self, y, rig):
+        a = self.params["isat"]
+        return np.tan(np.clip(y["i"] / a, -0.999 * math.pi / 2, 0.999 * math.pi / 2)) ** 2
 
     def equivalent_value(self, rig, rms):
         # E[L0 / (1 + (i/a)²)] for i ~ N(0, s²) = L0 √(π/2) (a/s) erfcx(a / (√2 s)), with s the true current's RMS

@@ -26,7 +26,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ...errors import DataError
-from .statespace import batch_fields, discretise, modal_filter, read_rows, slowest_decay, system
+from .statespace import Modal, discretise, read_rows, slowest_decay, system
 
 OUTPUTS = ("a1", "a2", "u1", "u2", "q", "v1", "v2", "i")
 _STATE_INDEX = {"u1": 0, "u2": 1, "q": 2, "v1": 3, "v2": 4}
@@ -79,8 +79,37 @@ def _batch_size(rig, elements, force) -> int:
     return sizes.pop() if sizes else 1
 
 
+def band_limited(force, fs_hz: float, pad: int = 2048) -> np.ndarray:
+    """The samples whose straight-line interpolation drives the rig as the band-limited force would.
+
+    Straight lines between samples pass a sinusoid at f with gain sinc²(f / fs) (-0.8 % at
+    100 Hz and 2048 Hz); dividing the spectrum by it (zero-padded, so the force is 0 outside
+    the record) makes the first-order-hold response that of the Shannon-interpolated force.
+
+    Parameters
+    ----------
+    force : (N,) or (batch, N) samples.
+    fs_hz : sample rate [Hz].
+    pad : zeros added at each end before the FFT.
+
+    Returns
+    -------
+    ndarray, the shape of ``force``.
+    """
+    from scipy.fft import irfft, next_fast_len, rfft, rfftfreq
+
+    x = np.asarray(force, float)
+    n = x.shape[-1]
+    size = next_fast_len(n + 2 * pad, real=True)
+    padded = np.zeros(x.shape[:-1] + (size,))
+    padded[..., pad:pad + n] = x
+    gain = np.sinc(rfftfreq(size, 1.0)) ** 2  # f / fs on the rfft grid
+    return irfft(rfft(padded) / gain, size)[..., pad:pad + n]
+
+
 def integrate(rig, force, fs_hz: float, elements=(), outputs=("a1", "a2"), segments="auto",
-              warmup_s="auto", memory_tol: float = 1e-9, corrections: int = 2) -> NonlinearResponse:
+              warmup_s="auto", memory_tol: float = 1e-7, corrections: int = 3,
+              hold: str = "bandlimited") -> NonlinearResponse:
     """Simulate the rig with nonlinear elements for a sampled force on the primary mass, from rest.
 
     Parameters
@@ -91,9 +120,11 @@ def integrate(rig, force, fs_hz: float, elements=(), outputs=("a1", "a2"), segme
     elements : sequence of NonlinearElement (parameters scalars or length-batch arrays).
     outputs : names from a1 a2 u1 u2 q v1 v2 i.
     segments : "auto", or the number of segments the record is cut into for the loop (1: exact).
-    warmup_s : "auto" (the slowest linear mode decays to ``memory_tol``), or seconds of warm-up per segment.
+    warmup_s : "auto" (1.5 x the time the slowest linear mode takes to decay to ``memory_tol``), or seconds of warm-up per segment.
     memory_tol : what the warm-up leaves of a segment's wrong start (relative).
     corrections : fixed-point steps on the implicit element forces per sample.
+    hold : ``"bandlimited"`` (default): the force is a band-limited signal sampled at fs (see
+        `band_limited`); ``"linear"``: it is a straight line between samples.
 
     Returns
     -------
@@ -112,21 +143,27 @@ def integrate(rig, force, fs_hz: float, elements=(), outputs=("a1", "a2"), segme
         np.ndim(v) for el in elements for v in el.params.values())
     P = _batch_size(rig, elements, force)
     n_samples = force.shape[-1]
-    F = np.broadcast_to(force, (P, n_samples))
+    if hold not in ("bandlimited", "linear"):
+        raise DataError(f"integrate: hold must be 'bandlimited' or 'linear', got {hold!r}")
+    drive = band_limited(force, fs_hz) if hold == "bandlimited" else force
+    F = np.broadcast_to(drive, (P, n_samples))
     A, B = system(rig, elements, P)
     dt = 1.0 / fs_hz
     phi, g0, g1 = discretise(A, B, dt)
     m = len(elements)
+    modal = [Modal(phi[b], g0[b], g1[b]) for b in range(P)]
+    eta = [modal[b].states(F[b][None], [0]) for b in range(P)]  # the force's response, whole record
     if m:
-        g, meta = _element_forces(rig, elements, F, A, phi, g0, g1, fs_hz, segments, warmup_s, memory_tol,
-                                  corrections)
+        g, meta = _element_forces(rig, elements, modal, eta, A, phi, g0, g1, fs_hz, segments, warmup_s,
+                                  memory_tol, corrections)
     else:
         g, meta = np.zeros((P, 0, n_samples)), {"segments": 0}
     rows, direct, names = _output_rows(A, B, elements, outputs)
     out = {name: np.empty((P, n_samples)) for name in names}
     for b in range(P):
-        u = np.vstack([F[b][None], g[b]])
-        y = modal_filter(phi[b], g0[b], g1[b], rows[b], direct[b], u)
+        u = np.vstack([np.broadcast_to(force, (P, n_samples))[b][None], g[b]])
+        states = eta[b] + modal[b].states(g[b], range(1, 1 + m)) if m else eta[b]
+        y = modal[b].project(rows[b], states) + direct[b] @ u
         for r, name in enumerate(names):
             out[name][b] = y[r]
     for j, el in enumerate(elements):
@@ -151,19 +188,20 @@ def _output_rows(A, B, elements, outputs):
     return rows, direct, list(outputs)
 
 
-def _element_forces(rig, elements, F, A, phi, g0, g1, fs_hz, segments, warmup_s, memory_tol, corrections):
+def _element_forces(rig, elements, modal, eta, A, phi, g0, g1, fs_hz, segments, warmup_s, memory_tol,
+                    corrections):
     """The element inputs g (batch, m, N), by the segmented implicit loop (see the module docstring)."""
-    P, N = F.shape
+    P, N = len(eta), eta[0].shape[1]
     m = len(elements)
     signals = sorted({s for el in elements for s in el.reads})
     C = read_rows(signals)
     index = {s: r for r, s in enumerate(signals)}
-    # the force's contribution to the read signals, over the whole record
-    zero = np.zeros((C.shape[0], 1 + m))
-    yF = np.stack([modal_filter(phi[b], g0[b, :, :1], g1[b, :, :1], C, zero[:, :1], F[b][None])
-                   for b in range(P)])  # (P, r, N)
-    if warmup_s == "auto":
-        warm = int(np.ceil(np.log(1.0 / memory_tol) / slowest_decay(A) * fs_hz))
+    yF = np.stack([modal[b].project(C, eta[b]) for b in range(P)])  # (P, r, N): the force's part of the readings
+    if segments == 1:
+        warm = 0
+    elif warmup_s == "auto":
+        # x1.5: amplitude-dependent stiffness and damping make the nonlinear memory longer than the linear one
+        warm = int(np.ceil(1.5 * np.log(1.0 / memory_tol) / slowest_decay(A) * fs_hz))
     else:
         warm = int(round(float(warmup_s) * fs_hz))
     if segments == "auto":
@@ -191,18 +229,24 @@ def _element_forces(rig, elements, F, A, phi, g0, g1, fs_hz, segments, warmup_s,
     g_now = np.zeros((P, m, S))
     g_prev = np.zeros((P, m, S))
     out = np.empty((P, m, steps, S))
-    single = m == 1
-    el0, reads0 = shaped[0], shaped[0].reads
+    rd = [index[el.reads[0]] for el in shaped]  # the one signal each element reads
+    Djj = np.stack([D[:, r, j] for j, r in enumerate(rd)], axis=1)[:, :, None]  # (P, m, 1)
+    single, el0 = m == 1, shaped[0]
     for k in range(steps):
         w = phi_b @ z + G0 @ g_now  # (P, n, S)
         y0 = win[:, :, k] + Cb @ w  # (P, r, S)
         guess = 2.0 * g_now - g_prev
-        for _ in range(corrections):
+        for _ in range(corrections):  # Newton on g = f(y0 + D g), diagonal in the elements
             y = y0 + D @ guess
             if single:
-                guess = el0.force({s: y[:, index[s]] for s in reads0}, rig)[:, None]
+                yy = {el0.reads[0]: y[:, rd[0]]}
+                res = guess[:, 0] - el0.force(yy, rig)
+                guess = guess - (res / (1.0 - el0.slope(yy, rig) * Djj[:, 0]))[:, None]
             else:
-                guess = np.stack([el.force({s: y[:, index[s]] for s in el.reads}, rig) for el in shaped], axis=1)
+                ys = [{el.reads[0]: y[:, r]} for el, r in zip(shaped, rd)]
+                res = guess - np.stack([el.force(yy, rig) for el, yy in zip(shaped, ys)], axis=1)
+                slope = np.stack([el.slope(yy, rig) for el, yy in zip(shaped, ys)], axis=1)
+                guess = guess - res / (1.0 - slope * Djj)
         z = w + G1 @ guess
         g_prev, g_now = g_now, guess
         out[:, :, k] = guess

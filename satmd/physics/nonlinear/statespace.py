@@ -117,6 +117,49 @@ def slowest_decay(A) -> float:
     return rate
 
 
+class Modal:
+    """The modal form of one discretised system: responses from rest as sums of first-order recursions.
+
+    Parameters
+    ----------
+    phi, g0, g1 : (n, n), (n, p), (n, p) from `discretise` (one parameter set).
+    """
+
+    def __init__(self, phi, g0, g1):
+        lam, V = np.linalg.eig(phi)
+        if np.linalg.cond(V) > 1e10:
+            raise DataError("the rig's modes are (nearly) repeated; the modal filter cannot separate them")
+        self.lam, self.V = lam, V
+        Vinv = np.linalg.inv(V)
+        self.w0, self.w1 = Vinv @ g0, Vinv @ g1
+
+    def states(self, inputs, columns=None) -> np.ndarray:
+        """Modal states (n, N) for the inputs (len(columns), N) fed to those input columns, from rest.
+
+        Parameters
+        ----------
+        inputs : (q, N) samples (0 before sample 0).
+        columns : indices of the input columns they drive (default: all).
+
+        Returns
+        -------
+        ndarray (n, N), complex
+        """
+        cols = slice(None) if columns is None else list(columns)
+        u = np.asarray(inputs, float)
+        shifted = np.zeros_like(u)
+        shifted[:, 1:] = u[:, :-1]
+        drive = self.w0[:, cols] @ shifted + self.w1[:, cols] @ u  # c'_k = W0 u_{k-1} + W1 u_k
+        eta = np.empty(drive.shape, complex)
+        for j in range(self.lam.size):
+            eta[j] = lfilter([1.0], [1.0, -self.lam[j]], drive[j])
+        return eta
+
+    def project(self, rows, eta) -> np.ndarray:
+        """Real outputs rows @ x for modal states ``eta`` (rows: (o, n))."""
+        return ((rows @ self.V) @ eta).real
+
+
 def modal_filter(phi, g0, g1, out_rows, out_direct, inputs):
     """Outputs of the discretised linear system, from rest, for sampled inputs (one parameter set).
 
@@ -130,16 +173,5 @@ def modal_filter(phi, g0, g1, out_rows, out_direct, inputs):
     -------
     ndarray (o, N)
     """
-    lam, V = np.linalg.eig(phi)
-    if np.linalg.cond(V) > 1e10:
-        raise DataError("the rig's modes are (nearly) repeated; the modal filter cannot separate them")
-    Vinv = np.linalg.inv(V)
-    w0, w1 = Vinv @ g0, Vinv @ g1
-    u = np.asarray(inputs, float)
-    shifted = np.zeros_like(u)
-    shifted[:, 1:] = u[:, :-1]
-    drive = w0 @ shifted + w1 @ u  # (n, N) complex: c'_k = W0 u_{k-1} + W1 u_k
-    eta = np.empty(drive.shape, complex)
-    for j in range(lam.size):
-        eta[j] = lfilter([1.0], [1.0, -lam[j]], drive[j])
-    return ((out_rows @ V) @ eta).real + out_direct @ u
+    modal = Modal(phi, g0, g1)
+    return modal.project(out_rows, modal.states(inputs)) + out_direct @ np.asarray(inputs, float)
