@@ -18,6 +18,9 @@ from .varpro import fit, project
 #: Tolerance of the fits on the subsample, which only rank products and skeletons (the
 #: finalists are refitted on all rows at `varpro.fit`'s default tolerance).
 RANK_TOL = 1e-5
+#: Most starts of a ranking fit: starts go on until two agree on the best (`varpro.fit`), so a
+#: product's rank does not hang on which basin one start's round-off falls into.
+RANK_STARTS = 4
 
 
 def _grow(parent: tuple, p_parent, new, factors: tuple, p_new) -> np.ndarray:
@@ -85,7 +88,8 @@ def search(Z, y, *, budget: int = 20, seed: int = 0, time_limit: float | None = 
                 continue
             warm = _grow(parent, fitted[parent], new, factors, initial(Skeleton((new,)), 1, rng))
             first = choices[0] if len(choices) == 1 else Skeleton(factors, everything)
-            r2, p, _ = fit(first, Zs, ys, starts=2, seed=seed + n_fit, p0=warm if parent else None, tol=RANK_TOL)
+            r2, p, _ = fit(first, Zs, ys, starts=2, seed=seed + n_fit, p0=warm if parent else None, tol=RANK_TOL,
+                           max_starts=RANK_STARTS)
             n_fit += 1
             if not np.isfinite(r2):
                 continue
@@ -105,7 +109,7 @@ def search(Z, y, *, budget: int = 20, seed: int = 0, time_limit: float | None = 
     scored = []
     for i, (f, sk) in enumerate((f, sk) for f in best_products for sk in budgeted(f, d, budget, block_extras)):
         warm = np.concatenate([fitted[f], initial(sk, 0, rng)[len(fitted[f]):]])  # a block term starts fresh
-        r2, p, _ = fit(sk, Zs, ys, starts=2, seed=seed + i, p0=warm, tol=RANK_TOL)
+        r2, p, _ = fit(sk, Zs, ys, starts=2, seed=seed + i, p0=warm, tol=RANK_TOL, max_starts=RANK_STARTS)
         if np.isfinite(r2):
             scored.append((r2, sk, p))
     scored.sort(key=lambda t: -t[0])

@@ -13,6 +13,8 @@ formula exactly as for ours.
 """
 from __future__ import annotations
 
+import re
+
 import numpy as np
 
 from ..conventions import TINY
@@ -37,7 +39,13 @@ def parse(text: str, n_vars: int) -> sp.Expr:
     xs = symbols(n_vars)
     local = {str(s): s for s in xs}
     local.update({f"X{i + 1}": s for i, s in enumerate(xs)})  # operon's default names
-    return sp.sympify(text.replace("^", "**"), locals=local)
+    text = _LARGE_INTEGER_POWER.sub(lambda m: f"**{float(m.group(1))!r}", text.replace("^", "**"))
+    return sp.sympify(text, locals=local)
+
+
+#: ``** n`` with a whole n of more than three digits: parsed as a float, since sympy would
+#: otherwise compute ``2**1000000000`` exactly (and `expanded_terms` treats it as no expansion).
+_LARGE_INTEGER_POWER = re.compile(r"\*\*\s*(\d{4,})(?![\d.eE])")
 
 
 def node_count(expr) -> int:
@@ -95,16 +103,57 @@ def binary_node_count(expr) -> int:
     return count(sp.sympify(expr))
 
 
+#: Most terms an expansion may produce (`expanded_terms`); past it `compact` does not expand.
+#: A few dozen nodes can hold ``(x0 + x1 + x2 + 1)**40``, whose expansion has 12 341 terms
+#: and grew a report to 24 GB: the bound keeps every rewrite within a few MB.
+MAX_EXPANDED_TERMS = 200
+
+
+def expanded_terms(expr, cap: int = MAX_EXPANDED_TERMS) -> int:
+    """An upper bound on the number of terms ``sympy.expand`` gives (saturating just above ``cap``).
+
+    Sums add, products multiply, a positive integer power ``(t1 + ... + tk)**n`` gives
+    ``C(n + k - 1, k - 1)`` (the multinomial count); a function is expanded inside, so its
+    argument's count is its own cost. Computed without expanding anything.
+    """
+    from math import comb
+
+    def terms(e) -> int:
+        if isinstance(e, sp.Add):
+            return min(cap + 1, sum(terms(a) for a in e.args))
+        if isinstance(e, sp.Mul):
+            out = 1
+            for a in e.args:
+                out = min(cap + 1, out * terms(a))
+            return out
+        if isinstance(e, sp.Pow):
+            k = terms(e.base)
+            n = e.exp
+            if n.is_Integer and n > 1 and k > 1:
+                return cap + 1 if int(n) > cap else min(cap + 1, comb(int(n) + k - 1, k - 1))
+            return max(k, terms(n))
+        return max([1] + [terms(a) for a in e.args])
+
+    return terms(sp.sympify(expr))
+
+
+def _bounded_expand(expr):
+    """``sympy.expand`` when it stays within `MAX_EXPANDED_TERMS`, else the expression as given."""
+    return sp.expand(expr) if expanded_terms(expr) <= MAX_EXPANDED_TERMS else expr
+
+
 def compact(expr: sp.Expr, max_nodes: int = 80) -> sp.Expr:
     """The smallest (by `node_count`) of a few algebraically identical forms.
 
     Expressions larger than ``max_nodes`` are returned as given (the
-    rewrites get slow and never make a large polynomial small).
+    rewrites get slow and never make a large polynomial small); nor is anything
+    expanded into more than `MAX_EXPANDED_TERMS` terms (`expanded_terms`), so the
+    memory `compact` needs is bounded whatever formula a search returns.
     """
     forms = [expr]
     if node_count(expr) > max_nodes:
         return expr
-    for f in (sp.expand, sp.factor_terms, sp.together):
+    for f in (_bounded_expand, sp.factor_terms, sp.together):
         try:
             forms.append(f(expr))
         except Exception:  # pragma: no cover - sympy corner cases
@@ -120,7 +169,7 @@ def _exp_as_powers(expr: sp.Expr) -> sp.Expr:
     reps = {}
     for e in expr.atoms(sp.exp):
         parts, rest = [], []
-        for term in sp.Add.make_args(sp.expand(e.args[0])):
+        for term in sp.Add.make_args(_bounded_expand(e.args[0])):
             coeff, var = term.as_coeff_Mul()
             if var == 1 or var.is_Symbol:
                 parts.append(sp.Pow(sp.Float(np.exp(float(coeff))), var))

@@ -79,8 +79,17 @@ def _kaufman(cols: list, target: np.ndarray, derivatives: list, intercept: bool 
     return R * scale
 
 
+#: Two starts agree on the best when their R² differ by less than this.
+AGREE = 1e-6
+
+
+def _agreed(costs: list, best: float, sst: float) -> bool:
+    """Whether at least two starts reached the best cost (R² within `AGREE`)."""
+    return sum(2.0 * (c - best) <= AGREE * sst for c in costs) >= 2
+
+
 def fit(sk: Skeleton, Zt: np.ndarray, y: np.ndarray, starts: int = 2, seed: int = 0, max_nfev: int | None = None,
-        p0=None, tol: float = 1e-8):
+        p0=None, tol: float = 1e-8, max_starts: int | None = None):
     """Variable-projection fit of one skeleton.
 
     Parameters
@@ -89,6 +98,11 @@ def fit(sk: Skeleton, Zt: np.ndarray, y: np.ndarray, starts: int = 2, seed: int 
     Zt : (d, n) inputs, one row a variable.
     y : (n,) target.
     starts : starts of Levenberg-Marquardt (the best is kept).
+    max_starts : with more than ``starts``, starts go on (up to ``max_starts``) until two of
+        them reach the best cost (R² within `AGREE`): a scale-free product has degenerate
+        basins (weights to 0 or to infinity) that one start in four or so falls into, and
+        which basin a start falls into can turn on round-off, i.e. on the BLAS and the
+        machine. Two starts agreeing on the best makes the result a property of the data.
     seed : seed of the starts after the first.
     max_nfev : evaluation cap per start (default 25 per inner constant + 25).
     p0 : inner constants of the first start (a warm start); else `skeletons.initial`'s.
@@ -122,14 +136,17 @@ def fit(sk: Skeleton, Zt: np.ndarray, y: np.ndarray, starts: int = 2, seed: int 
             J = _kaufman(cols, target, sk.derivatives(p, Zt), sk.intercept)
         return J if np.all(np.isfinite(J)) else np.zeros((y.size, p.size))
 
-    best = None
-    for s in range(starts):
+    best, costs = None, []
+    for s in range(max(starts, max_starts or 0)):
+        if s >= starts and best is not None and _agreed(costs, best.cost, sst):
+            break
         try:
             start = np.asarray(p0, float) if (p0 is not None and s == 0) else initial(sk, s, rng)
             sol = least_squares(residual, start, jac=jacobian, method="lm", ftol=tol, xtol=tol,
                                 max_nfev=max_nfev or 25 * (sk.n_inner + 1))
         except (ValueError, np.linalg.LinAlgError):
             continue
+        costs.append(sol.cost)
         if best is None or sol.cost < best.cost:
             best = sol
     if best is None:
