@@ -1,6 +1,8 @@
 """satmd reproduce: the paper's results and satmd's extensions as a report."""
 from __future__ import annotations
 
+import sys
+
 
 def register(sub):
     p = sub.add_parser("reproduce", help="reproduce the paper and the discovery demo as a report",
@@ -18,5 +20,14 @@ def run(args):
 
     check_outputs([("--out", args.out, None)])
     only = [s.strip() for s in args.only.split(",")] if args.only else None
-    index = reproduce(args.out, only=only, quick=args.quick)
+    from ..report import IncompleteReport
+
+    try:
+        index = reproduce(args.out, only=only, quick=args.quick)
+    except IncompleteReport as exc:
+        print(f"report written to {exc.index} (and index.html), but {len(exc.failed)} section(s) failed:",
+              file=sys.stderr)
+        for key, reason in exc.failed.items():
+            print(f"  {key}: {reason}", file=sys.stderr)
+        return 1
     print(f"report written to {index} (and index.html)")
