@@ -32,8 +32,13 @@ def simulate(
     noise: float | tuple[float, float] | None = None,
     seed: int | None = None,
     meta: dict | None = None,
-) -> FRFData:
-    """FRFData from the model, optionally with noise (std columns then included).
+    *,
+    time: bool = False,
+    nonlinear: Sequence = (),
+    level: float = 1.0,
+    **time_options,
+):
+    """FRFData from the model, optionally with noise (std columns then included); or a time recording.
 
     Parameters
     ----------
@@ -48,11 +53,26 @@ def simulate(
         per channel (the SPEC noise model); None: noise-free, no std columns.
     seed : seed of the noise.
     meta : extra header entries for the data's metadata.
+    time : bool
+        True: a time `Recording` (force, acc1, acc2) instead of FRFs; ``noise`` is then the
+        sensor noise relative to each channel's RMS and ``freq_hz``, ``channels`` are unused.
+    nonlinear : sequence of NonlinearElement
+        SPEC §8b elements in the rig (time recordings only; simulated by `satmd.physics.integrate`).
+    level : float
+        Time recordings: RMS of the clean force in N (the drive level).
+    **time_options
+        ``duration_s``, ``fs_hz``, ``band_hz``, ``excitation`` (random, sweep, multisine),
+        ``force_noise``; for multisines ``periods`` and ``realisations`` (see
+        `simulate_nonlinear_recording`).
 
     Returns
     -------
-    FRFData
+    FRFData, or Recording with ``time=True``
     """
+    if time:
+        return _simulate_time(rig, effects, noise, seed, meta, nonlinear, level, time_options)
+    if nonlinear or time_options:
+        raise DataError("nonlinear elements and time options need time=True (a recording; FRFs are linear)")
     rig = Rig() if rig is None else rig
     if rig.batch_shape != ():
         raise DataError("simulate takes a single rig; loop or use satmd.physics.frf for batches")
@@ -77,3 +97,24 @@ def simulate(
     info.update({"noise_rel": f"{rel:g}", "noise_floor": f"{floor:g}", "seed": str(seed)})
     info.update(meta or {})
     return FRFData(np.asarray(freq_hz, float), noisy, std, info)
+
+
+def _simulate_time(rig, effects, noise, seed, meta, nonlinear, level, options):
+    """simulate(time=True): the linear recorder of satmd.io, or the integrator for elements and multisines."""
+    noise = 0.0 if noise is None else noise
+    if not np.isscalar(noise):
+        raise DataError("with time=True, noise is one number: sensor noise relative to each channel's RMS")
+    excitation = options.get("excitation", "random")
+    if not nonlinear and excitation in ("random", "sweep") and not {"periods", "realisations"} & set(options):
+        from .io import simulate_recording
+
+        known = {"duration_s", "fs_hz", "band_hz", "excitation", "force_noise", "burn_in_s"}
+        if set(options) - known:
+            raise DataError(f"unknown time option(s) {sorted(set(options) - known)}")
+        rec = simulate_recording(rig=rig, effects=effects, force_rms=level, noise=noise, seed=seed, **options)
+    else:
+        from .simulation_nonlinear import simulate_nonlinear_recording
+
+        rec = simulate_nonlinear_recording(rig, nonlinear, level, noise=noise, seed=seed, effects=effects, **options)
+    rec.meta.update(meta or {})
+    return rec

@@ -19,6 +19,7 @@ from ._common import (
     parse_band,
     parse_effect,
     parse_freq,
+    parse_kv,
     parse_names,
     parse_number,
     rig_from_args,
@@ -52,7 +53,16 @@ def register(sub):
     t.add_argument("--force-rms", type=float, default=1.0, metavar="N", help="RMS force in N (default 1)")
     t.add_argument("--excitation", default="random", choices=("random", "sweep", "multisine"),
                    help="random: band-limited non-periodic noise, rig at rest at t = 0 (default, as on a rig); "
-                        "sweep: one log sine sweep; multisine: periodic, exact steady state (the ideal case)")
+                        "sweep: one log sine sweep; multisine: odd random-phase multisine with detection lines, "
+                        "--realisations x --periods, each realisation from rest (first period: transient)")
+    t.add_argument("--nonlinear", action="append", default=None, metavar="NAME:key=value,...",
+                   help="SPEC 8b nonlinear element, e.g. cubic_absorber_spring:k3=2e9 (repeatable); "
+                        "simulated by the time-domain integrator")
+    t.add_argument("--level", type=real(0, 1e12, lo_open=True), default=None, metavar="N",
+                   help="drive level: RMS force in N (same as --force-rms)")
+    t.add_argument("--periods", type=int, default=None, metavar="P", help="multisine periods per realisation (default 3)")
+    t.add_argument("--realisations", type=int, default=None, metavar="M",
+                   help="multisine realisations, each with new phases (default 4)")
     t.add_argument("--force-noise", type=float, default=None, metavar="REL",
                    help="force-sensor noise relative to the force RMS (default: half of --noise)")
     t.add_argument("--burn-in", type=float, default=0.0, metavar="S",
@@ -113,9 +123,38 @@ def run_time(args, rig, effects):
         raise SatmdError(f"--duration {args.duration:g} s at --fs {args.fs:g} Hz is {n:.3g} samples per channel; "
                          f"at most {MAX_SAMPLES} (e.g. --duration {MAX_SAMPLES // args.fs:g})")
     check_outputs([("-o", args.out, tuple(sorted(RECORDING_WRITERS)))])
+    if args.nonlinear or args.excitation == "multisine" or args.level is not None:
+        return run_nonlinear(args, rig, effects, noise, (lo, hi))
     rec = simulate_recording(args.duration, args.fs, rig, effects, band_hz=(lo, hi), force_rms=args.force_rms,
                              noise=noise[0] if noise else 0.0, seed=args.seed, excitation=args.excitation,
                              force_noise=args.force_noise, burn_in_s=args.burn_in)
     save_recording(rec, args.out)
     print(f"wrote {args.out} ({rec.n_samples} samples at {rec.fs_hz:g} Hz = {rec.duration_s:g} s, "
           f"channels {', '.join(rec.channels)})")
+
+
+def run_nonlinear(args, rig, effects, noise, band):
+    """--time with --nonlinear, --level or --excitation multisine: the time-domain integrator."""
+    from ..io import save_recording
+    from ..physics import nonlinear_element
+    from ..simulation_nonlinear import simulate_nonlinear_recording
+
+    if args.level is not None and args.force_rms not in (None, 1.0):
+        raise SatmdError("give the drive level once: --level or --force-rms")
+    if args.burn_in:
+        raise SatmdError("--burn-in does not apply with --nonlinear or a multisine (each record starts at rest)")
+    level = args.level if args.level is not None else args.force_rms
+    elements = []
+    for text in args.nonlinear or ():
+        name, _, kv = text.partition(":")
+        try:
+            elements.append(nonlinear_element(name, **(parse_kv(kv, f"--nonlinear {name}") if kv else {})))
+        except (TypeError, ValueError) as exc:
+            raise SatmdError(f"--nonlinear {text!r}: {exc}") from None
+    rec = simulate_nonlinear_recording(rig, elements, level, args.duration, args.fs, band,
+                                       noise=noise[0] if noise else 0.0, force_noise=args.force_noise, seed=args.seed,
+                                       excitation=args.excitation, periods=args.periods or 3,
+                                       realisations=args.realisations or 4, effects=effects)
+    save_recording(rec, args.out)
+    print(f"wrote {args.out} ({rec.n_samples} samples at {rec.fs_hz:g} Hz = {rec.duration_s:g} s, level "
+          f"{level:g} N RMS, {', '.join(e.name for e in elements) or 'linear'}, {args.excitation} force)")
