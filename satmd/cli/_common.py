@@ -9,10 +9,12 @@ import os
 import sys
 import time
 import warnings
+from numbers import Integral, Real
 from pathlib import Path
 
 import numpy as np
 
+from ..validation import Interval
 from ..conventions import DEFAULT_FREE
 from ..errors import FormatError, SatmdError
 from ..physics import Rig, effect
@@ -25,6 +27,8 @@ MAX_SAMPLES = 2 ** 24  # time samples per channel (3 channels of float64: 400 MB
 # --- option types: argparse names the option in its message ---------------------
 def real(lo=None, hi=None, *, lo_open=False, hi_open=False):
     """An argparse ``type``: a finite float within [lo, hi] (open ends with lo_open / hi_open)."""
+    allowed = Interval(Real, lo, hi, {(0, 0): "", (1, 0): "lo", (0, 1): "hi", (1, 1): "both"}[bool(lo_open), bool(hi_open)])
+
     def parse(text):
         try:
             x = float(text)
@@ -32,10 +36,8 @@ def real(lo=None, hi=None, *, lo_open=False, hi_open=False):
             raise argparse.ArgumentTypeError(f"{text!r} is not a number") from None
         if not math.isfinite(x):
             raise argparse.ArgumentTypeError(f"{text!r} is not a finite number")
-        if lo is not None and (x < lo or (lo_open and x == lo)):
-            raise argparse.ArgumentTypeError(f"{text} must be {'>' if lo_open else '>='} {lo:g}")
-        if hi is not None and (x > hi or (hi_open and x == hi)):
-            raise argparse.ArgumentTypeError(f"{text} must be {'<' if hi_open else '<='} {hi:g}")
+        if not allowed.accepts(x):
+            raise argparse.ArgumentTypeError(f"{text} must be {allowed.bounds_text()}")
         return x
 
     parse.__name__ = "number"
@@ -44,14 +46,15 @@ def real(lo=None, hi=None, *, lo_open=False, hi_open=False):
 
 def integer(lo=None, hi=None):
     """An argparse ``type``: an integer within [lo, hi]."""
+    allowed = Interval(Integral, lo, hi)
+
     def parse(text):
         try:
             x = int(text)
         except ValueError:
             raise argparse.ArgumentTypeError(f"{text!r} is not an integer") from None
-        if (lo is not None and x < lo) or (hi is not None and x > hi):
-            span = f"{lo}..{hi}" if lo is not None and hi is not None else f">= {lo}" if lo is not None else f"<= {hi}"
-            raise argparse.ArgumentTypeError(f"{text} must be {span}")
+        if not allowed.accepts(x):
+            raise argparse.ArgumentTypeError(f"{text} must be {allowed.bounds_text()}")
         return x
 
     parse.__name__ = "integer"

@@ -169,10 +169,11 @@ def _identified(args, data):
         with one_line_warnings("tune"):
             return identify(data, free=free, channels=channels)
     from ..discovery import discover
-    from ..io import DataWarning
+    from ..errors import PinnedParameterWarning, PoorFitWarning
 
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", DataWarning)  # discovery fits wrong models on purpose; its report speaks
+    with one_line_warnings("tune"), warnings.catch_warnings():
+        for category in (PoorFitWarning, PinnedParameterWarning):  # discovery fits wrong models on purpose;
+            warnings.simplefilter("ignore", category)  # its report speaks for them; other warnings are shown
         rep = discover(data, free=free, channels=channels)
     if rep.significant_mismatch:
         found = ", ".join(rep.effect_names) or "nothing in the vocabulary"

@@ -127,7 +127,7 @@ def _discover_frf(data: FRFData, rig, free, candidates, channels, alpha, max_eff
     data = data.select(channels)
     candidates = tuple(candidates) if candidates else default_candidates()
 
-    nominal_fit = identify(data, rig, free, channels)
+    nominal_fit = identify(data, rig, free, channels, warn=False)
     noise, noise_dof = "given", None
     if data.estimator.get("noise_dof"):  # an estimated std (Welch averages, LPM residuals): F tests keep α
         noise_dof = data.estimator.get("noise_dof")
@@ -135,7 +135,7 @@ def _discover_frf(data: FRFData, rig, free, candidates, channels, alpha, max_eff
         noise = "estimated"
         data = data.with_std(estimate_std(data, nominal_fit))
         noise_dof = 2 * len(channels) * (len(data) - 2)
-        nominal_fit = identify(data, rig, free, channels, start=nominal_fit.values, global_search=False)
+        nominal_fit = identify(data, rig, free, channels, start=nominal_fit.values, global_search=False, warn=False)
     test0 = test_mismatch(nominal_fit, alpha, noise_dof)
     before = _fit_summary(nominal_fit)
     p_values = {"global": test0.p_global, "band": test0.p_band}

@@ -95,7 +95,7 @@ def concealed_case(seed: int, names=None, n_effects: int = 1, std_given: bool = 
         for _ in range(6):
             # each effect must show on top of the others (known), the whole still look fine to the eye
             weak = [_without(data, picked, i).chi2_reduced < 1.5 for i in range(len(picked))]
-            if identify(data).rel_error > 4 * NOISE[0]:
+            if identify(data, warn=False).rel_error > 4 * NOISE[0]:
                 picked = [scaled(e, 0.5) for e in picked]
             elif any(weak):
                 picked = [scaled(e, 2.0) if w else e for e, w in zip(picked, weak)]
@@ -106,7 +106,7 @@ def concealed_case(seed: int, names=None, n_effects: int = 1, std_given: bool = 
     if picked:
         from scipy import stats
 
-        chi2_red = identify(data).chi2_reduced
+        chi2_red = identify(data, warn=False).chi2_reduced
         fits = [_without(data, picked, i) for i in range(len(picked))]
         detectable = all(stats.chi2.sf(f.chi2, f.dof) < 1e-3 for f in fits)
     if not std_given:
@@ -118,7 +118,7 @@ def _without(data, effects, i):
     """Nominal fit with every true effect but the i-th included at its true value."""
     from ..identification import identify
 
-    return identify(data, effects=[e for j, e in enumerate(effects) if j != i])
+    return identify(data, effects=[e for j, e in enumerate(effects) if j != i], warn=False)
 
 
 def scaled(eff, factor: float):

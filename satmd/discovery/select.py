@@ -52,7 +52,7 @@ class Search:
 
     def fit(self, effects, starts) -> object:
         return identify(self.data, self.rig, self.free_names(effects), self.channels, effects, start=starts,
-                        global_search=False, tol=1e-9, max_nfev=300)
+                        global_search=False, tol=1e-9, max_nfev=300, warn=False)
 
     def add(self, model: Model, name: str) -> Model:
         """Best fit of ``model`` plus effect ``name`` (screened starts, then least squares)."""

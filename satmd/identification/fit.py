@@ -1,12 +1,13 @@
 """Grey-box identification: global search + scipy least squares with the analytic Jacobian."""
 from __future__ import annotations
 
-import sys
 import time
+from numbers import Real
 from typing import Sequence
 
 import numpy as np
 
+from ..validation import Interval, Whole, validate_params
 from ..numerics import distinct_best
 from ..conventions import DEFAULT_FREE
 from ..errors import DataError
@@ -23,6 +24,13 @@ from .statistics import build_result, emit_warnings
 SEARCH_POINTS = 512
 
 
+@validate_params({
+    "reg": [Interval(Real, 0)],
+    "n_search": [Interval(Whole, 1, 1 << 20)],
+    "n_refine": [Interval(Whole, 1, 1 << 20)],
+    "max_nfev": [None, Interval(Whole, 1)],
+    "tol": [Interval(Real, 0, 1, "both")],
+})
 def identify(
     data: FRFData,
     rig: Rig | None = None,
@@ -39,7 +47,7 @@ def identify(
     max_nfev: int | None = None,
     tol: float = 1e-12,
     seed: int = 0,
-    warn: bool | None = None,
+    warn: bool = True,
 ) -> FitResult:
     """Fit free model parameters to measured FRFs.
 
@@ -72,11 +80,12 @@ def identify(
     max_nfev : most function evaluations of each least-squares run (None: SciPy's default).
     tol : ftol, xtol and gtol of least squares.
     seed : seed of the scrambled Sobol design.
-    warn : also emit the result's poor-fit warnings (model cannot represent
-        the data, parameters pinned at a bound) as `satmd.io.DataWarning`.
-        They are always in ``FitResult.warnings``. None (default): emit when
-        called from user code or the CLI, not from satmd's own packages,
-        which fit wrong models on purpose (discovery's model selection).
+    warn : also emit the result's poor-fit and pinned-parameter warnings
+        (`satmd.errors.PoorFitWarning`, `PinnedParameterWarning`, both
+        `DataWarning`). They are always in ``FitResult.warnings`` (with their
+        ``category``). satmd's own packages pass ``warn=False``: they fit
+        wrong models on purpose (discovery's model selection) and judge the
+        fits themselves.
 
     Returns
     -------
@@ -90,7 +99,6 @@ def identify(
         start values outside the bounds, invalid search settings.
     """
     t0 = time.perf_counter()
-    _check_settings(reg, n_search, n_refine, max_nfev, tol)
     n_search, n_refine = int(n_search), int(n_refine)
     max_nfev = None if max_nfev is None else int(max_nfev)
     problem = Problem(data, rig, free, channels, effects, bounds, scale)
@@ -118,9 +126,6 @@ def identify(
         nfev += best.nfev
     theta = problem.values_from_x(best.x, nominal)
     result = build_result(problem, theta, nominal, nfev, time.perf_counter() - t0, best, reg)
-    if warn is None:
-        caller = sys._getframe(1).f_globals.get("__name__", "")
-        warn = not caller.startswith("satmd.") or caller.startswith("satmd.cli")
     if warn:
         emit_warnings(result)
     return result
@@ -133,26 +138,6 @@ def _suspect(problem: Problem, fit, nominal) -> bool:
     on_bound = np.any((theta - problem.lower <= 1e-9 * span) | (problem.upper - theta <= 1e-9 * span))
     dof = max(problem.n_data - theta.size, 1)
     return bool(on_bound or (problem.weighted and 2.0 * fit.cost / dof > 3.0))
-
-
-def _check_settings(reg, n_search, n_refine, max_nfev, tol):
-    """Refuse settings that would give NaN or a silent no-op instead of a fit."""
-    def bad(name, value, need):
-        raise DataError(f"{name} must be {need}, got {value!r}")
-
-    if not (isinstance(reg, (int, float, np.number)) and np.isfinite(reg) and reg >= 0):
-        bad("reg", reg, "a finite number >= 0")
-    if not (isinstance(tol, (int, float, np.number)) and np.isfinite(tol) and 0 < tol < 1):
-        bad("tol", tol, "in (0, 1)")
-
-    def whole(v):
-        return isinstance(v, (int, float, np.number)) and np.isfinite(v) and float(v).is_integer()
-
-    for name, value in (("n_search", n_search), ("n_refine", n_refine)):
-        if not (whole(value) and 1 <= value <= 1 << 20):
-            bad(name, value, "an integer in 1..1048576")
-    if max_nfev is not None and not (whole(max_nfev) and max_nfev >= 1):
-        bad("max_nfev", max_nfev, "None or an integer >= 1")
 
 
 def _starts(problem: Problem, start) -> list[np.ndarray]:

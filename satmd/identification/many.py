@@ -13,7 +13,7 @@ if TYPE_CHECKING:  # only for the annotation: concurrent.futures would cost star
 
 
 def _fit_one(data, kwargs):
-    return identify(data, **kwargs)
+    return identify(data, **{"warn": False, **kwargs})  # warnings stay on the results unless asked for
 
 
 def identify_many(datas: Sequence[FRFData], executor: Executor | None = None, progress: bool = False,

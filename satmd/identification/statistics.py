@@ -5,6 +5,7 @@ import warnings as _warnings
 
 import numpy as np
 
+from ..errors import DataWarning, IdentifiabilityWarning, PinnedParameterWarning, PoorFitWarning, WarningRecord
 from ..numerics import lag1_autocorrelation
 from ..conventions import TINY
 from .covariance import parameter_covariance
@@ -54,14 +55,14 @@ def build_result(problem, theta, nominal, nfev, wall, opt, reg) -> FitResult:
         if not np.isfinite(std[i]) or (theta[i] != 0 and std[i] / abs(theta[i]) > 1):
             rel_std = std[i] / abs(theta[i] or 1)
             how = f"relative std {rel_std:.3g}" if np.isfinite(rel_std) else "its std is unbounded"
-            warnings.append(f"{nm} is not identifiable from these data ({how})")
+            warnings.append(WarningRecord(f"{nm} is not identifiable from these data ({how})", IdentifiabilityWarning))
     for i in range(k):
         for j in range(i + 1, k):
             if np.isfinite(corr[i, j]) and abs(corr[i, j]) > 0.99:
-                warnings.append(f"{names[i]} and {names[j]} are strongly correlated ({corr[i, j]:+.4f}): "
-                                f"the data constrain a combination of them")
+                warnings.append(WarningRecord(f"{names[i]} and {names[j]} are strongly correlated ({corr[i, j]:+.4f}): "
+                                              "the data constrain a combination of them", IdentifiabilityWarning))
     if cond > 1e12 and free.any():
-        warnings.append(f"ill-conditioned problem (condition number {cond:.3g})")
+        warnings.append(WarningRecord(f"ill-conditioned problem (condition number {cond:.3g})", IdentifiabilityWarning))
     return FitResult(
         names=names,
         values={nm: float(v) for nm, v in zip(names, theta)},
@@ -116,20 +117,21 @@ def _lag1(r, n_series) -> float:
 
 
 def _fit_warnings(problem, theta, r, rel, chi2_red, dof, pinned) -> list:
-    """Poor-fit and pinned-parameter warnings (each starts with "poor fit:" or names a pinned parameter)."""
+    """Poor-fit and pinned-parameter warnings, as `WarningRecord` of PoorFitWarning / PinnedParameterWarning."""
     out = []
     for nm in pinned:
         p = problem.params[problem.names.index(nm)]
         v = theta[problem.names.index(nm)]
         side = "lower" if abs(v - p.lower) <= abs(v - p.upper) else "upper"
-        out.append(f"{nm} is pinned at its {side} bound ({v:.6g}): the data push it beyond the model's "
-                   "range; it gets no std (check units, frequency axis and channels)")
+        out.append(WarningRecord(f"{nm} is pinned at its {side} bound ({v:.6g}): the data push it beyond the "
+                                 "model's range; it gets no std (check units, frequency axis and channels)",
+                                 PinnedParameterWarning))
     if rel >= POOR_REL_ERROR:
-        out.append(f"poor fit: relative FRF error {rel:.3g}: the model reproduces little of the data "
-                   "(a different structure, or wrong channels, units or frequency axis?)")
+        out.append(WarningRecord(f"poor fit: relative FRF error {rel:.3g}: the model reproduces little of the data "
+                                 "(a different structure, or wrong channels, units or frequency axis?)", PoorFitWarning))
     if problem.weighted and chi2_red > 1.5 and chi2_red > 1 + 5 * np.sqrt(2 / dof):
-        out.append(f"poor fit: reduced chi-square {chi2_red:.3g} with the data's std ({dof} dof): "
-                   "the model does not fit within the noise")
+        out.append(WarningRecord(f"poor fit: reduced chi-square {chi2_red:.3g} with the data's std ({dof} dof): "
+                                 "the model does not fit within the noise", PoorFitWarning))
     n_series = 2 * len(problem.channels)
     rho = _lag1(r, n_series)
     n_freq = r.size // n_series
@@ -137,21 +139,25 @@ def _fit_warnings(problem, theta, r, rel, chi2_red, dof, pinned) -> list:
     # 0.1 % of the data, below which a model reproduces an FRF better than it can be measured
     material = chi2_red > 1 + 3 * np.sqrt(2 / dof) if problem.weighted else rel > MATERIAL_REL_ERROR
     if material and rho > max(STRUCTURED_LAG1, 4 / np.sqrt(r.size)) and n_freq > 4:
-        out.append(f"poor fit: residuals are structured along frequency (lag-1 autocorrelation {rho:.2f}; "
-                   "noise gives about 0): the model misses something systematic")
+        out.append(WarningRecord(f"poor fit: residuals are structured along frequency (lag-1 autocorrelation "
+                                 f"{rho:.2f}; noise gives about 0): the model misses something systematic",
+                                 PoorFitWarning))
     return out
 
 
+# the categories `identify` emits; the others (identifiability) stay on the result
+EMITTED = (PoorFitWarning, PinnedParameterWarning)
+
+
 def emit_warnings(result: FitResult):
-    """Emit the poor-fit and pinned-parameter warnings of a result as `satmd.io.DataWarning`.
+    """Emit the result's warnings of the `EMITTED` categories (poor fit, pinned parameter) as Python warnings.
 
     Parameters
     ----------
     result : FitResult
         Its other warnings (correlation, conditioning) stay on the result only.
     """
-    from ..io import DataWarning
-
     for w in result.warnings:
-        if w.startswith("poor fit:") or " is pinned at " in w:
-            _warnings.warn(w, DataWarning, stacklevel=3)
+        category = getattr(w, "category", DataWarning)
+        if issubclass(category, EMITTED):
+            _warnings.warn(str(w), category, stacklevel=3)

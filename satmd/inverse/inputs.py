@@ -184,7 +184,7 @@ def _least_squares_RL(freq, a, std, rig):
     data = FRFData(freq, {"a1": a[0], "a2": a[1]}, {} if std is None else {"a1": std[0], "a2": std[1]})
     with warnings.catch_warnings():  # the forward check reports on the fit's quality, once
         warnings.simplefilter("ignore")
-        fit = identify(data, rig=rig, free=("R", "L"), global_search=True)
+        fit = identify(data, rig=rig, free=("R", "L"), global_search=True, warn=False)
     return float(fit.values["R"]), float(fit.values["L"])
 
 

@@ -140,7 +140,7 @@ def least_squares(model, a, std, start):
         fits = identify_many(datas, rig=model.rig_or_default, free=("R", "L"), global_search=True, seed=int(model.seed))
     else:
         fits = [identify(d, rig=model.rig_or_default, free=("R", "L"), start={"R": float(s[0]), "L": float(max(s[1], 1e-5))},
-                         global_search=False, max_nfev=model.refine_nfev) for d, s in zip(datas, start)]
+                         global_search=False, max_nfev=model.refine_nfev, warn=False) for d, s in zip(datas, start)]
     out = {k: np.array([f.values[k] for f in fits]) for k in ("R", "L")}
     out.update({f"{k}_std": np.array([f.std.get(k, np.nan) for f in fits]) for k in ("R", "L")})
     return out

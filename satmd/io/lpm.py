@@ -34,9 +34,11 @@ estimated per window and removed; ``force_noise_bias`` records its size.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from numbers import Real
 
 import numpy as np
 
+from ..validation import Interval, Whole, validate_params
 from ..conventions import RECORDING_CHANNELS
 from ..errors import DataError
 
@@ -196,6 +198,7 @@ def _runs(mask, bridge):
     return runs
 
 
+@validate_params({"width_hz": [None, Interval(Real, 0, open="lo")], "degree": [Interval(Whole, 0)]})
 def lpm(recording, band=None, width_hz: float | None = None, degree: int = 2, smooth: int = 10) -> LPMEstimate:
     """LPM FRF estimates a1 = acc1/force, a2 = acc2/force on non-overlapping windows.
 
@@ -222,10 +225,6 @@ def lpm(recording, band=None, width_hz: float | None = None, degree: int = 2, sm
     """
     from .chain import sharpest_resonance
 
-    if degree < 0 or int(degree) != degree:
-        raise DataError(f"degree must be an integer >= 0, got {degree}")
-    if width_hz is not None and (not np.isfinite(width_hz) or width_hz <= 0):
-        raise DataError(f"width_hz must be > 0, got {width_hz}")
     fs, n = recording.fs_hz, recording.n_samples
     x = recording["force"]
     found = _excited(x, fs)

@@ -25,7 +25,7 @@ def build(ctx) -> str:
 
     truth = Rig()
     target = simulate(PAPER_GRID_HZ, truth, channels=STATE)
-    common = dict(start=START, channels=STATE, scale="global", global_search=False)
+    common = dict(start=START, channels=STATE, scale="global", global_search=False, warn=False)
     identify(target, **common)  # warm-up, so that the times below are steady-state
     reg = identify(target, reg=1e-8, **common)
     exact = identify(target, reg=0.0, **common)
@@ -67,7 +67,7 @@ def build(ctx) -> str:
     rng = np.random.default_rng(20)
     hidden = {k: float(rng.uniform(lo, hi)) for k, (lo, hi) in RANGES.items()}
     acc = simulate(PAPER_GRID_HZ, truth.replace(**hidden))
-    glob = identify(acc)
+    glob = identify(acc, warn=False)
     lines += [
         "**No good start needed.** A rig drawn at random in the SPEC §9 ranges, noise-free accelerations A1, A2 "
         "on the paper grid, fitted from the default start with the default global search (a batched "
@@ -80,7 +80,7 @@ def build(ctx) -> str:
 
     # --- uncertainty: 1 % noise with std given ---------------------------------------------------
     noisy = simulate(PAPER_GRID_HZ, truth, noise=0.01, seed=1)
-    nfit = identify(noisy)
+    nfit = identify(noisy, warn=False)
     ci = nfit.confidence_intervals()
     lines += [
         "**Uncertainty.** The true rig's accelerations with 1 % noise (std = 0.01·|A| on the real and "

@@ -2,10 +2,12 @@
 from __future__ import annotations
 
 import time
+from numbers import Real
 from typing import Sequence
 
 import numpy as np
 
+from ..validation import Interval, check
 from ..conventions import DEFAULT_FREE
 from ..errors import DataError
 from ..physics.effects import Effect
@@ -75,9 +77,7 @@ def tune(
     TuneResult
     """
     t0 = time.perf_counter()
-    q = float(quantile)
-    if not 0.5 <= q < 1.0:
-        raise DataError(f"quantile must lie in [0.5, 1), got {q}")
+    q = float(check("quantile", quantile, [Interval(Real, 0.5, 1, "hi")], "tune"))
     rig, effects, source, parameters, uncertain, notes, span = resolve_model(model, effects)
     obj = Objective(objective, output, tuple(band))
     if span and (obj.band[0] < span[0] or obj.band[1] > span[1]):

@@ -180,7 +180,7 @@ def retune(
     prev, results, fixed = None, [], None
     fixed_values, open_values = [], []
     for data in series:
-        fit = identify(data, rig, free, start=prev, global_search=prev is None)
+        fit = identify(data, rig, free, start=prev, global_search=prev is None, warn=False)
         prev = dict(fit.values)
         res = tune(fit, objective, output, band, bounds, design, closed_form_check=False, **tune_options)
         results.append(res)

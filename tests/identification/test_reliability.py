@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 
 from satmd import PAPER_GRID_HZ, ExtraMode, Rig, simulate
-from satmd.errors import DataError
+from satmd.errors import DataError, IdentifiabilityWarning, PinnedParameterWarning, PoorFitWarning
 from satmd.identification import identify
 from satmd.identification import problem as problem_mod
 from satmd.identification.problem import Problem
@@ -29,7 +29,7 @@ def _no_std(data: FRFData) -> FRFData:
 
 
 def _poor(fit):
-    return [w for w in fit.warnings if w.startswith("poor fit:") or " is pinned at " in w]
+    return [w for w in fit.warnings if issubclass(w.category, (PoorFitWarning, PinnedParameterWarning))]
 
 
 # --- item 3: intervals without std -----------------------------------------------------------
@@ -243,11 +243,19 @@ def test_bad_settings_refused(kw, match):
         identify(simulate(), **kw)
 
 
-def test_satmd_internal_callers_are_not_warned():
-    """discover fits wrong models on purpose: its fits keep their warnings on the result only."""
+def test_warnings_are_typed_records():
+    """Warnings are decided by type, not text: each carries its DataWarning subclass, emitted and stored alike."""
+    import pickle
+
     data = simulate(effects=[ExtraMode(f_hz=66.0, zeta=0.01, mass_ratio=0.05)], noise=0.002, seed=1)
-    scope = {"__name__": "satmd.discovery.fake", "identify": identify, "data": data}
-    with warnings.catch_warnings():
-        warnings.simplefilter("error", DataWarning)
-        exec("fit = identify(data)", scope)
-    assert _poor(scope["fit"])
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        fit = identify(data)
+    emitted = [w for w in caught if issubclass(w.category, DataWarning)]
+    assert emitted and all(w.category in (PoorFitWarning, PinnedParameterWarning) for w in emitted)
+    assert [str(w.message) for w in emitted] == [str(w) for w in _poor(fit)]
+    assert all(issubclass(w.category, DataWarning) for w in fit.warnings)
+    assert all(w.startswith("poor fit:") for w in fit.warnings if w.category is PoorFitWarning)
+    again = pickle.loads(pickle.dumps(fit))  # identify_many sends results between processes
+    assert [(str(w), w.category) for w in again.warnings] == [(str(w), w.category) for w in fit.warnings]
+    assert issubclass(IdentifiabilityWarning, DataWarning)
