@@ -18,6 +18,9 @@ from .physics import (
     TimeDelay,
     effect,
     frf,
+    NonlinearElement,
+    integrate,
+    nonlinear_element,
 )
 from .simulation import simulate
 from .identification import FitResult, identify, identify_many  # noqa: E402  (binds the functions over the subpackages)
@@ -40,4 +43,5 @@ __all__ = [
     "SensorGain", "TimeDelay", "StructuralDamping", "DielectricLoss", "ShuntCapacitance", "ExtraMode",
     "ParameterOffset", "SatmdError", "DataError", "FormatError", "identify", "identify_many", "FitResult",
     "discover", "discover_many", "DiscoveryReport", "InverseModel", "tune", "TuneResult", "retune",
+    "NonlinearElement", "nonlinear_element", "integrate",
 ]
