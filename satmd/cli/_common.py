@@ -75,9 +75,21 @@ def refuse_unused(args, parser_defaults: dict, when: str):
         raise SatmdError(f"{', '.join(given)} {'applies' if len(given) == 1 else 'apply'} {when}")
 
 
-def option_defaults(group) -> dict:
-    """dest -> (flag, default) of every option in an argparse group (for `refuse_unused`)."""
-    return {a.dest: (a.option_strings[0], a.default) for a in group._group_actions if a.option_strings}
+class OptionGroup:
+    """An argparse argument group that keeps the actions added to it (argparse's own list is private)."""
+
+    def __init__(self, group):
+        self.group, self.actions = group, []
+
+    def add_argument(self, *args, **kwargs):
+        """``group.add_argument``, remembering the action it returns."""
+        self.actions.append(self.group.add_argument(*args, **kwargs))
+        return self.actions[-1]
+
+
+def option_defaults(actions) -> dict:
+    """dest -> (flag, default) of argparse actions (those `add_argument` returned; for `refuse_unused`)."""
+    return {a.dest: (a.option_strings[0], a.default) for a in actions if a.option_strings}
 
 
 # --- outputs: checked before any work ---------------------------------------------

@@ -12,6 +12,7 @@ from ._common import (
     SEED,
     add_rig_options,
     check_outputs,
+    OptionGroup,
     option_defaults,
     plot_suffixes,
     real,
@@ -36,11 +37,11 @@ def register(sub):
     p.add_argument("--noise", default=None, metavar="REL[:FLOOR]",
                    help="Gaussian noise with std = REL|A| + FLOOR max|A| on Re and Im; adds std columns")
     p.add_argument("--seed", type=SEED, default=None, help="random seed for the noise")
-    p.add_argument("--freq", default="40:130:60", metavar="LO:HI:N", help="frequency grid (default 40:130:60)")
-    p.add_argument("--channels", default="a1,a2", help="channels to write, from a1,a2,u1,u2,q (default a1,a2)")
+    freq = p.add_argument("--freq", default="40:130:60", metavar="LO:HI:N", help="frequency grid (default 40:130:60)")
+    channels = p.add_argument("--channels", default="a1,a2", help="channels to write, from a1,a2,u1,u2,q (default a1,a2)")
     p.add_argument("-o", "--out", required=True, metavar="OUT.csv",
                    help="output file (FRFs: .csv .uff .mat .npz; with --time: .csv .uff .wav .mat .npz)")
-    t = p.add_argument_group("time recordings (--time)")
+    t = OptionGroup(p.add_argument_group("time recordings (--time)"))
     t.add_argument("--time", action="store_true",
                    help="write a time recording (force, acc1, acc2) instead of FRFs: band-limited random force "
                         "through the linear model; --noise REL is then sensor noise relative to each channel's RMS")
@@ -69,9 +70,7 @@ def register(sub):
                    help="seconds of excitation before the record starts (default 0: starts at rest)")
     p.add_argument("--plot", default=None, metavar="OUT.png", help="also plot the FRFs")
     # options of one mode given in the other are refused, not ignored
-    p.set_defaults(func=run, time_only=option_defaults(t),
-                   frf_only={a.dest: (a.option_strings[0], a.default) for a in p._actions
-                             if a.dest in ("freq", "channels")})
+    p.set_defaults(func=run, time_only=option_defaults(t.actions), frf_only=option_defaults([freq, channels]))
 
 
 def parse_noise(text):

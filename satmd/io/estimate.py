@@ -9,19 +9,19 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..conventions import RECORDING_CHANNELS
 from ..errors import DataError
 from ._common import warn
 from .frfdata import FRFData
 from .recording import Recording
 from .transmissibility import Transmissibility, model_transmissibility, save_transmissibility, transmissibility
 from .welch import (
-    _FLOOR,
-    _RESPONSES,
+    STD_FLOOR,
     Spectra,
-    _check_estimator,
-    _frf_from_spectra,
-    _kernel_rms_hz,
-    _usable,
+    check_estimator,
+    frf_from_spectra,
+    kernel_rms_hz,
+    usable_bins,
     default_nperseg,
     get_window,
     spectra,
@@ -89,7 +89,7 @@ def _check_force(recording: Recording):
     if "force" not in recording.channels:
         raise DataError(f"{source}: no force channel (output-only recording): FRFs need the force; "
                         f"transmissibilities A2/A1 do not (satmd.io.transmissibility)")
-    responses = [r for r in _RESPONSES if r in recording.channels]
+    responses = [r for r in RECORDING_CHANNELS if r in recording.channels]
     if not responses:
         raise DataError(f"{source}: no acc1 or acc2 channel (has {', '.join(recording.channels)})")
     return source, responses
@@ -130,7 +130,7 @@ def _estimate_welch(recording: Recording, nperseg, window, overlap, estimator, b
     from .chain import clipping_findings, welch_findings
     from .lpm import excited_band
 
-    est = _check_estimator(estimator)
+    est = check_estimator(estimator)
     source, responses = _check_force(recording)
     s = spectra(recording, "force", responses, nperseg, window, overlap)
     # bins the force never excited are noise over noise: keep to the excited band, as the LPM does
@@ -141,15 +141,15 @@ def _estimate_welch(recording: Recording, nperseg, window, overlap, estimator, b
     if band[1] <= band[0]:
         raise DataError(f"band {requested[0]}:{requested[1]} Hz holds no frequency bin the force excites "
                         f"({lo:.1f}–{hi:.1f} Hz)")
-    results = {r: _frf_from_spectra(s, r, est) for r in responses}
-    keep = _usable(source, s, [a for res in results.values() for a in res], band)
+    results = {r: frf_from_spectra(s, r, est) for r in responses}
+    keep = usable_bins(source, s, [a for res in results.values() for a in res], band)
     f = s.freq_hz[keep]
     channels, std, coh = {}, {}, {}
     for r, (h, g, sd) in results.items():
-        ch = _RESPONSES[r]
+        ch = RECORDING_CHANNELS[r]
         channels[ch] = h[keep]
         coh[ch] = g[keep]
-        std[ch] = np.maximum(sd[keep], _FLOOR * np.max(np.abs(h[keep])))
+        std[ch] = np.maximum(sd[keep], STD_FLOOR * np.max(np.abs(h[keep])))
     if s.segments < 8:
         warn(source, f"only {s.segments} averages: coherence and std are rough; use a shorter nperseg")
     resolution = recording.fs_hz / int(s.meta["nperseg"])
@@ -157,7 +157,7 @@ def _estimate_welch(recording: Recording, nperseg, window, overlap, estimator, b
     meta = {"source": str(source), "estimator": est, **s.meta, "n_eff": f"{s.n_eff:.4g}",
             "noise": "coherence-based std (Bendat & Piersol)"}
     info = {"method": f"welch-{est}", "window": s.meta["window"], "nperseg": int(s.meta["nperseg"]),
-            "kernel_rms_hz": _kernel_rms_hz(get_window(window, int(s.meta["nperseg"])), recording.fs_hz),
+            "kernel_rms_hz": kernel_rms_hz(get_window(window, int(s.meta["nperseg"])), recording.fs_hz),
             "overlap": float(s.meta["overlap"]), "segments": s.segments, "resolution_hz": resolution,
             "points": int(f.size), "noise_dof": round(2 * max(s.n_eff - 1.0, 0.5), 1),
             "measurement": [x.to_dict() for x in findings]}

@@ -9,7 +9,7 @@ import numpy as np
 from ..conventions import ACCEL_CHANNELS
 from ._common import atomic_write
 from .recording import Recording
-from .welch import _FLOOR, _check_estimator, _frf_from_spectra, _usable, spectra
+from .welch import STD_FLOOR, check_estimator, frf_from_spectra, usable_bins, spectra
 
 
 @dataclass(frozen=True)
@@ -103,17 +103,17 @@ def transmissibility(recording: Recording, nperseg: int | None = None, window="h
         A missing channel, an unknown estimator or window, Welch settings the
         record cannot support, or a band that holds no usable bin.
     """
-    est = _check_estimator(estimator)
+    est = check_estimator(estimator)
     source = recording.meta.get("source", "recording")
     for name in (reference, response):
         recording[name]  # noqa: B018 - raises a DataError naming the missing channel
     s = spectra(recording, reference, [response], nperseg, window, overlap)
-    h, g, sd = _frf_from_spectra(s, response, est)
-    keep = _usable(source, s, [h, g, sd], band)
+    h, g, sd = frf_from_spectra(s, response, est)
+    keep = usable_bins(source, s, [h, g, sd], band)
     t = h[keep]
     meta = {"source": str(source), "estimator": est, "reference": reference, "response": response, **s.meta,
             "n_eff": f"{s.n_eff:.4g}"}
-    return Transmissibility(s.freq_hz[keep], t, np.maximum(sd[keep], _FLOOR * np.max(np.abs(t))), g[keep], meta)
+    return Transmissibility(s.freq_hz[keep], t, np.maximum(sd[keep], STD_FLOOR * np.max(np.abs(t))), g[keep], meta)
 
 
 def save_transmissibility(t: Transmissibility, path) -> Path:

@@ -26,13 +26,11 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..conventions import RECORDING_CHANNELS
 from ..errors import DataError
 from ._common import warn
 from .recording import Recording
 
-_RESPONSES = RECORDING_CHANNELS
-_FLOOR = 1e-10
+STD_FLOOR = 1e-10
 
 
 def default_nperseg(fs_hz: float, n_samples: int) -> int:
@@ -145,8 +143,8 @@ def _effective_averages(win, step, segments) -> float:
     return segments / total
 
 
-def _frf_from_spectra(s: Spectra, name: str, estimator: str):
-    """(H, coherence, std) for one response."""
+def frf_from_spectra(s: Spectra, name: str, estimator: str):
+    """(H, coherence, std) of one response from cross- and auto-spectra (H1 or H2, std from coherence)."""
     gxx, gxy, gyy = s.gxx, s.gxy[name], s.gyy[name]
     n_d = max(s.n_eff - 1.0, 0.5)
     with np.errstate(divide="ignore", invalid="ignore"):
@@ -161,14 +159,15 @@ def _frf_from_spectra(s: Spectra, name: str, estimator: str):
     return h, coh, std
 
 
-def _check_estimator(estimator):
+def check_estimator(estimator):
+    """The estimator's name, upper-cased ("H1" or "H2"); anything else is refused with a DataError."""
     est = str(estimator).upper()
     if est not in ("H1", "H2"):
         raise DataError(f"estimator must be H1 or H2, got {estimator!r}")
     return est
 
 
-def _usable(path, s: Spectra, arrays, band):
+def usable_bins(path, s: Spectra, arrays, band):
     """Mask of bins to keep: f > 0, inside the band, finite everywhere (force has energy)."""
     keep = s.freq_hz > 0
     lo, hi = band if band else (None, None)
@@ -188,7 +187,7 @@ def _usable(path, s: Spectra, arrays, band):
     return keep
 
 
-def _kernel_rms_hz(win: np.ndarray, fs_hz: float):
+def kernel_rms_hz(win: np.ndarray, fs_hz: float):
     """RMS width of a window's power kernel |W(f)|², from Parseval: ∫f²|W|² = ∫|w'|²/(4π²).
 
     None for windows that do not taper to zero (boxcar): their sinc² kernel has no
