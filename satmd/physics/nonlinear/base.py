@@ -33,21 +33,38 @@ _GH_X, _GH_W = np.polynomial.hermite_e.hermegauss(80)
 _GH_W = _GH_W / _GH_W.sum()
 
 
-def gaussian_mean(fun, sigma):
-    """E[fun(X)] for X ~ N(0, sigma²) by 80-point Gauss-Hermite quadrature (sigma may be an array).
+def gaussian_mean(fun, sigma, width=None):
+    """E[fun(X)] for X ~ N(0, sigma²) (sigma may be an array).
+
+    Smooth laws: 80-point Gauss-Hermite quadrature. A law with a feature of ``width``
+    near 0 (friction's tanh(v / v0)): trapezoid on a grid that resolves both sigma and width.
 
     Parameters
     ----------
     fun : callable, vectorised over its argument.
     sigma : standard deviation(s) of X.
+    width : size of the law's sharpest feature around 0 (None: smooth).
 
     Returns
     -------
     ndarray or float
         The expectation, with sigma's shape.
     """
-    s = np.asarray(sigma, float)[..., None]
-    return np.sum(_GH_W * fun(s * _GH_X), axis=-1)
+    s = np.asarray(sigma, float)
+    if width is None:
+        return np.sum(_GH_W * fun(s[..., None] * _GH_X), axis=-1)
+    from scipy.integrate import quad
+
+    out = np.empty(s.shape)
+    for idx, sv in np.ndenumerate(s):
+        sv, w = max(float(sv), 1e-300), float(width)
+        dens = lambda v: np.exp(-0.5 * (v / sv) ** 2) / (sv * np.sqrt(2 * np.pi)) * fun(v)  # noqa: E731
+        total = 0.0
+        for lo, hi in ((-9 * sv, 0.0), (0.0, 9 * sv)):
+            brk = [p for p in (-5 * w, -w, w, 5 * w) if lo < p < hi]
+            total += quad(dens, lo, hi, points=brk or None, limit=200, epsabs=0.0, epsrel=1e-11)[0]
+        out[idx] = total
+    return out if out.ndim else float(out)
 
 
 @dataclass(frozen=True)

@@ -97,7 +97,8 @@ class AbsorberFriction(NonlinearElement):
     def equivalent_value(self, rig, rms):
         fc, v0 = self.params["Fc"], self.params["v0"]
         # E[f'(v)] = Fc / v0 E[sech²(v / v0)]
-        sech2 = gaussian_mean(lambda x: 1.0 / np.cosh(np.clip(x / v0, -350, 350)) ** 2, np.asarray(rms["v"], float))
+        sech2 = gaussian_mean(lambda x: 1.0 / np.cosh(np.clip(x / v0, -350, 350)) ** 2, np.asarray(rms["v"], float),
+                              width=float(np.min(v0)))
         return rig.cp + fc / v0 * sech2
 
     def explain(self, rig) -> str:
