@@ -1,15 +1,20 @@
 # Two commands on a fresh machine: `make demo` and `make test`.
+# Both install the locked versions of requirements.lock (every direct and transitive dependency
+# at an exact version), so a new machine gets what CI tested. `make lock` refreshes the lock;
+# `make test-latest` runs the suite on the newest versions pyproject.toml admits.
 PYTHON ?= python3
 VENV   := .venv
 PY     := $(VENV)/bin/python
 STAMP  := $(VENV)/.installed
+LOCK   := requirements.lock
+PIP_TOOLS := pip-tools==7.6.2
 
-.PHONY: demo test bench clean
+.PHONY: demo test bench lock test-latest clean
 
-$(STAMP): pyproject.toml constraints.txt
+$(STAMP): pyproject.toml $(LOCK)
 	@test -x $(PY) || $(PYTHON) -m venv $(VENV)
-	$(PY) -m pip install -q --upgrade pip
-	$(PY) -m pip install -q -c constraints.txt -e '.[all,dev]'
+	$(PY) -m pip install -q --disable-pip-version-check -r $(LOCK)
+	$(PY) -m pip install -q --disable-pip-version-check --no-deps --no-build-isolation -e .
 	@touch $(STAMP)
 
 demo: $(STAMP)
@@ -23,5 +28,20 @@ bench: $(STAMP)
 	  echo "== $$b"; $(PY) $$b || exit 1; done
 	$(PY) benchmarks/readme_tables.py   # README's result tables from the new JSON
 
+# The lock: the newest versions pyproject.toml admits (torch held by constraints.txt to the
+# build the project's machines have), resolved by pip-tools in a throw-away environment.
+lock:
+	@test -x .venv-lock/bin/pip-compile || ($(PYTHON) -m venv .venv-lock && \
+	  .venv-lock/bin/pip install -q --disable-pip-version-check $(PIP_TOOLS))
+	.venv-lock/bin/pip-compile -q --upgrade --extra all --extra dev --strip-extras --allow-unsafe \
+	  -c constraints.txt --no-emit-index-url --no-emit-find-links -o $(LOCK) pyproject.toml
+	sed -i '/^satmd @ /d' $(LOCK)   # the project itself (its `all` extra names it) is installed editable
+
+# Drift, seen rather than suffered: the suite on the newest versions, in its own environment.
+test-latest:
+	@test -x .venv-latest/bin/python || $(PYTHON) -m venv .venv-latest
+	.venv-latest/bin/pip install -q --disable-pip-version-check --upgrade -c constraints.txt -e '.[all,dev]'
+	.venv-latest/bin/python -m pytest -q
+
 clean:
-	rm -rf $(VENV) report .pytest_cache .hypothesis
+	rm -rf $(VENV) .venv-lock .venv-latest report .pytest_cache .hypothesis
