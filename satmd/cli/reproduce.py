@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 import sys
+from pathlib import Path
 
 
 def register(sub):
@@ -11,7 +12,23 @@ def register(sub):
     p.add_argument("--out", default="report", metavar="DIR", help="output folder (default: report)")
     p.add_argument("--only", default=None, metavar="SECTIONS", help="comma-separated section keys, e.g. forward")
     p.add_argument("--quick", action="store_true", help="smaller runs (for smoke tests)")
+    p.add_argument("--acceptance", default=None, metavar="DIR",
+                   help="folder of independent acceptance data (with discovery/) to report on too "
+                        "(default: the first shared/acceptance in the working directory or above it)")
     p.set_defaults(func=run)
+
+
+def acceptance_dir(given):
+    """The acceptance folder: the one given, else ``shared/acceptance`` in the working directory or a parent."""
+    if given is not None:
+        if not Path(given).is_dir():
+            from ..errors import SatmdError
+
+            raise SatmdError(f"--acceptance {given}: not a folder")
+        return Path(given)
+    here = Path.cwd()
+    return next((d / "shared" / "acceptance" for d in (here, *here.parents) if (d / "shared" / "acceptance").is_dir()),
+                None)
 
 
 def run(args):
@@ -23,7 +40,7 @@ def run(args):
     from ..report import IncompleteReport
 
     try:
-        index = reproduce(args.out, only=only, quick=args.quick)
+        index = reproduce(args.out, only=only, quick=args.quick, acceptance=acceptance_dir(args.acceptance))
     except IncompleteReport as exc:
         print(f"report written to {exc.index} (and index.html), but {len(exc.failed)} section(s) failed:",
               file=sys.stderr)

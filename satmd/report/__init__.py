@@ -26,6 +26,7 @@ class Context:
     results: dict = field(default_factory=dict)  # numbers a section wants kept in results.json
     shared: dict = field(default_factory=dict)  # objects later sections may reuse (e.g. a trained net)
     failed: dict = field(default_factory=dict)  # section key -> one-line reason it failed
+    acceptance: Path | None = None  # a folder of independent acceptance data (e.g. discovery/), given by the caller
 
     fig_tmp: Path | None = None  # figures are written here and swapped in when the report is complete
 
@@ -63,7 +64,7 @@ def section_keys() -> list[str]:
     return [m.__name__.rsplit(".sec_", 1)[-1] for m in sections()]
 
 
-def reproduce(out, only=None, quick=False, log=print) -> Path:
+def reproduce(out, only=None, quick=False, log=print, acceptance=None) -> Path:
     """Build the report in folder ``out``; returns the path of index.md.
 
     Parameters
@@ -76,6 +77,11 @@ def reproduce(out, only=None, quick=False, log=print) -> Path:
         Smaller runs (smoke tests).
     log : callable
         Progress lines.
+    acceptance : str or Path, optional
+        A folder of acceptance data made independently of satmd (with a
+        ``discovery/`` folder of FRFs and ``truth.json``); sections that find
+        their part in it report on it too. None: none (the package never looks
+        for data outside itself).
 
     Returns
     -------
@@ -97,7 +103,7 @@ def reproduce(out, only=None, quick=False, log=print) -> Path:
         if unknown or not only:
             raise DataError(f"--only: unknown section {', '.join(map(repr, unknown)) or '(none given)'}; "
                             f"choose from {', '.join(keys)}")
-    ctx = Context(Path(out), quick=quick)
+    ctx = Context(Path(out), quick=quick, acceptance=None if acceptance is None else Path(acceptance))
     created = [p for p in [ctx.out, *ctx.out.parents] if not p.exists()]
     ctx.out.mkdir(parents=True, exist_ok=True)
     try:

@@ -1,8 +1,6 @@
 """Report section: missing-physics discovery on concealed effects."""
 from __future__ import annotations
 
-from pathlib import Path
-
 import numpy as np
 
 ORDER = 50
@@ -53,8 +51,8 @@ def build(ctx) -> str:
     lines += ["", "Plain-language report for the two-effect case:", "", "```", rep2.report(), "```", "",
               ctx.figure(rep2.figure(), "discover_two_effects.png"), ""]
 
-    acceptance = Path(__file__).resolve().parents[3] / "shared" / "acceptance" / "discovery"
-    if acceptance.is_dir() and not ctx.quick:
+    acceptance = None if ctx.acceptance is None else ctx.acceptance / "discovery"
+    if acceptance is not None and acceptance.is_dir() and not ctx.quick:
         import json
 
         truth = json.loads((acceptance / "truth.json").read_text())
