@@ -118,8 +118,8 @@ def test_segments_agree_with_one_pass():
     fs = 1024.0
     F = _random_force(12.0, fs, seed=5)
     for el in (element("cubic_absorber_spring", k3=2e13), element("inductor_saturation", isat=0.015)):
-        exact = integrate(Rig(), F, fs, [el], segments=1)
-        fast = integrate(Rig(), F, fs, [el], segments=6)
+        exact = integrate(Rig(), F, fs, [el], segments=1, backend="numpy")
+        fast = integrate(Rig(), F, fs, [el], segments=6, backend="numpy")
         assert fast.meta["segments"] == 6
         assert np.max(np.abs(fast.a1 - exact.a1)) < 1e-5 * np.std(exact.a1)
 
@@ -160,3 +160,25 @@ def test_bad_input_is_refused():
     with pytest.raises(DataError, match="output"):
         integrate(Rig(), np.ones(10), 1000.0, outputs=("a3",))
     assert band_limited(np.zeros(5), 100.0).shape == (5,)
+
+
+@pytest.mark.skipif(not __import__("satmd.physics.nonlinear.kernel", fromlist=["x"]).available,
+                    reason="numba not installed")
+def test_compiled_and_numpy_paths_agree():
+    fs = 1024.0
+    F = _random_force(8.0, fs, seed=9)
+    rig = Rig(kp=np.array([1.0e5, 1.2e5]))
+    for name, params in (("cubic_absorber_spring", {"k3": 2e13}), ("cubic_host_spring", {"k3": 5e13}),
+                         ("absorber_friction", {"Fc": 0.05, "v0": 1e-3}), ("quadratic_damping", {"c2": 300.0}),
+                         ("inductor_saturation", {"isat": 0.015})):
+        el = element(name, **params)
+        a = integrate(rig, F, fs, [el], outputs=("a1", "a2", "i"), backend="numba")
+        b = integrate(rig, F, fs, [el], outputs=("a1", "a2", "i"), backend="numpy", segments=1)
+        assert a.meta["backend"] == "numba"
+        for ch in ("a1", "a2", "i", f"g:{name}"):
+            x, y = getattr(a, ch) if ch[0] != "g" else a.signals[ch], getattr(b, ch) if ch[0] != "g" else b.signals[ch]
+            assert np.max(np.abs(x - y)) <= 1e-9 * np.max(np.abs(y)) + 1e-300, (name, ch)
+    two = [element("cubic_absorber_spring", k3=2e13), element("quadratic_damping", c2=300.0)]
+    a = integrate(Rig(), F, fs, two, backend="numba")
+    b = integrate(Rig(), F, fs, two, backend="numpy", segments=1)
+    assert np.max(np.abs(a.a2 - b.a2)) <= 1e-9 * np.max(np.abs(b.a2))

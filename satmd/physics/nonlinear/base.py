@@ -127,6 +127,16 @@ class NonlinearElement(Effect):
     reads: ClassVar[tuple[str, ...]] = ()
     linear_parameter: ClassVar[str] = ""
     strength: ClassVar[str] = ""  # the parameter that sets the element's size (k3, Fc, c2, isat)
+    kernel_law: ClassVar[int | None] = None  # the compiled integrator's form of `force` (see `kernel`)
+
+    def kernel_parameters(self) -> tuple:
+        """(p0, p1) of ``kernel_law`` (the compiled integrator's form of `force`).
+
+        Returns
+        -------
+        tuple
+        """
+        raise NotImplementedError
 
     def force(self, y: dict, rig):
         """The element's force beyond the linear model, for readings ``y`` ({signal: array}).

@@ -30,6 +30,10 @@ class CubicAbsorberSpring(NonlinearElement):
                                  search=(-1e16, 1e16), starts=(1e9, 1e11, 1e13)),)
     description = "cubic absorber spring: restoring force kp d + k3 d³ (k3 > 0 hardening, < 0 softening)"
     acts, reads, linear_parameter, strength = "absorber", ("d",), "kp", "k3"
+    kernel_law = 0  # p0 y³
+
+    def kernel_parameters(self):
+        return (self.params["k3"], 0.0)
 
     def force(self, y, rig):
         d = y["d"]
@@ -57,6 +61,10 @@ class CubicHostSpring(NonlinearElement):
                                  search=(-1e17, 1e17), starts=(1e9, 1e11, 1e13)),)
     description = "cubic host spring: k1 u1 + k3 u1³ on the primary mass"
     acts, reads, linear_parameter, strength = "host", ("u1",), "k1", "k3"
+    kernel_law = 0  # p0 y³
+
+    def kernel_parameters(self):
+        return (self.params["k3"], 0.0)
 
     def force(self, y, rig):
         u = y["u1"]
@@ -86,6 +94,10 @@ class AbsorberFriction(NonlinearElement):
     )
     description = "friction in the absorber's guide: Fc tanh(v / v0) (regularised Coulomb)"
     acts, reads, linear_parameter, strength = "absorber", ("v",), "cp", "Fc"
+    kernel_law = 1  # p0 tanh(y / p1)
+
+    def kernel_parameters(self):
+        return (self.params["Fc"], self.params["v0"])
 
     def force(self, y, rig):
         return self.params["Fc"] * np.tanh(y["v"] / self.params["v0"])
@@ -115,6 +127,10 @@ class QuadraticDamping(NonlinearElement):
                                  starts=(10.0, 100.0, 1000.0)),)
     description = "velocity-squared damping on the absorber: c2 |v| v"
     acts, reads, linear_parameter, strength = "absorber", ("v",), "cp", "c2"
+    kernel_law = 2  # p0 |y| y
+
+    def kernel_parameters(self):
+        return (self.params["c2"], 0.0)
 
     def force(self, y, rig):
         v = y["v"]
@@ -146,6 +162,10 @@ class InductorSaturation(NonlinearElement):
     parameter_specs = (Parameter("isat", "A", hard=(1e-12, _INF), search=(1e-4, 100.0), starts=(0.01, 0.1, 1.0)),)
     description = "a saturating shunt inductor: incremental inductance L0 / (1 + (i / isat)²)"
     acts, reads, linear_parameter, strength = "shunt", ("i",), "L", "isat"
+    kernel_law = 3  # p0 tan(y / p0) - y
+
+    def kernel_parameters(self):
+        return (self.params["isat"], 0.0)
 
     def force(self, y, rig):
         a = self.params["isat"]

@@ -25,7 +25,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ...conventions import ACCEL_CHANNELS
 from ...errors import DataError
+from . import kernel
 from .statespace import Modal, discretise, read_rows, slowest_decay, system
 
 OUTPUTS = ("a1", "a2", "u1", "u2", "q", "v1", "v2", "i")
@@ -107,9 +109,9 @@ def band_limited(force, fs_hz: float, pad: int = 2048) -> np.ndarray:
     return irfft(rfft(padded) / gain, size)[..., pad:pad + n]
 
 
-def integrate(rig, force, fs_hz: float, elements=(), outputs=("a1", "a2"), segments="auto",
+def integrate(rig, force, fs_hz: float, elements=(), outputs=ACCEL_CHANNELS, segments="auto",
               warmup_s="auto", memory_tol: float = 1e-7, corrections: int = 3,
-              hold: str = "bandlimited") -> NonlinearResponse:
+              hold: str = "bandlimited", backend: str = "auto") -> NonlinearResponse:
     """Simulate the rig with nonlinear elements for a sampled force on the primary mass, from rest.
 
     Parameters
@@ -125,6 +127,9 @@ def integrate(rig, force, fs_hz: float, elements=(), outputs=("a1", "a2"), segme
     corrections : fixed-point steps on the implicit element forces per sample.
     hold : ``"bandlimited"`` (default): the force is a band-limited signal sampled at fs (see
         `band_limited`); ``"linear"``: it is a straight line between samples.
+    backend : ``"auto"`` (compiled when numba is installed, else NumPy), ``"numba"`` or ``"numpy"``.
+        The compiled pass is sequential over the whole record (``segments``, ``warmup_s``
+        and ``memory_tol`` then do not apply: it is exact).
 
     Returns
     -------
@@ -151,6 +156,15 @@ def integrate(rig, force, fs_hz: float, elements=(), outputs=("a1", "a2"), segme
     dt = 1.0 / fs_hz
     phi, g0, g1 = discretise(A, B, dt)
     m = len(elements)
+    if backend not in ("auto", "numba", "numpy"):
+        raise DataError(f"integrate: backend must be auto, numba or numpy, got {backend!r}")
+    if backend == "numba" and not kernel.available:
+        raise DataError("integrate: backend='numba' needs numba (pip install numba)")
+    if backend != "numpy" and kernel.available and all(el.kernel_law is not None for el in elements):
+        out = _compiled(elements, F, np.broadcast_to(force, (P, n_samples)), A, B, phi, g0, g1, outputs, corrections)
+        if not batched:
+            out = {k: v[0] for k, v in out.items()}
+        return NonlinearResponse(float(fs_hz), out, {"segments": 1, "backend": "numba", "corrections": corrections})
     modal = [Modal(phi[b], g0[b], g1[b]) for b in range(P)]
     eta = [modal[b].states(F[b][None], [0]) for b in range(P)]  # the force's response, whole record
     if m:
@@ -173,12 +187,33 @@ def integrate(rig, force, fs_hz: float, elements=(), outputs=("a1", "a2"), segme
     return NonlinearResponse(float(fs_hz), out, meta)
 
 
+def _compiled(elements, drive, force, A, B, phi, g0, g1, outputs, corrections) -> dict:
+    """Outputs and element forces by the compiled sequential pass (`kernel`)."""
+    P = drive.shape[0]
+    m = len(elements)
+    signals = sorted({s for el in elements for s in el.reads}) or ["d"]
+    C = read_rows(signals)
+    rd = [signals.index(el.reads[0]) for el in elements]
+    D = C[None] @ g1[:, :, 1:]
+    prm = np.zeros((P, m, 2))
+    for j, el in enumerate(elements):
+        p0, p1 = el.kernel_parameters()
+        prm[:, j, 0], prm[:, j, 1] = np.broadcast_to(np.ravel(p0), (P,)), np.broadcast_to(np.ravel(p1), (P,))
+    rows, direct, names = _output_rows(A, B, elements, outputs)
+    y, g = kernel.run(phi, g0, g1, C, D, rows, direct, np.ascontiguousarray(drive, float),
+                      np.ascontiguousarray(force, float), [el.kernel_law for el in elements], prm, rd, corrections)
+    out = {name: y[:, r] for r, name in enumerate(names)}
+    for j, el in enumerate(elements):
+        out[f"g:{el.name}"] = g[:, j]
+    return out
+
+
 def _output_rows(A, B, elements, outputs):
     """Rows and direct terms giving each output from (state, inputs)."""
     P, n, p = B.shape
     rows, direct = np.zeros((P, len(outputs), n)), np.zeros((P, len(outputs), p))
     for r, name in enumerate(outputs):
-        if name in ("a1", "a2"):
+        if name in ACCEL_CHANNELS:
             k = 3 if name == "a1" else 4
             rows[:, r], direct[:, r] = A[:, k], B[:, k]
         elif name == "i":  # the true current: q' = ĩ + (shunt element inputs)
