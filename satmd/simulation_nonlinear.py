@@ -17,6 +17,7 @@ from typing import Sequence
 
 import numpy as np
 
+from .conventions import ACCEL_CHANNELS
 from .errors import DataError
 from .io.recording import Recording
 from .physics import Rig, integrate
@@ -96,7 +97,7 @@ def simulate_nonlinear_recording(rig: Rig | None = None, nonlinear: Sequence = (
         forces = level * random_force(n, fs_hz, (lo, hi), rng)[None]
     else:
         forces = level * _sweep(n, fs_hz, lo, hi)[None]
-    r = integrate(rig, forces, fs_hz, list(nonlinear), outputs=("a1", "a2"))  # each realisation from rest
+    r = integrate(rig, forces, fs_hz, list(nonlinear), outputs=ACCEL_CHANNELS)  # each realisation from rest
     clean = {"force": forces, "acc1": r.a1, "acc2": r.a2}
     signals = {}
     for name, parts in clean.items():

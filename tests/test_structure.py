@@ -270,3 +270,134 @@ def test_no_private_import_across_packages():
 def test_no_private_import_across_packages_in_inverse():
     pending = [s for s in PRIVATE if s.startswith("satmd/inverse/")]
     assert not pending, "private modules or names used outside their package:\n" + "\n".join(pending)
+
+
+# --- issue 25: one foundation under every package -------------------------------------------------
+# Rank of each top-level unit: a module imports only from lower ranks (or its own unit). The floor
+# (rank 0: facts, vocabulary, warnings, shared numerics) may import within itself; so may rank 3.
+LAYERS = {
+    "errors": 0, "conventions": 0, "validation": 0, "numerics": 0, "jsonsafe": 0, "version": 0,
+    "_progress": 0, "_fleet": 0,
+    "physics": 1, "io": 2, "simulation": 3, "simulation_nonlinear": 3, "plots": 3,
+    "identification": 4, "inverse": 5, "discovery": 5, "tuning": 6, "explain": 7, "report": 8, "cli": 9,
+    "satmd": 10, "__main__": 10,
+}
+SHARED_RANKS = {0, 3}
+
+
+def _unit(module: str) -> str:
+    parts = module.split(".")
+    return parts[1] if len(parts) > 1 else "satmd"
+
+
+def _where(module: str) -> str:
+    return str(MODULES[module].relative_to(ROOT.parent)) if module in MODULES else module
+
+
+def _layer_violations(graph) -> list[str]:
+    out = []
+    for module, edges in graph.items():
+        a = _unit(module)
+        for target, line in edges.items():
+            b = _unit(target)
+            if a == b:
+                continue
+            if a not in LAYERS or b not in LAYERS:
+                out.append(f"{_where(module)}: unit {a if a not in LAYERS else b} has no rank in LAYERS")
+            elif LAYERS[a] < LAYERS[b] or (LAYERS[a] == LAYERS[b] and LAYERS[a] not in SHARED_RANKS):
+                out.append(f"{_where(module)}:{line}: {a} (rank {LAYERS[a]}) imports "
+                           f"{target} (rank {LAYERS[b]})")
+    return sorted(set(out))
+
+
+def test_layering():
+    bad = _layer_violations(GRAPH)
+    assert not bad, "imports against the layering (a package imports only those below it):\n" + "\n".join(bad)
+
+
+def test_the_layering_check_sees_an_upward_import():
+    assert _layer_violations({"satmd.io.x": {"satmd.identification.fit": 3}})
+    assert _layer_violations({"satmd.validation": {"satmd.physics": 1}})
+    assert not _layer_violations({"satmd.physics.model": {"satmd.conventions": 1, "satmd.errors": 2}})
+
+
+# Literals of a convention, written once in satmd.conventions: anywhere else they drift apart.
+CONVENTION_LITERALS = {("m2", "kp", "R", "L"): "DEFAULT_FREE", ("a1", "a2"): "ACCEL_CHANNELS"}
+# files other engineers are restructuring while this rule arrived (issue 25); each is to take the
+# name from satmd.conventions, then leave this list (the pending test reports XPASS when all have)
+PENDING_LITERALS = {"satmd/inverse/training.py", "satmd/inverse/objective.py"}
+
+
+def _convention_literals() -> list[str]:
+    out = []
+    for name, tree in TREES.items():
+        if name == "satmd.conventions":
+            continue
+        for node in ast.walk(tree):
+            if isinstance(node, (ast.Tuple, ast.List, ast.Set)) and node.elts \
+                    and all(isinstance(e, ast.Constant) for e in node.elts):
+                value = tuple(e.value for e in node.elts)
+                if value in CONVENTION_LITERALS:
+                    out.append(f"{MODULES[name].relative_to(ROOT.parent)}:{node.lineno}: {value} "
+                               f"(use satmd.conventions.{CONVENTION_LITERALS[value]})")
+    return out
+
+
+LITERALS = _convention_literals()
+
+
+def test_no_convention_literal_outside_the_conventions():
+    done = [s for s in LITERALS if s.split(":")[0] not in PENDING_LITERALS]
+    assert not done, "facts written again instead of taken from satmd.conventions:\n" + "\n".join(done)
+
+
+@pytest.mark.xfail(strict=False, reason="files under restructuring this session (PENDING_LITERALS)")
+def test_no_convention_literal_pending():
+    pending = [s for s in LITERALS if s.split(":")[0] in PENDING_LITERALS]
+    assert not pending, "\n".join(pending)
+
+
+def test_no_frame_inspection():
+    """Behaviour never depends on who the caller is (sys._getframe, inspect.currentframe/stack): say it with an argument."""
+    bad = [f"{MODULES[n].relative_to(ROOT.parent)}:{node.lineno}" for n, tree in TREES.items()
+           for node in ast.walk(tree)
+           if (isinstance(node, ast.Attribute) and node.attr in ("_getframe", "currentframe", "stack", "_current_frames")
+               and isinstance(node.value, ast.Name) and node.value.id in ("sys", "inspect"))
+           or (isinstance(node, ast.ImportFrom) and node.module in ("sys", "inspect")
+               and {a.name for a in node.names} & {"_getframe", "currentframe", "stack"})]
+    assert not bad, "frame inspection:\n" + "\n".join(bad)
+
+
+# private names imported from another module of the same package (issue 25); others' new files pending
+PENDING_PRIVATE = {"satmd/discovery/nonlinear_periodic.py"}
+
+
+def _private_names_across_modules() -> list[str]:
+    out = []
+    for module in MODULES:
+        for target, names, line in _imports(module):
+            for n in names or ():
+                if n.startswith("_") and not n.startswith("__") and f"{target}.{n}" not in MODULES:
+                    out.append(f"{MODULES[module].relative_to(ROOT.parent)}:{line}: private name {n} from {target}")
+    return out
+
+
+def test_no_private_name_imported_from_another_module():
+    bad = [s for s in _private_names_across_modules() if s.split(":")[0] not in PENDING_PRIVATE]
+    assert not bad, "private names used outside their module (make them public within the package):\n" + "\n".join(bad)
+
+
+def test_internal_identify_calls_say_whether_to_warn():
+    """satmd's own fits (outside the CLI) pass ``warn=`` explicitly: identify warns by default, for users."""
+    bad = []
+    for name, tree in TREES.items():
+        if name.startswith("satmd.cli") or name == "satmd.identification.fit":
+            continue
+        for node in ast.walk(tree):
+            if isinstance(node, ast.Call) and getattr(node.func, "id", getattr(node.func, "attr", None)) == "identify":
+                said = any(k.arg == "warn" or (k.arg is None and isinstance(k.value, ast.Dict) and any(
+                    isinstance(key, ast.Constant) and key.value == "warn" for key in k.value.keys))
+                    for k in node.keywords)
+                if not said:
+                    bad.append(f"{MODULES[name].relative_to(ROOT.parent)}:{node.lineno}")
+    assert not bad, "identify called without warn= inside satmd:\n" + "\n".join(bad)

@@ -25,10 +25,10 @@ def build(ctx) -> str:
 
     truth = Rig()
     target = simulate(PAPER_GRID_HZ, truth, channels=STATE)
-    common = dict(start=START, channels=STATE, scale="global", global_search=False, warn=False)
-    identify(target, **common)  # warm-up, so that the times below are steady-state
-    reg = identify(target, reg=1e-8, **common)
-    exact = identify(target, reg=0.0, **common)
+    common = dict(start=START, channels=STATE, scale="global", global_search=False)
+    identify(target, warn=False, **common)  # warm-up, so that the times below are steady-state
+    reg = identify(target, reg=1e-8, warn=False, **common)
+    exact = identify(target, reg=0.0, warn=False, **common)
 
     lines = [
         "Target: the full state [U1, U2, Q] of the true rig on the paper's grid (60 points, 40–130 Hz). "

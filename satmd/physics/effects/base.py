@@ -96,7 +96,8 @@ class MatchedFilter:
     refine: int = 3
 
 
-def _times(factor, x):
+def scaled(factor, x):
+    """``factor * x``, or ``x`` itself when there is no factor (None): a hook's optional scaling."""
     return x if factor is None else factor * x
 
 

@@ -8,7 +8,7 @@ from __future__ import annotations
 import numpy as np
 
 from .. import dual
-from .base import Effect, Parameter, _times
+from .base import Effect, Parameter, scaled
 
 _GAIN = dict(default=1.0, neutral=1.0, hard=(1e-3, 1e3), search=(0.5, 2.0), starts=(0.93, 1.0, 1.07))
 
@@ -20,7 +20,7 @@ class SensorGain(Effect):
     acts_on = "sensor"
 
     def sensor(self, omega, channel, factor):
-        return _times(factor, self.params["gain_" + channel])
+        return scaled(factor, self.params["gain_" + channel])
 
     def explain(self, rig) -> str:
         parts = []
@@ -38,7 +38,7 @@ class TimeDelay(Effect):
     acts_on = "sensor"
 
     def sensor(self, omega, channel, factor):
-        return _times(factor, dual.exp(-1j * omega * self.params["tau_s"]))
+        return scaled(factor, dual.exp(-1j * omega * self.params["tau_s"]))
 
     def explain(self, rig) -> str:
         tau = float(self.params["tau_s"])
