@@ -27,7 +27,7 @@ from .identification import FitResult, identify, identify_many  # noqa: E402  (b
 from .discovery import DiscoveryReport, discover, discover_many  # noqa: E402
 from .tuning import TuneResult, retune, tune  # noqa: E402  (light: scipy.optimize loads on first use)
 
-from .version import __version__  # noqa: E402
+from .version import __version__  # noqa: E402, F401  (re-exported: satmd.__version__)
 
 
 def __getattr__(name):

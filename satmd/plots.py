@@ -75,7 +75,7 @@ def frf_figure(curves: Sequence[tuple], channels: Sequence[str], title: str = ""
 
 def plot_frfdata(data, path, title="", others: Sequence[tuple] = ()):
     """Plot an FRFData (with ±2σ band when std is given) and optional model curves."""
-    plt = pyplot()
+    pyplot()  # selects the non-interactive backend before the figure is made
     channels = list(data.channels)
     curves = [("data", data.freq_hz, data.channels, {"color": "k", "marker": ".", "ms": 3, "lw": 0.6})]
     curves += [(lbl, f, d, st) for lbl, f, d, st in others]

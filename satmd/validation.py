@@ -19,7 +19,7 @@ import functools
 import inspect
 import math
 from dataclasses import dataclass
-from numbers import Integral, Real
+from numbers import Real
 
 import numpy as np
 

@@ -8,7 +8,7 @@ TITLE = "Forward model: the rig and the effects"
 
 
 def build(ctx) -> str:
-    from ..physics import CHANNELS, PAPER_GRID_HZ, PARAMETER_INFO, Rig, frf
+    from ..physics import CHANNELS, PARAMETER_INFO, Rig, frf
     from ..physics.effects import effect
     from ..plots import frf_figure
 

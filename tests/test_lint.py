@@ -1,0 +1,37 @@
+"""ruff over satmd/ at the rule set of pyproject.toml's [tool.ruff] (issue 25); skipped where ruff is not installed."""
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+# new files other engineers are writing while the linter arrived (issue 25): reported apart, to leave this list
+PENDING = {"satmd/discovery/nonlinear.py"}
+
+
+def _findings() -> list[str]:
+    pytest.importorskip("ruff")
+    run = subprocess.run([sys.executable, "-m", "ruff", "check", "satmd", "--output-format", "json", "--no-cache"],
+                         cwd=ROOT, capture_output=True, text=True, timeout=120)
+    if run.returncode not in (0, 1):  # 2: ruff itself failed (bad configuration)
+        pytest.fail(f"ruff failed: {run.stderr.strip()[:500]}")
+    out = []
+    for f in json.loads(run.stdout or "[]"):
+        path = Path(f["filename"]).resolve().relative_to(ROOT).as_posix()
+        out.append(f"{path}:{f['location']['row']}: {f['code']} {f['message']}")
+    return out
+
+
+def test_ruff_is_clean():
+    bad = [s for s in _findings() if s.split(":")[0] not in PENDING]
+    assert not bad, "ruff findings (`ruff check satmd`):\n" + "\n".join(bad)
+
+
+@pytest.mark.xfail(strict=False, reason="files written by others this session (PENDING)")
+def test_ruff_is_clean_in_pending_files():
+    bad = [s for s in _findings() if s.split(":")[0] in PENDING]
+    assert not bad, "\n".join(bad)
