@@ -44,6 +44,9 @@ def register(sub):
                    help="standard deviations for --robust (instead of the fit's covariance; needed with --rig)")
     p.add_argument("--free", default="m2,kp,R,L", help="parameters identified from DATA (default m2,kp,R,L)")
     p.add_argument("--channels", default=None, help="channels to fit (default a1,a2 when present)")
+    p.add_argument("--force", action="store_true",
+                   help="tune even when the SATMD model cannot describe DATA (model_adequate false); "
+                        "without it such data are refused (exit 2)")
     p.add_argument("--no-discover", action="store_true",
                    help="tune on the nominal fit without looking for missing physics")
     p.add_argument("--data-band", default=None, metavar="LO:HI", help="use only LO <= f <= HI Hz of DATA")
@@ -78,7 +81,7 @@ def run(args):
             with one_line_warnings("tune"):
                 result = retune(series, free=free, labels=[f.stem for f in files], **options)
             return _finish(args, result)
-        result = tune(_identified(args, series[0]), **options)
+        result = tune(_identified(args, series[0]), force=args.force, **options)
     return _finish(args, result)
 
 
@@ -175,7 +178,7 @@ def _identified(args, data):
         for category in (PoorFitWarning, PinnedParameterWarning):  # discovery fits wrong models on purpose;
             warnings.simplefilter("ignore", category)  # its report speaks for them; other warnings are shown
         rep = discover(data, free=free, channels=channels)
-    if rep.significant_mismatch:
+    if rep.significant_mismatch and rep.model_adequate:
         found = ", ".join(rep.effect_names) or "nothing in the vocabulary"
         print(f"satmd tune: note: discovery found a significant mismatch ({found}); "
               "tuning on the augmented model", file=sys.stderr)

@@ -30,6 +30,7 @@ from .._fleet import fleet_map
 from ..identification import identify
 from ..io.frfdata import FRFData
 from ..physics import Rig
+from .adequacy import after_search, assess_fit, inadequate_report, withdraw_if_inadequate
 from .candidates import default_candidates
 from .discrepancy import fit_discrepancy
 from .findings import UNEXPLAINED, EffectFinding, UnexplainedFinding
@@ -149,6 +150,9 @@ def _discover_frf(data: FRFData, rig, free, candidates, channels, alpha, max_eff
     search = Search(data, rig, free, channels, candidates)
 
     def significant(fit):
+    verdict = assess_fit(nominal_fit)  # can the SATMD model describe these data at all? (adequacy.py)
+    if not verdict.adequate:
+        return inadequate_report(verdict, nominal_fit, alpha, t0)
         return test_mismatch(fit, alpha, noise_dof).significant
 
     final = select_effects(search, nominal, significant, max_effects)
@@ -162,7 +166,8 @@ def _discover_frf(data: FRFData, rig, free, candidates, channels, alpha, max_eff
             # what accounting for this effect does to the free parameters (vs the model without it)
             ref = without[name].fit.values
             shifts = {k: final.fit.values[k] / ref[k] - 1 for k in free if ref[k]}
-            effects.append(EffectFinding(name=name, parameters={k: float(v) for k, v in eff.params.items()},
+            effects.append(EffectFinding(name=name, parameters={k: float(v) for k, v in eff.params.items()
+                                                                if search.measured(k)},
                                          equivalent=equiv[name], delta_bic=round(float(dbic[name]), 2),
                                          explanation=describe_effect(eff, rig, shifts), shifts=shifts))
     after = _fit_summary(final.fit)
@@ -180,7 +185,7 @@ def _discover_frf(data: FRFData, rig, free, candidates, channels, alpha, max_eff
             explanation=describe_unexplained(test1.bands_hz, structured, n_terms),
             bands_hz=test1.bands_hz, structured_fraction=structured, n_terms=n_terms))
     p_values.update({"global_after": test1.p_global, "band_after": test1.p_band})
-    return DiscoveryReport(significant_mismatch=True, noise=noise, mismatch_bands_hz=test0.bands_hz, effects=effects,
+    report = DiscoveryReport(significant_mismatch=True, noise=noise, mismatch_bands_hz=test0.bands_hz, effects=effects,
                            parameters={k: final.fit.values[k] for k in free}, fit_before=before, fit_after=after,
                            nominal_fit=nominal_fit, final_fit=final.fit, discrepancy=disc, p_values=p_values,
                            whiteness=test0.whiteness, wall_time=time.perf_counter() - t0)
@@ -205,6 +210,7 @@ def _rel_error(fit, disc):
     import numpy as np
 
     model = fit.prediction()
+    return withdraw_if_inadequate(report, after_search(final.fit, final.effects, rig, disc))
     pred = np.stack([model[c] + disc.correction[c] for c in fit.channels])
     target = np.stack([fit.data[c] for c in fit.channels])
     return float(np.linalg.norm(pred - target) / np.linalg.norm(target))

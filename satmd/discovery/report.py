@@ -29,6 +29,18 @@ class DiscoveryReport:
     # --- from recordings: how the FRFs were estimated, and what the chain did (SPEC §9) ---
     estimator: dict = field(default_factory=dict)
     measurement: list = field(default_factory=list)  # dicts: name, explanation, remedy, corrected
+    nonlinear: object = None  # NonlinearReport (SPEC §9 ``nonlinear`` block), when time data or levels were given
+    adequacy: object = None  # Adequacy (SPEC §9 ``model_adequate``); None: adequate (nothing spoke against it)
+
+    @property
+    def model_adequate(self) -> bool:
+        """False when the SATMD model, with any vocabulary effects, cannot describe the data (then no effects)."""
+        return self.adequacy is None or bool(self.adequacy.adequate)
+
+    @property
+    def adequacy_reasons(self) -> list:
+        """The evidence against the model (`Reason` objects; empty when adequate)."""
+        return [] if self.adequacy is None else list(self.adequacy.reasons)
 
     def to_dict(self) -> dict:
         chain = {}
@@ -39,6 +51,8 @@ class DiscoveryReport:
             "schema": SCHEMA,
             "significant_mismatch": bool(self.significant_mismatch),
             "noise": self.noise,
+            "model_adequate": self.model_adequate,
+            "adequacy_reasons": [r.to_dict() for r in self.adequacy_reasons],
             "mismatch_bands_hz": [[round(a, 4), round(b, 4)] for a, b in self.mismatch_bands_hz],
             "effects": [e.to_dict() for e in self.effects],
             "parameters": dict(self.parameters),
@@ -71,9 +85,14 @@ class DiscoveryReport:
                  f"relative error {self.fit_before['rel_error']:.3g} "
                  f"(p = {self.p_values.get('global', float('nan')):.2g} globally, "
                  f"{self.p_values.get('band', float('nan')):.2g} in the worst band)"]
+        if not self.model_adequate:
+            lines.append(f"    MODEL NOT ADEQUATE: {self.adequacy.summary}. No physics is named: the SATMD model, "
+                         "with any vocabulary effects, does not describe these data.")
+            lines += [f"      - {r.kind}: {r.message}" for r in self.adequacy_reasons]
+            return self._with_nonlinear(lines)
         if not self.significant_mismatch:
             lines.append("    The nominal model fits within the noise: no missing physics is needed.")
-            return "\n".join(lines)
+            return self._with_nonlinear(lines)
         bands = ", ".join(f"{a:.1f}–{b:.1f} Hz" for a, b in self.mismatch_bands_hz) or "spread over the band"
         lines.append(f"    significant mismatch located at: {bands}")
         for i, e in enumerate(self.effects, 1):

@@ -19,6 +19,7 @@ import numpy as np
 from ..numerics import distinct_best
 from ..identification import identify
 from ..identification.problem import Problem
+from ..io.frfdata import CHANNELS
 from ..physics.effects import at_rest
 from .candidates import candidate_starts
 
@@ -48,9 +49,19 @@ class Search:
     log: list = field(default_factory=list)
 
     def free_names(self, effects):
-        return self.base_free + tuple(e.qualified(p) for e in effects for p in e.parameter_names)
+        return self.base_free + tuple(e.qualified(p) for e in effects for p in e.parameter_names if self.measured(p))
+
+    def measured(self, param: str) -> bool:
+        """False for an effect parameter of a channel that is not fitted (``gain_a2`` without a2): never fitted
+        nor reported."""
+        channel = param.rsplit("_", 1)[-1]
+        return channel not in CHANNELS or channel in self.channels
 
     def fit(self, effects, starts) -> object:
+        problem = Problem(self.data, self.rig, self.free_names(effects), self.channels, effects)
+        bounds = {n: (lo, hi) for n, lo, hi in zip(problem.names, problem.lower, problem.upper)}
+        # a start taken from another fit may sit a rounding error outside a bound: bring it inside
+        starts = [{k: float(np.clip(v, *bounds[k])) if k in bounds else v for k, v in s.items()} for s in starts]
         return identify(self.data, self.rig, self.free_names(effects), self.channels, effects, start=starts,
                         global_search=False, tol=1e-9, max_nfev=300, warn=False)
 
@@ -97,7 +108,7 @@ class Search:
 
 
 def _with_values(effect, values):
-    return effect.replace(**{p: values[effect.qualified(p)] for p in effect.parameter_names})
+    return effect.replace(**{p: values.get(effect.qualified(p), effect.params[p]) for p in effect.parameter_names})
 
 
 def _distinct_best(thetas, cost, names, effect, k):

@@ -4,6 +4,7 @@ from __future__ import annotations
 import json
 import math
 from dataclasses import dataclass, field
+from functools import cached_property
 
 import numpy as np
 
@@ -99,6 +100,19 @@ class FitResult:
         z = p.standardize(p.prediction(self.theta))  # whitened across channels when their noise is correlated
         return {c: z[k] for k, c in enumerate(p.channels)}
 
+    @cached_property
+    def adequacy(self):
+        """Whether the SATMD model can describe these data at all (`satmd.identification.adequacy`);
+        computed on first use (a failed fit is refitted under the usual reading mistakes to name one)."""
+        from .adequacy import assess_fit
+
+        return assess_fit(self)
+
+    @property
+    def model_adequate(self) -> bool:
+        """``adequacy.adequate``: False when the model cannot describe the data (see `adequacy`)."""
+        return self.adequacy.adequate
+
     # --- public views of the fitted problem (callers never reach into _problem) ---
     @property
     def data(self) -> FRFData:
@@ -162,6 +176,7 @@ class FitResult:
             "covariance": "jacobian" if self.weighted else "sandwich (HC3), Student-t intervals",
             "condition_number": num(self.condition_number, "condition_number", "singular Jacobian"),
             "warnings": list(self.warnings),
+            **self.adequacy.to_dict(),
             "nfev": self.nfev,
             "wall_time_s": self.wall_time,
             "success": self.success,
@@ -173,7 +188,8 @@ class FitResult:
 
     def report(self) -> str:
         """Plain-text fit report (in the spirit of lmfit's fit_report; formatted by `fit_report`)."""
-        return fit_report(self)
+        text = fit_report(self)
+        return text if self.adequacy.adequate else text + "\n" + self.adequacy.report()
 
     def __str__(self):
         return self.report()

@@ -43,7 +43,7 @@ from ..errors import DataError, SatmdError
 from ..physics import PAPER_GRID_HZ, Rig
 from .dataset import BOUNDS, PRESETS, InverseDataset, complex_to_features, make_dataset
 from .params import PRESET_SIZES, Grid, Interval, Options, validate
-from .strategies import KINDS, NET_KINDS, STRATEGIES  # noqa: F401 - NET_KINDS re-exported
+from .strategies import CALIBRATIONS, KINDS, NET_KINDS, STRATEGIES  # noqa: F401 - NET_KINDS re-exported
 
 _LEARNED = ("ensemble_", "networks_", "scaler_", "std_scale_", "history_", "fit_info_")
 
@@ -72,12 +72,18 @@ class InverseModel:
     lr_final : learning rate at the end of each phase (cosine schedule)
     n_members : ensemble members
     precondition : Gauss-Newton preconditioning of the eq. 22 gradient
+    jacobian : how the preconditioner gets d residual / d(R, L): "shunt" (one difference in R;
+        dA/dL = iω dA/dR since R, L enter only through Zs = R + iωL) or "fd" (both by differences,
+        one more twin call: the method before issue 29)
     twin_dtype : precision of the torch twin in training, "complex64" or "complex128"
     threads : torch CPU threads during training (None leaves torch's setting)
     samples_per_pair : paper preset: samples around each pair (None: ``PRESET_SIZES``)
     n_samples : box preset: number of samples (None: ``PRESET_SIZES``)
-    val_fraction : share of pairs (paper) or samples (box) held out to calibrate the std
-    refit : after the calibration, train the nets on, with every pair
+    calibration : std calibration (`satmd.inverse.strategies`): "crossfit" (one training; each validation
+        pair held out from one member, whose out-of-fold predictions calibrate) or "holdout" (train without
+        the validation pairs, calibrate on them, retrain on all with ``refit``: the method before issue 29)
+    val_fraction : share of pairs (paper) or samples (box) held out (from one member: crossfit) to calibrate
+    refit : holdout: after the calibration, train the nets again, from scratch, on every pair
     mc_samples : Monte Carlo draws for the noise part of the std
     refine_nfev : least-squares evaluations of the hybrid refinement
     seed : every random number derives from it
@@ -93,9 +99,11 @@ class InverseModel:
         "batch_size": [Interval(Integral, 1)], "lr": [Interval(Real, 0, 1, "lo")],
         "physics_lr": [Interval(Real, 0, 1, "lo")], "lr_final": [Interval(Real, 0, 1)],
         "n_members": [Interval(Integral, 1, 256)], "precondition": [bool],
+        "jacobian": [Options(("shunt", "fd"))],
         "twin_dtype": [Options(("complex64", "complex128"))], "threads": [None, Interval(Integral, 1)],
         "samples_per_pair": [None, Interval(Integral, 1)], "n_samples": [None, Interval(Integral, 2)],
-        "val_fraction": [Interval(Real, 0, 1, "hi")], "refit": [bool], "mc_samples": [Interval(Integral, 0)],
+        "val_fraction": [Interval(Real, 0, 1, "hi")], "refit": [bool],
+        "calibration": [Options(CALIBRATIONS)], "mc_samples": [Interval(Integral, 0)],
         "refine_nfev": [None, Interval(Integral, 1)], "seed": [Interval(Integral, 0)], "device": [None, str],
         "verbose": [bool], "rig": [None, Rig], "freq_hz": [Grid()],
     }
@@ -103,9 +111,9 @@ class InverseModel:
 
     def __init__(self, kind="physics", preset="paper", noise=0.0, *, epochs=90, warm_start_epochs=50,
                  batch_size=64, lr=1e-3, physics_lr=3e-4, lr_final=1e-5, n_members=5, precondition=True,
-                 twin_dtype="complex64", threads=1, samples_per_pair=None, n_samples=None, val_fraction=0.2,
-                 refit=True, mc_samples=64, refine_nfev=20, seed=0, device=None, verbose=True, rig=None,
-                 freq_hz=PAPER_GRID_HZ):
+                 jacobian="shunt", twin_dtype="complex64", threads=1, samples_per_pair=None, n_samples=None,
+                 val_fraction=0.2, refit=True, calibration="crossfit", mc_samples=64, refine_nfev=20, seed=0,
+                 device=None, verbose=True, rig=None, freq_hz=PAPER_GRID_HZ):
         self.kind = kind
         self.preset = preset
         self.noise = noise
@@ -117,12 +125,14 @@ class InverseModel:
         self.lr_final = lr_final
         self.n_members = n_members
         self.precondition = precondition
+        self.jacobian = jacobian
         self.twin_dtype = twin_dtype
         self.threads = threads
         self.samples_per_pair = samples_per_pair
         self.n_samples = n_samples
         self.val_fraction = val_fraction
         self.refit = refit
+        self.calibration = calibration
         self.mc_samples = mc_samples
         self.refine_nfev = refine_nfev
         self.seed = seed
@@ -172,7 +182,7 @@ class InverseModel:
                            batch_size=int(self.batch_size), lr=float(self.lr), physics_lr=float(self.physics_lr),
                            lr_final=float(self.lr_final), n_members=int(self.n_members), noise=float(self.noise),
                            seed=int(self.seed), device=self.device, precondition=bool(self.precondition),
-                           threads=self.threads, twin_dtype=self.twin_dtype)
+                           threads=self.threads, twin_dtype=self.twin_dtype, jacobian=self.jacobian)
 
     # -------------------------------------------------------------------- fit
     def make_data(self) -> InverseDataset:

@@ -2,7 +2,8 @@
 
 A saved model is a folder:
 
-- ``model.json``: schema ``satmd-inverse/1``, hyperparameters, kind, preset,
+- ``model.json``: schema ``satmd-inverse/2`` (format 1, before issue 29, still
+  loads: see ``FORMATS``), hyperparameters, kind, preset,
   bounds, frequency grid, rig, input scaling, std calibration, training
   summary, the versions of satmd / torch / numpy, and a sha256 of all that
   (a hand-edited file is noticed);
@@ -26,7 +27,10 @@ from ..jsonsafe import jsonable
 from .dataset import BOUNDS
 from .strategies import KINDS, STRATEGIES
 
-SCHEMA = "satmd-inverse/1"
+SCHEMA = "satmd-inverse/2"
+#: The formats this version reads, each with the hyperparameters its files lack: format 1 models were
+#: trained with the hold-out calibration and the finite-difference Jacobian (issue 29 added both settings).
+FORMATS = {"satmd-inverse/1": {"calibration": "holdout", "jacobian": "fd"}, SCHEMA: {}}
 META = "model.json"
 WEIGHTS = "weights.pt"
 CHECKSUM = "sha256"
@@ -75,9 +79,8 @@ def model_from_meta(cls, meta: dict, state: dict | None = None):
     """The model `model_meta` described, with weights ``state`` (net kinds); `SatmdError` for anything else."""
     from ..physics import Rig
 
-    if not isinstance(meta, dict) or meta.get("schema") != SCHEMA:
-        got = meta.get("schema") if isinstance(meta, dict) else type(meta).__name__
-        raise DataError(f"schema {got!r}, expected {SCHEMA!r}")
+    if not isinstance(meta, dict) or meta.get("schema") not in FORMATS:
+        raise DataError(_schema_refusal(meta))
     if CHECKSUM in meta and meta[CHECKSUM] != _checksum(meta):  # models saved before the checksum have none
         raise DataError("contents differ from what was saved (checksum mismatch); edited by hand?")
     for key, kind in (("params", dict), ("rig", dict), ("bounds", dict), ("freq_hz", list), ("std_scale", list)):
@@ -97,8 +100,9 @@ def model_from_meta(cls, meta: dict, state: dict | None = None):
                                              else "has no network"))
     names = set(cls._param_names()) - set(_NOT_PARAMS)
     # a None where None is not allowed stands for "the default" in models saved by earlier versions
-    params = {k: v for k, v in meta["params"].items()
-              if k in names and (v is not None or None in cls._parameter_constraints.get(k, ()))}
+    params = {**FORMATS[meta["schema"]], **{k: v for k, v in meta["params"].items()
+              if k in names and (v is not None or None in cls._parameter_constraints.get(k, ()))}}
+
     params["verbose"] = False
     try:
         if {k: tuple(map(float, v)) for k, v in meta["bounds"].items()} != {k: tuple(v) for k, v in BOUNDS.items()}:
@@ -124,6 +128,16 @@ def model_from_meta(cls, meta: dict, state: dict | None = None):
             raise DataError("a network model needs its weights")
         model.set_ensemble(_ensemble(meta["network"], state, model.freq_hz.size))
     return model
+
+
+def _schema_refusal(meta) -> str:
+    """Why a file's schema is refused, in one line (a newer format says to upgrade)."""
+    got = meta.get("schema") if isinstance(meta, dict) else type(meta).__name__
+    prefix, _, version = str(got).rpartition("/")
+    if prefix == "satmd-inverse" and version.isdigit() and int(version) > len(FORMATS):
+        return (f"schema {got!r}: saved by a newer satmd (format {version}); this version reads formats "
+                f"1-{len(FORMATS)}: upgrade satmd to load it")
+    return f"schema {got!r}, expected one of {', '.join(map(repr, FORMATS))}"
 
 
 def _ensemble(net: dict, state: dict, n_freq: int):

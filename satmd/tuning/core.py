@@ -40,6 +40,7 @@ def tune(
     n_starts: int = 3,
     closed_form_check: bool = True,
     seed: int = 0,
+    force: bool = False,
 ) -> TuneResult:
     """Best setting of the design variables (the shunt's R and L by default).
 
@@ -71,6 +72,8 @@ def tune(
     n_starts : local Nelder–Mead runs from the best distinct points
     closed_form_check : evaluate the classical closed forms on this rig
     seed : seeds the Sobol design and the draws
+    force : tune even when the fit or discovery report says the SATMD model cannot describe the data
+        (``model_adequate`` false); without it such a model is refused with a DataError
 
     Returns
     -------
@@ -78,7 +81,13 @@ def tune(
     """
     t0 = time.perf_counter()
     q = float(check("quantile", quantile, [Interval(Real, 0.5, 1, "hi")], "tune"))
+    verdict = model_verdict(model)
+    if verdict is not None and not verdict.adequate and not force:
+        raise DataError(f"the SATMD model cannot describe these data: {verdict.summary}; not tuned "
+                        "(force=True, or --force on the CLI, tunes anyway)")
     rig, effects, source, parameters, uncertain, notes, span = resolve_model(model, effects)
+    if verdict is not None and not verdict.adequate:
+        notes.append(f"tuned although the SATMD model cannot describe these data (forced): {verdict.summary}")
     obj = Objective(objective, output, tuple(band))
     if span and (obj.band[0] < span[0] or obj.band[1] > span[1]):
         notes.append(f"the band {obj.band[0]:g}–{obj.band[1]:g} Hz reaches beyond the measured "
@@ -124,7 +133,7 @@ def tune(
 
     if _is_augmented(model):  # what finding the left-out physics is worth here
         naive = tune(model.nominal_fit, objective, output, obj.band, bounds, design, current=current,
-                     n_search=n_search, n_starts=n_starts, closed_form_check=False, seed=seed)
+                     n_search=n_search, n_starts=n_starts, closed_form_check=False, seed=seed, force=force)
         at_naive = obj(space.apply(rig, [naive.design[n] for n in space.names]), effects)[0]
         cost = db(float(at_naive) / value)
         notes.append("tuned on the nominal model instead, the setting would be "
@@ -150,6 +159,21 @@ def tune(
         model_source=source, peaks_hz=peaks, closed_forms=tuple(forms), robust=robust_summary, notes=tuple(notes),
         nfev=int(nfev), wall_time=time.perf_counter() - t0, _rig=space.apply(rig, x), _current_rig=current_rig,
         _effects=tuple(effects))
+
+
+def model_verdict(model):
+    """The adequacy verdict (`Adequacy`) a fit or discovery report carries; None for a Rig (a model by
+    definition)."""
+    from ..discovery.report import DiscoveryReport
+    from ..identification.result import FitResult
+
+    if isinstance(model, DiscoveryReport):
+        from ..identification.adequacy import Adequacy
+
+        return model.adequacy if model.adequacy is not None else Adequacy(True)
+    if isinstance(model, FitResult):
+        return model.adequacy
+    return None
 
 
 def _is_augmented(model) -> bool:

@@ -26,6 +26,8 @@ class SensorGain(Effect):
         parts = []
         for ch, label in (("gain_a1", "accelerometer 1 (primary)"), ("gain_a2", "accelerometer 2 (absorber)")):
             g = float(self.params[ch])
+            if g == 1.0 and any(float(v) != 1.0 for v in self.params.values()):
+                continue  # a channel held at exactly 1 was not fitted (not measured): say nothing of it
             parts.append(f"{label} reads {abs(g - 1) * 100:.1f} % {'high' if g > 1 else 'low'}")
         return "; ".join(parts) + " (calibration error)"
 
