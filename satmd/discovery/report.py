@@ -58,7 +58,7 @@ class DiscoveryReport:
             "parameters": dict(self.parameters),
             "fit_before": dict(self.fit_before),
             "fit_after": dict(self.fit_after),
-        } | chain
+        } | chain | ({"nonlinear": self.nonlinear.to_dict()} if self.nonlinear is not None else {})
 
     def to_json(self, **kw) -> str:
         return json.dumps(self.to_dict(), **kw)
@@ -103,6 +103,11 @@ class DiscoveryReport:
         lines.append(f"    after: χ²_red = {self.fit_after['chi2_reduced']:.3g}, "
                      f"relative error {self.fit_after['rel_error']:.3g}")
         lines.append("    fitted free parameters: " + ", ".join(f"{k} = {v:.6g}" for k, v in self.parameters.items()))
+        return self._with_nonlinear(lines)
+
+    def _with_nonlinear(self, lines) -> str:
+        if self.nonlinear is not None:
+            lines = lines + [self.nonlinear.report()]
         return "\n".join(lines)
 
     def __str__(self):

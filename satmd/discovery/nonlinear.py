@@ -1,0 +1,204 @@
+"""Nonlinear rigs: detect, locate and name what a linear FRF cannot hold (SPEC §8b, the ``nonlinear`` block of §9).
+
+>>> rep = discover_nonlinear([rec_low, rec_high])          # doctest: +SKIP
+>>> rep.detected, [f["name"] for f in rep.findings]         # doctest: +SKIP
+(True, ['cubic_absorber_spring'])
+
+Steps (each module says how):
+
+1. detect from each recording: nonlinear distortion regressors in local
+   polynomial windows (`nonlinear_stats.linearity_test`), or the detection lines
+   of a multisine (`nonlinear_periodic`);
+2. detect from several: their FRFs against their noise
+   (`nonlinear_stats.level_dependence`), located as bands;
+3. name (SATMD rigs): which linear parameter moves with level and which way,
+   by joint fits (`nonlinear_name`), then the element's strength from its own
+   equivalent linearisation; a generic input→output record gets a one-mode fit
+   per level (hardening when the resonance rises);
+4. say which experiment would settle what is open.
+
+The level α is split: half for the distortion tests (Bonferroni over the
+recordings), half for the level-dependence test.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..conventions import ACCEL_CHANNELS, DEFAULT_FREE
+from .nonlinear_stats import NonlinearTest, distortion_regressors, integrate, level_dependence, linearity_test
+
+UNEXPLAINED_NL = "nonlinear_unexplained"
+EXPERIMENT_LEVEL = "record a second level (about 20 dB apart, same band): the level dependence names the element"
+EXPERIMENT_MULTISINE = ("a random-phase odd multisine with detection lines (several realisations, ≥ 2 periods): "
+                        "separates noise from distortion and odd from even nonlinearity")
+
+
+@dataclass(frozen=True)
+class NonlinearReport:
+    """The ``nonlinear`` block of SPEC §9 with its evidence.
+
+    Attributes
+    ----------
+    detected : whether any test rejects linearity at its level
+    tests : list of `NonlinearTest`
+    findings : list of dicts: name, parameters, ci95, equivalent, equivalent_linear, explanation
+    experiments : what to record next to settle what is open
+    levels : one level figure per recording (force RMS), in the order given
+    set_aside : linear effects a one-recording fit named while distortion is present (not physics)
+    """
+
+    detected: bool
+    tests: list
+    findings: list
+    experiments: list = field(default_factory=list)
+    levels: list = field(default_factory=list)
+    set_aside: list = field(default_factory=list)
+
+    def to_dict(self) -> dict:
+        """The SPEC §9 ``nonlinear`` block (plus ``experiments``)."""
+        keys = ("name", "parameters", "ci95", "equivalent", "equivalent_linear", "explanation")
+        out = {"detected": bool(self.detected), "tests": [t.to_dict() for t in self.tests],
+               "findings": [{k: f[k] for k in keys if k in f} | ({"character": f["character"]} if "character" in f
+                                                                    else {}) for f in self.findings],
+               "experiments": list(self.experiments)}
+        if self.set_aside:
+            out["set_aside"] = list(self.set_aside)
+        return out
+
+    def report(self) -> str:
+        """Plain-language text."""
+        head = "nonlinearity DETECTED" if self.detected else "no nonlinearity detected (consistent with a linear rig)"
+        lines = [f"[[Nonlinearity]] {head}"]
+        lines += [f"    test {t.report()}" for t in self.tests]
+        for f in self.findings:
+            lines.append(f"  - {f['name']}: {f['explanation']}")
+            if f.get("equivalent"):
+                lines.append(f"     equally good: {', '.join(f['equivalent'])} (the levels cannot tell them apart)")
+        if self.set_aside:
+            lines.append("    linear effects a fit would name are set aside while distortion is present: "
+                         + ", ".join(self.set_aside))
+        lines += [f"    next experiment: {e}" for e in self.experiments]
+        return "\n".join(lines)
+
+    def __str__(self):
+        return self.report()
+
+
+# --- detection on one recording ----------------------------------------------------------------------------
+def distortion_test(recording, band=None, alpha: float = 1e-3) -> NonlinearTest:
+    """Distortion test of one random-force recording (force and accelerations, or force and any output ``y``).
+
+    Parameters
+    ----------
+    recording : Recording with ``force`` and ``acc1``/``acc2`` (SATMD) or one other output channel
+    band : (lo, hi) Hz (default: the band the force excites)
+    alpha : level
+
+    Returns
+    -------
+    NonlinearTest
+    """
+    from ..io.lpm import excited_band
+
+    fs = recording.fs_hz
+    x = recording["force"]
+    if band is None:
+        lo, hi, _ = excited_band(x, fs)
+        band = (lo, hi)
+    accs = [c for c in ("acc1", "acc2") if c in recording.channels]
+    if accs:
+        responses = {ch: recording[c] for c, ch in zip(("acc1", "acc2"), ACCEL_CHANNELS) if c in recording.channels}
+        a1 = recording["acc1"] if "acc1" in recording.channels else None
+        a2 = recording["acc2"] if "acc2" in recording.channels else None
+        signals, shapes = {}, {}
+        if a1 is not None:
+            signals["u1"], shapes["u1"] = integrate(a1, fs, 2, band), ("cube",)
+        if a1 is not None and a2 is not None:
+            signals["d"], shapes["d"] = integrate(a2 - a1, fs, 2, band), ("cube",)
+            signals["v"], shapes["v"] = integrate(a2 - a1, fs, 1, band), ("cube", "absv", "sign")
+    else:
+        others = [c for c in recording.channels if c != "force"]
+        responses = {c: recording[c] for c in others}
+        y = recording[others[0]]
+        signals = {"y": y - np.mean(y), "dy": np.gradient(y) * fs}
+        shapes = {"y": ("square", "cube"), "dy": ("cube", "absv")}
+    regs = distortion_regressors(signals, shapes)
+    return linearity_test(x, responses, fs, regs, band=band, alpha=alpha)
+
+
+def strongest_regressor(test: NonlinearTest) -> str | None:
+    """The regressor group that explains most of the distortion (a hint, not a name)."""
+    regs = test.details.get("regressors") or []
+    return regs[0] if regs else None
+
+
+# --- FRFs of several recordings on one grid ---------------------------------------------------------------
+def common_frfs(recordings) -> list:
+    """LPM FRFs of several recordings on one frequency grid (same band and window width).
+
+    Parameters
+    ----------
+    recordings : list of Recording (same sample rate and length give the same grid)
+
+    Returns
+    -------
+    list of FRFData
+    """
+    from ..io.estimate import estimate_frf
+    from ..io.lpm import excited_band
+
+    bands = [excited_band(r["force"], r.fs_hz)[:2] for r in recordings]
+    band = (max(b[0] for b in bands), min(b[1] for b in bands))
+    first = estimate_frf(recordings[0], band=band)
+    width = first.estimator.get("window_hz") or first.estimator.get("settings", {}).get("window_hz")
+    out = [estimate_frf(r, band=band, width_hz=width) for r in recordings]
+    return out
+
+
+def on_common_grid(datas):
+    """Restrict FRFData to the frequencies all of them share (to 1e-9 relative); None if they share < 4."""
+    freq = datas[0].freq_hz
+    keep = np.ones(freq.size, bool)
+    for d in datas[1:]:
+        j = np.searchsorted(d.freq_hz, freq)
+        j = np.clip(j, 0, d.freq_hz.size - 1)
+        ok = np.abs(d.freq_hz[j] - freq) <= 1e-9 * np.maximum(freq, 1.0)
+        keep &= ok
+    if keep.sum() < 4:
+        return None
+    f_keep = freq[keep]
+    return f_keep, [_take(d, f_keep) for d in datas]
+
+
+def _take(d, freqs):
+    """FRFData rows at the given frequencies."""
+    from dataclasses import replace
+
+    j = np.searchsorted(d.freq_hz, freqs)
+    return replace(d, freq_hz=d.freq_hz[j], channels={c: v[j] for c, v in d.channels.items()},
+                   std={c: v[j] for c, v in d.std.items()}, coherence={c: v[j] for c, v in d.coherence.items()},
+                   correlation={k: v[j] for k, v in d.correlation.items()})
+
+
+def concentrated_bands(test: NonlinearTest, share: float = 0.25, smooth: int = 7) -> list:
+    """Where a test's per-point score is significant *and* within ``share`` of its peak (smoothed): the locus."""
+    score = test.details.get("scores")
+    freq = test.details.get("freq_hz")
+    if score is None or not test.bands_hz:
+        return test.bands_hz
+    s = np.convolve(score, np.ones(smooth) / smooth, mode="same")
+    on = s >= share * s.max()
+    sig = np.zeros(freq.size, bool)
+    for a, b in test.bands_hz:
+        sig |= (freq >= a) & (freq <= b)
+    on &= sig
+    bands, start = [], None
+    for i, v in enumerate(np.append(on, False)):
+        if v and start is None:
+            start = i
+        elif not v and start is not None:
+            bands.append([float(freq[start]), float(freq[i - 1])])
+            start = None
+    return bands or test.bands_hz

@@ -1,0 +1,123 @@
+"""`discover` on several recordings of one rig, and the nonlinear check of one recording.
+
+Several recordings (levels or repeats) are judged together: the ``nonlinear``
+block (`nonlinear_findings.analyse_recordings`) says whether they are one
+linear system; the linear vocabulary (`effects`) then runs
+
+- on their pooled FRF (inverse-variance mean) when they are: more data, one answer;
+- on the lowest level, with the parameter the nonlinear finding moves set free,
+  when they are not: the nonlinearity is named once, in its own block, and a
+  linear effect that only stands in for it (``parameter_offset`` of that
+  parameter, ``unexplained``) is dropped from ``effects``.
+
+A single recording in which distortion is detected keeps the linear effects
+found in ``nonlinear.set_aside`` instead of ``effects``: one level cannot tell a
+linear effect from an equivalent linearisation, and a nonlinear rig must not get
+linear physics for its nonlinearity.
+
+The linear discovery is passed in (``linear``: `satmd.discovery.discover`) so that
+this module does not import the package it serves.
+"""
+from __future__ import annotations
+
+from dataclasses import replace
+
+import numpy as np
+
+from .nonlinear_findings import analyse_recordings
+
+_UNEXPLAINED = "unexplained"
+
+
+def _is_recording(x) -> bool:
+    return hasattr(x, "fs_hz") and hasattr(x, "channels") and "force" in getattr(x, "channels", {})
+
+
+def pooled(datas):
+    """Inverse-variance mean of FRFData on one grid (std of the mean)."""
+    first = datas[0]
+    chans, std = {}, {}
+    for c in first.channels:
+        w = np.stack([1.0 / np.maximum(d.std[c], 1e-300) ** 2 for d in datas])
+        H = np.stack([d.channels[c] for d in datas])
+        chans[c] = np.sum(w * H, axis=0) / w.sum(axis=0)
+        std[c] = 1.0 / np.sqrt(w.sum(axis=0))
+    est = dict(first.estimator)
+    if "noise_dof" in est and est["noise_dof"]:
+        est["noise_dof"] = float(est["noise_dof"]) * len(datas)
+    est["pooled_records"] = len(datas)
+    return replace(first, channels=chans, std=std, correlation={}, estimator=est)
+
+
+def discover_recordings(items, linear, rig=None, free=None, alpha: float = 1e-3, **kwargs):
+    """Discovery on several recordings (or FRFData with std) of one rig: effects and the nonlinear block.
+
+    Parameters
+    ----------
+    items : list of Recording (force, acc1, acc2) or of FRFData with std, in any level order
+    linear : the linear discovery, ``linear(data, rig=..., free=..., alpha=..., **kwargs)``
+    rig, free, alpha, **kwargs : as `satmd.discovery.discover`
+
+    Returns
+    -------
+    DiscoveryReport
+        With ``nonlinear`` (SPEC §9).
+    """
+    from ..conventions import DEFAULT_FREE
+    from .nonlinear import common_frfs, on_common_grid
+    from .nonlinear_findings import analyse_frfs
+
+    free = tuple(free or DEFAULT_FREE)
+    items = list(items)
+    if all(_is_recording(x) for x in items):
+        datas = common_frfs(items)
+        nl = analyse_recordings(items, rig, free, alpha, datas=datas)
+        grid = on_common_grid(datas)
+        datas = grid[1] if grid is not None else datas
+        levels = nl.levels
+    else:
+        grid = on_common_grid(items)
+        if grid is None:
+            from ..errors import DataError
+
+            raise DataError("the FRFs share fewer than 4 frequencies: give them on one grid")
+        datas = grid[1]
+        nl = analyse_frfs(datas, rig, free, alpha)
+        levels = nl.levels
+    finding = nl.findings[0] if nl.findings else {}
+    moving = finding.get("moving")
+    if not nl.detected:
+        rep = linear(pooled(datas), rig=rig, free=free, alpha=alpha, **kwargs)
+        return replace(rep, nonlinear=nl)
+    ref = datas[int(np.argmin(levels))] if levels else datas[0]
+    free2 = free + ((moving,) if moving and moving not in free else ())
+    rep = linear(ref, rig=rig, free=free2, alpha=alpha, **kwargs)
+    drop = {_UNEXPLAINED} | ({f"parameter_offset:{moving}"} if moving else set())
+    if not moving:
+        drop |= {e.name for e in rep.effects}
+    kept = [e for e in rep.effects if e.name not in drop]
+    aside = [e.name for e in rep.effects if e.name in drop]
+    return replace(rep, effects=kept, nonlinear=replace(nl, set_aside=aside))
+
+
+def check_one(report, recording, alpha: float = 1e-3, rig=None, free=None):
+    """Add the nonlinear block to the discovery of one recording; set linear effects aside when distorted.
+
+    Parameters
+    ----------
+    report : DiscoveryReport of the recording
+    recording : the Recording it came from
+    alpha : level of the distortion test
+    rig, free : as `satmd.discovery.discover`
+
+    Returns
+    -------
+    DiscoveryReport
+    """
+    if not _is_recording(recording) or not any(c in recording.channels for c in ("acc1", "acc2")):
+        return report
+    nl = analyse_recordings([recording], rig, free or (), alpha)
+    if not nl.detected:
+        return replace(report, nonlinear=nl)
+    aside = [e.name for e in report.effects]
+    return replace(report, effects=[], nonlinear=replace(nl, set_aside=aside))

@@ -1,0 +1,282 @@
+"""Statistics of nonlinearity: linearity of one record, level dependence of several, band scans.
+
+One record (random force). A nonlinear element adds to the equations of motion a
+force g(state); the response then holds, beside the best linear approximation
+(BLA) H·X, a term G·Z where Z is the spectrum of a nonlinear function of the
+response and G is smooth in frequency (it is the transfer path of that force).
+`linearity_test` fits, in non-overlapping local windows (as the local polynomial
+method does), ``Y = H(r) X + T(r) + Σ_j G_j Z_j + V`` with H and the transient T
+polynomials of degree R and G_j constant, and tests G = 0 window by window (an F
+test with the window's own residual: the noise estimate never holds the
+distortion, because the distortion has its own regressors). The regressors are
+Hermite polynomials of the *standardised measured* responses (He2, He3): for a
+linear system with Gaussian force and Gaussian noise every Hermite polynomial of
+degree ≥ 2 of a measured signal is uncorrelated, at every lag, with everything
+linear (force, noise, transient), so the test holds its level whatever the
+noise colour or force spectrum; the distortion of a nonlinear one is not.
+
+Several records (levels or repeats). `level_dependence` compares FRF estimates
+point by point against their standard deviations: under "one linear system"
+every difference is noise, Σ|z|² is χ², and a band scan (Bonferroni over every
+window of several widths) locates where they differ.
+
+Each window's p-value is turned into a χ² score of the same p, so that the
+global sum and the band scan of `band_scan` apply to both tests alike.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+WIDTHS = (1, 3, 7, 15, 31)
+
+
+@dataclass(frozen=True)
+class NonlinearTest:
+    """One test of linearity: name, p-value, bands where it fails, and its numbers.
+
+    Attributes
+    ----------
+    name : ``distortion`` (one record), ``level_dependence`` (several), ...
+    p_value : smallest of the global and band p-values, Bonferroni-corrected for both
+    bands_hz : [[lo, hi], ...] where the test fails at its level
+    alpha : level of the test
+    details : dict of what the test measured (per-channel scores, dof, ...)
+    """
+
+    name: str
+    p_value: float
+    bands_hz: list
+    alpha: float
+    details: dict = field(default_factory=dict, compare=False)
+
+    @property
+    def significant(self) -> bool:
+        """True when the test rejects linearity at its level."""
+        return self.p_value < self.alpha
+
+    def to_dict(self) -> dict:
+        """The SPEC §9 entry: name, p_value, bands_hz."""
+        return {"name": self.name, "p_value": float(self.p_value),
+                "bands_hz": [[round(a, 3), round(b, 3)] for a, b in self.bands_hz]}
+
+    def report(self) -> str:
+        """One line in words."""
+        where = ", ".join(f"{a:.1f}–{b:.1f} Hz" for a, b in self.bands_hz) or "no band alone"
+        verdict = "rejects linearity" if self.significant else "consistent with a linear system"
+        return f"{self.name}: p = {self.p_value:.2g} ({verdict} at α = {self.alpha:g}); bands: {where}"
+
+
+def band_scan(freq, score, dof, alpha, widths=WIDTHS):
+    """Global and band-wise χ² tests of per-point scores (each χ²(dof) under the null).
+
+    Returns (p_value, bands_hz, p_global, p_band): p_value = 2·min(p_global,
+    p_band) (both tests at level α/2), bands where a Bonferroni-corrected window
+    p-value is below α/2, merged.
+    """
+    from scipy import stats
+
+    score = np.asarray(score, float)
+    n = score.size
+    p_global = float(stats.chi2.sf(score.sum(), dof * n))
+    windows = []
+    for w in widths:
+        if w > n:
+            break
+        s = np.convolve(score, np.ones(w), mode="valid")
+        p = stats.chi2.sf(s, dof * w)
+        windows += [(p[i], i, i + w - 1) for i in range(p.size)]
+    p_adj = np.minimum(np.array([p for p, _, _ in windows]) * len(windows), 1.0) if windows else np.ones(1)
+    spans = sorted((i0, i1) for (p, i0, i1), pa in zip(windows, p_adj) if pa < alpha / 2)
+    merged = []
+    for i0, i1 in spans:
+        if merged and i0 <= merged[-1][1] + 1:
+            merged[-1][1] = max(merged[-1][1], i1)
+        else:
+            merged.append([i0, i1])
+    bands = [[float(freq[a]), float(freq[b])] for a, b in merged]
+    p_band = float(p_adj.min())
+    return min(1.0, 2 * min(p_global, p_band)), bands, p_global, p_band
+
+
+def _chi2_score(p, dof):
+    """The χ²(dof) value with upper tail p (a common scale for tests of different dof)."""
+    from scipy import stats
+
+    return stats.chi2.isf(np.clip(p, 1e-300, 1.0), dof)
+
+
+# --- one record: distortion regressors ----------------------------------------------------------------
+_SHAPES = {"square": lambda s: s * s, "cube": lambda s: s ** 3, "absv": lambda s: np.abs(s) * s,
+           "sign": np.sign}
+
+
+def distortion_regressors(signals: dict, shapes=("cube",)) -> dict:
+    """Nonlinear functions of each standardised signal, made uncorrelated with every linear one.
+
+    For a Gaussian signal s and any g, E[g(s) w] = E[g(s) s] Cov(s, w) / Var(s)
+    for every w jointly Gaussian with s (Stein's lemma), so g(s) − β s with
+    β = E[g s]/E[s²], and g(s) − E[g] for even g, is uncorrelated at every lag
+    with the force, the noise and every linear response.
+
+    Parameters
+    ----------
+    signals : {name: (n,) samples}
+    shapes : any of ``square``, ``cube``, ``absv`` (|s|s: velocity-squared
+        damping), ``sign`` (Coulomb friction); a dict {name: shapes} gives each signal its own
+
+    Returns
+    -------
+    dict {"<name>:<shape>": (n,) regressor}
+    """
+    out = {}
+    for name, r in signals.items():
+        r = np.asarray(r, float)
+        s = (r - r.mean()) / max(r.std(), 1e-300)
+        for shape in (shapes[name] if isinstance(shapes, dict) else shapes):
+            g = _SHAPES[shape](s)
+            g = g - g.mean()
+            out[f"{name}:{shape}"] = g - np.dot(g, s) / np.dot(s, s) * s
+    return out
+
+
+def linearity_test(force, responses: dict, fs_hz: float, regressors: dict, band=None, window_bins: int = 0,
+                   degree: int = 2, alpha: float = 1e-3) -> NonlinearTest:
+    """Test one random-excitation record for nonlinear distortion (see the module docstring).
+
+    Parameters
+    ----------
+    force : (n,) input samples
+    responses : {channel: (n,) samples} measured outputs
+    fs_hz : sample rate
+    regressors : {name: (n,) samples} nonlinear regressors (e.g. `hermite_regressors` of the responses)
+    band : (lo, hi) Hz analysed (default: where the force has power)
+    window_bins : bins per local window (default: enough for 8 noise dof above the parameters, ≥ 0.4 Hz)
+    degree : polynomial degree of H and of the transient in each window
+    alpha : level
+
+    Returns
+    -------
+    NonlinearTest
+        ``distortion``, with per-channel and per-regressor figures in ``details``
+        (``explained``: fraction of the residual power the regressors explain,
+        per channel, near the worst band).
+    """
+    from scipy import stats
+
+    n = len(force)
+    X = np.fft.rfft(np.asarray(force, float) - np.mean(force))
+    Z = np.stack([np.fft.rfft(z - z.mean()) for z in regressors.values()], axis=1) if regressors else None
+    df = fs_hz / n
+    lo, hi = band if band is not None else _power_band(X, df)
+    nz = 0 if Z is None else Z.shape[1]
+    p_h = 2 * (degree + 1)
+    width = max(window_bins, p_h + nz + 9, int(np.ceil(0.4 / df)) | 1)
+    width += 1 - width % 2
+    half = width // 2
+    first, last = int(np.ceil(lo / df)), int(np.floor(hi / df))
+    centres = np.arange(first + half, last - half + 1, width)
+    if centres.size < 4 or nz == 0:
+        return NonlinearTest("distortion", 1.0, [], alpha, {"reason": "record too short for the test"})
+    idx = centres[:, None] + np.arange(-half, half + 1)
+    u = np.arange(-half, half + 1) / half
+    powers = u[None, :, None] ** np.arange(degree + 1)
+    Xw = X[idx]
+    xs = np.sqrt(np.mean(np.abs(Xw) ** 2, axis=1))[:, None, None]
+    K0 = np.concatenate([Xw[..., None] / xs * powers, np.broadcast_to(powers, Xw.shape + (degree + 1,))], axis=2)
+    Zw = Z[idx]  # (M, W, nz)
+    Zw = Zw / np.sqrt(np.mean(np.abs(Zw) ** 2, axis=1, keepdims=True))
+    K1 = np.concatenate([K0, Zw], axis=2)
+    q1 = width - K1.shape[2]
+    dof = 2 * nz
+    scores, explained, per_channel = np.zeros(centres.size), {}, {}
+    for name, y in responses.items():
+        Y = np.fft.rfft(np.asarray(y, float) - np.mean(y))[idx]
+        rss0 = _rss(K0, Y)
+        rss1 = _rss(K1, Y)
+        F = ((rss0 - rss1) / nz) / np.maximum(rss1 / q1, 1e-300)
+        p = stats.f.sf(F, dof, 2 * q1)
+        s = _chi2_score(p, dof)
+        scores += s
+        per_channel[name] = s
+        explained[name] = float(np.sum(rss0 - rss1) / max(np.sum(rss0), 1e-300))
+    freq = centres * df
+    dof_all = dof * len(responses)
+    p_value, bands, p_global, p_band = band_scan(freq, scores, dof_all, alpha)
+    details = {"window_hz": width * df, "windows": int(centres.size), "regressors": list(regressors),
+               "p_global": p_global, "p_band": p_band, "explained": explained, "freq_hz": freq,
+               "scores": scores, "per_channel": per_channel, "dof": dof_all}
+    return NonlinearTest("distortion", p_value, bands, alpha, details)
+
+
+def _rss(K, Y):
+    """Residual sum of squares of the local least-squares fits Y ≈ K θ (per window)."""
+    Q, _ = np.linalg.qr(K)
+    proj = np.einsum("mwp,mp->mw", Q, np.einsum("mwp,mw->mp", np.conj(Q), Y))
+    return np.sum(np.abs(Y - proj) ** 2, axis=1)
+
+
+def _power_band(X, df, drop_db=20.0):
+    """(lo, hi) Hz where the smoothed input power is within ``drop_db`` of its 95th percentile."""
+    p = np.abs(X) ** 2
+    k = max(1, int(round(1.0 / df)))
+    sm = np.convolve(p, np.ones(k) / k, mode="same")
+    sm[0] = 0.0
+    on = np.flatnonzero(sm > np.percentile(sm[1:], 95) * 10 ** (-drop_db / 10))
+    return (on[0] + k) * df, (on[-1] - k) * df
+
+
+def integrate(signal, fs_hz, times: int, band):
+    """Band-limited integration in the frequency domain (÷ iω per time), zero outside ``band``."""
+    n = len(signal)
+    S = np.fft.rfft(np.asarray(signal, float) - np.mean(signal))
+    f = np.fft.rfftfreq(n, 1.0 / fs_hz)
+    keep = (f >= band[0]) & (f <= band[1])
+    out = np.zeros_like(S)
+    out[keep] = S[keep] / (2j * np.pi * f[keep]) ** times
+    return np.fft.irfft(out, n)
+
+
+# --- several records: level dependence -------------------------------------------------------------------
+def level_dependence(freq, frfs: list, stds: list, alpha: float = 1e-3, name: str = "level_dependence",
+                     dof_noise: float | None = None) -> NonlinearTest:
+    """Do several FRF estimates on one grid differ beyond their noise? (see the module docstring)
+
+    Parameters
+    ----------
+    freq : (M,) common frequency grid
+    frfs : list over records of {channel: (M,) complex}
+    stds : list over records of {channel: (M,) std on each of Re, Im}
+    alpha : level
+    name : test name in the report
+    dof_noise : degrees of freedom behind the stds (None: known)
+
+    Returns
+    -------
+    NonlinearTest
+        ``details`` holds per-point scores, the largest standardised difference
+        per channel and the pair it comes from.
+    """
+    from scipy import stats
+
+    k = len(frfs)
+    chans = [c for c in frfs[0] if all(c in f for f in frfs)]
+    scores = np.zeros(len(freq))
+    dof = 0
+    worst = {}
+    for c in chans:
+        H = np.stack([f[c] for f in frfs])
+        w = 1.0 / np.maximum(np.stack([s[c] for s in stds]) ** 2, 1e-300)
+        mean = np.sum(w * H, axis=0) / np.sum(w, axis=0)  # weighted mean, the "one linear system" estimate
+        chi = np.sum(w * np.abs(H - mean) ** 2, axis=0)  # χ² with 2(k-1) dof per point
+        if dof_noise:
+            chi = _chi2_score(stats.f.sf(chi / (2 * (k - 1)), 2 * (k - 1), dof_noise), 2 * (k - 1))
+        scores += chi
+        dof += 2 * (k - 1)
+        z = np.abs(H - mean) * np.sqrt(w)
+        i = int(np.argmax(chi))
+        worst[c] = {"freq_hz": float(freq[i]), "chi2": float(chi[i]), "max_z": float(z[:, i].max())}
+    p_value, bands, p_global, p_band = band_scan(freq, scores, dof, alpha)
+    return NonlinearTest(name, p_value, bands, alpha, {"p_global": p_global, "p_band": p_band, "scores": scores,
+                                                       "freq_hz": np.asarray(freq), "dof": dof, "worst": worst})
