@@ -22,7 +22,26 @@ one line of figures.
 Table 2 MAE and the MAE on the 246 blind FRFs, and appends the figures with
 the device, torch version and thread count to
 benchmarks/results/inverse_training.json.
+
+``--once`` (issue 29: train the inverse once) fits the default paper-preset
+physics model twice per job, back to back: the method before issue 29
+(``calibration="holdout"``: train on 80 % of the pairs, calibrate, train again
+from scratch on all; finite-difference Jacobian) and the new default
+(``calibration="crossfit"``: one training, each validation pair held out from
+one member, whose out-of-fold predictions calibrate the std; shunt Jacobian).
+Jobs: every seed of ``--seeds`` at 1 torch thread and noise 0 (Table 2 MAE on
+the six blind pairs, MAE on the 246 blind FRFs), the first seed at each of
+``--thread-counts`` (wall and CPU seconds, ratio new/old in the same run), and
+the first seed trained and scored at ``--coverage-noise`` (2σ coverage on the
+246 blind FRFs at that noise). Records merge into
+benchmarks/results/inverse_once.json by (method, seed, threads, noise), so a
+long comparison can be split over several runs (``--seeds 0,1`` then
+``--seeds 2,3,4 --thread-counts 1 --coverage-noise 0``); the summary is
+recomputed from all records each time. It also times one training step of the
+batched members three ways (stacked weights with ``baddbmm``, ``torch.func``
+``vmap`` over ``functional_call``, a Python loop over members).
 Usage: python benchmarks/inverse.py [--quick] [--threads N] [--noises 0,0.01] [--presets paper] [--training]
+       python benchmarks/inverse.py --once [--seeds 0,1,2,3,4] [--thread-counts 1,2] [--coverage-noise 0.01]
 """
 from __future__ import annotations
 
@@ -48,7 +67,16 @@ def main(argv=None):
     ap.add_argument("--training", action="store_true", help="only time the paper-preset physics training")
     ap.add_argument("--device", default=None, help="training device for --training (default: CUDA when present)")
     ap.add_argument("--label", default="", help="a note stored with the --training figures")
+    ap.add_argument("--once", action="store_true", help="issue 29: old (hold-out + refit) vs new (cross-fit) training")
+    ap.add_argument("--seeds", default="0,1,2,3,4", help="--once: seeds of the MAE comparison")
+    ap.add_argument("--thread-counts", default="1,2", help="--once: torch threads timed on the first seed")
+    ap.add_argument("--coverage-noise", type=float, default=0.01, help="--once: noise of the coverage check (0: none)")
     args = ap.parse_args(argv)
+    if args.once:
+        from inverse_once import run_once
+
+        return run_once([int(x) for x in args.seeds.split(",") if x], [int(x) for x in args.thread_counts.split(",")
+                                                                        if x], args.coverage_noise)
     if args.training:
         return time_training(args.threads, args.device, args.label)
     out = Path(args.out)

@@ -64,13 +64,11 @@ except ImportError as exc:  # pragma: no cover
     raise ImportError("satmd.inverse needs torch: pip install 'satmd[nn]'") from exc
 
 from ..physics import Rig
-from ..physics.torch import frf as torch_frf
 from .dataset import BOUNDS, InverseDataset
 from .nets import EnsembleNet
+from .objective import gauss_newton_step, physics_loss, physics_objective, real_of  # noqa: F401 - re-exported
 
 REFERENCE_BATCH = 64  # the batch at which ``lr`` is quoted (sqrt rule above)
-MAX_STEP = 0.05  # largest Gauss-Newton step per output (normalised units)
-FD_STEP = {"complex128": 1e-6, "complex64": 1e-3}  # finite-difference step of the Jacobian, per twin precision
 N_VAL_POINTS = 20  # validation MAE is recorded this many times per run (cheap history, not every epoch)
 
 
@@ -92,6 +90,7 @@ class TrainConfig:
     precondition: bool
     threads: int | None
     twin_dtype: str
+    jacobian: str = "shunt"
 
     def to_dict(self):
         return asdict(self)
@@ -150,78 +149,15 @@ class Scaler:
         return cls(np.array(d["mean"], float), np.array(d["scale"], float))
 
 
-def _real(dtype):
-    return torch.float64 if dtype == torch.complex128 else torch.float32
-
-
-def _denormalised(out, bounds):
-    r_lo, r_hi = bounds["R"]
-    l_lo, l_hi = bounds["L"]
-    return r_lo + out[..., 0] * (r_hi - r_lo), l_lo + out[..., 1] * (l_hi - l_lo)
-
-
-def _residuals(norm_out, target, s_n, freq_t, rig, bounds, dtype):
-    """Scaled real residual vector of eq. 22, (..., n, 4F): [Re d1, Re d2, Im d1, Im d2] / s_n."""
-    R, L = _denormalised(norm_out, bounds)
-    pred = torch_frf(freq_t, rig.replace(R=R, L=L), dtype=dtype, device=freq_t.device, outputs=("a1", "a2"))
-    d = torch.cat([pred["a1"] - target[:, 0], pred["a2"] - target[:, 1]], dim=-1) * (1.0 / s_n)[:, None]
-    return torch.cat([d.real, d.imag], dim=-1)
-
-
-def physics_loss(norm_out, target, s_n, freq_t, rig: Rig, bounds=BOUNDS, dtype=torch.complex128):
-    """Eq. 22 for normalised outputs (..., n, 2) against complex targets (n, 2, F); per sample, shape (..., n)."""
-    r = _residuals(norm_out.to(_real(dtype)), target, s_n, freq_t, rig, bounds, dtype)
-    return (r * r).sum(dim=-1) / freq_t.numel()
-
-
-def gauss_newton_step(norm_out, target, s_n, freq_t, rig, bounds=BOUNDS, dtype=torch.complex128,
-                      damping: float = 1e-3):
-    """Per-sample Gauss-Newton step of eq. 22 in the normalised outputs, and the loss.
-
-    Returns ``(step, loss)``, shapes (..., n, 2) and (..., n). The Jacobian
-    d residual / d output comes from forward differences, with the point and
-    its two nudges in *one* twin call; the 2x2 normal equations (with
-    Levenberg-Marquardt damping) are solved in closed form.
-    """
-    h = FD_STEP["complex128" if dtype == torch.complex128 else "complex64"]
-    with torch.no_grad():
-        o = norm_out.detach().to(_real(dtype))
-        nudge = torch.eye(2, dtype=o.dtype, device=o.device) * h
-        r = _residuals(torch.stack([o, o + nudge[0], o + nudge[1]]), target, s_n, freq_t, rig, bounds, dtype)
-        # products, not divisions: a division costs several multiplications here
-        r0, jr, jl = r[0], (r[1] - r[0]) * (1.0 / h), (r[2] - r[0]) * (1.0 / h)
-        a = (jr * jr).sum(-1) * (1 + damping) + 1e-30
-        b = (jr * jl).sum(-1)
-        c = (jl * jl).sum(-1) * (1 + damping) + 1e-30
-        gr, gl = (jr * r0).sum(-1), (jl * r0).sum(-1)
-        det = a * c - b * b
-        step = torch.stack([(c * gr - b * gl) / det, (a * gl - b * gr) / det], dim=-1)
-    return step, (r0 * r0).sum(-1) / freq_t.numel()
-
-
-def physics_objective(out, target, s_n, freq_t, rig, bounds=BOUNDS, dtype=torch.complex128,
-                      precondition: bool = True):
-    """``(objective, loss)`` of the network outputs ``out`` (..., n, 2): ``objective.backward()`` trains.
-
-    With ``precondition`` the objective is the surrogate ``sum(out * step) / n``
-    whose gradient is each sample's Gauss-Newton step (clipped at `MAX_STEP`):
-    the minimiser of eq. 22 is unchanged, but R converges as fast as L.
-    Otherwise it is eq. 22 itself, differentiated through the twin.
-    ``loss`` is the mean eq. 22 value (detached).
-    """
-    if not precondition:
-        loss = physics_loss(out, target, s_n, freq_t, rig, bounds, dtype).mean()
-        return loss, loss.detach()
-    step, loss = gauss_newton_step(out, target, s_n, freq_t, rig, bounds, dtype)
-    step = step.clamp(-MAX_STEP, MAX_STEP).to(out.dtype) / out[..., 0].numel()
-    return (out * step).sum(), loss.mean()
-
-
 class _Batches:
     """Tensors of one partition, resident on the training device."""
 
-    def __init__(self, ds: InverseDataset, scaler: Scaler, bounds, device, dtype):
+    def __init__(self, ds: InverseDataset, scaler: Scaler, bounds, device, dtype, members=None):
         self.n = len(ds)
+        # members: per ensemble member, the indices of the samples it trains on (None: every member, every sample)
+        self.members = None if members is None else [
+            torch.as_tensor(np.flatnonzero(m), device=device) for m in np.asarray(members, bool)]
+        self.n_epoch = self.n if members is None else max(len(m) for m in self.members)
         self.x = torch.as_tensor(scaler.transform(ds.features()), device=device)
         # per-feature noise scale in standardised units: |A| / feature scale
         mag = np.abs(np.concatenate([ds.a1, ds.a2], axis=-1))
@@ -230,16 +166,30 @@ class _Batches:
         self.y = torch.as_tensor(ds.labels_normalised(bounds), dtype=torch.float32, device=device)
         target = np.stack([ds.a1, ds.a2], axis=1)
         self.target = torch.as_tensor(target, dtype=dtype, device=device)
-        self.s_n = torch.as_tensor(np.abs(target).max(axis=(1, 2)), dtype=_real(dtype), device=device)
+        self.s_n = torch.as_tensor(np.abs(target).max(axis=(1, 2)), dtype=real_of(dtype), device=device)
+
+    def epoch_order(self, gen) -> torch.Tensor:
+        """One epoch's sample order: (n,) shared by all members, or (E, n_epoch), each member its own samples
+        (a member with fewer samples than the largest starts its order again to fill the epoch)."""
+        if self.members is None:
+            return torch.randperm(self.n, generator=gen).to(self.x.device)
+        rows = []
+        for m in self.members:
+            p = m[torch.randperm(len(m), generator=gen).to(m.device)]
+            rows.append(p.repeat(math.ceil(self.n_epoch / len(m)))[:self.n_epoch])
+        return torch.stack(rows)
 
 
 def train_ensemble(train: InverseDataset, val: InverseDataset | None, config: TrainConfig, scaler: Scaler,
-                   rig: Rig | None = None, bounds=BOUNDS, verbose: bool = True):
+                   rig: Rig | None = None, bounds=BOUNDS, verbose: bool = True, members=None):
     """Train a deep ensemble; returns (EnsembleNet on CPU, history dict).
 
     Parameters
     ----------
     train, val : training data and optional validation data (its MAE is recorded in the history)
+    members : None (every member trains on every sample) or a boolean array (n_members, len(train)):
+        the samples each member trains on (cross-fitting); the members still train together, one
+        batched step for all, each on its own mini-batch
     config : resolved settings (`InverseModel.train_config`)
     scaler : input standardisation
     rig : fixed mechanical parameters (default: the paper's rig)
@@ -259,9 +209,13 @@ def train_ensemble(train: InverseDataset, val: InverseDataset | None, config: Tr
     gen = torch.Generator().manual_seed(int(config.seed))
     noise_gen = torch.Generator(device=device).manual_seed(int(config.seed) + 1)
     net = EnsembleNet(config.n_members, generator=gen).to(device)
-    tr = _Batches(train, scaler, bounds, device, dtype)
+    if members is not None and np.shape(members) != (config.n_members, len(train)):
+        raise DataError(f"members must be a boolean array ({config.n_members}, {len(train)}), got {np.shape(members)}")
+    if members is not None and not np.all(np.any(members, axis=1)):
+        raise DataError("every ensemble member needs training samples")
+    tr = _Batches(train, scaler, bounds, device, dtype, members)
     va = _Batches(val, scaler, bounds, device, dtype) if val is not None and len(val) else None
-    freq_t = torch.as_tensor(train.freq_hz, dtype=_real(dtype), device=device)
+    freq_t = torch.as_tensor(train.freq_hz, dtype=real_of(dtype), device=device)
 
     warm = min(int(config.warm_start_epochs), int(config.epochs)) if config.objective == "physics" else 0
     phases = []  # (objective, epochs, peak lr at the reference batch)
@@ -316,35 +270,36 @@ def _run_phase(net, opt, tr, va, freq_t, config, rig, bounds, dtype, gen, noise_
     """One phase of mini-batch epochs (all members at once), cosine learning rate from ``peak``."""
     device = tr.x.device
     batch = int(config.batch_size)
-    steps = n_epochs * max(1, math.ceil(tr.n / batch))
+    steps = n_epochs * max(1, math.ceil(tr.n_epoch / batch))
     val_every = max(1, math.ceil(total_epochs / N_VAL_POINTS))
     step = 0
     for _ in range(n_epochs):
         t0 = time.perf_counter()
-        perm = torch.randperm(tr.n, generator=gen).to(device)
+        order = tr.epoch_order(gen)
         total = torch.zeros((), device=device)  # summed on the device: no host sync per step
         net.train()
-        for i in range(0, tr.n, batch):
-            idx = perm[i:i + batch]
+        for i in range(0, tr.n_epoch, batch):
+            idx = order[..., i:i + batch]  # (B,) shared by the members, or (E, B): one mini-batch per member
             x = tr.x[idx]
             if config.noise:
-                eps = torch.randn((net.n_members,) + tuple(x.shape), generator=noise_gen, device=device)
-                x = x.unsqueeze(0) + config.noise * tr.noise_unit[idx].unsqueeze(0) * eps
+                eps = torch.randn(x.shape if x.ndim == 3 else (net.n_members,) + tuple(x.shape), generator=noise_gen,
+                                  device=device)
+                x = x + config.noise * tr.noise_unit[idx] * eps
             t = min(1.0, step / max(1, steps))
             for g in opt.param_groups:
                 g["lr"] = config.lr_final + 0.5 * (peak - config.lr_final) * (1 + math.cos(math.pi * t))
             out = net(x)
             if objective == "physics":
                 obj, loss = physics_objective(out, tr.target[idx], tr.s_n[idx], freq_t, rig, bounds, dtype,
-                                              config.precondition)
+                                              config.precondition, config.jacobian)
             else:
                 obj = loss = ((out - tr.y[idx]) ** 2).mean()
             opt.zero_grad(set_to_none=True)
             obj.backward()
             opt.step()
-            total += loss.detach().to(total.dtype) * idx.numel()
+            total += loss.detach().to(total.dtype) * idx.shape[-1]
             step += 1
-        history["loss"].append(float(total) / tr.n)
+        history["loss"].append(float(total) / tr.n_epoch)
         history["phase"].append(objective)
         epoch = len(history["loss"])
         if va is not None and (epoch % val_every == 0 or epoch == total_epochs):
@@ -380,7 +335,7 @@ def per_sample_epoch(net: EnsembleNet, train: InverseDataset, scaler: Scaler, ri
     """
     rig = Rig() if rig is None else rig
     tr = _Batches(train, scaler, bounds, torch.device("cpu"), dtype)
-    freq_t = torch.as_tensor(train.freq_hz, dtype=_real(dtype))
+    freq_t = torch.as_tensor(train.freq_hz, dtype=real_of(dtype))
     opt = torch.optim.Adam(net.parameters(), lr=lr)
     n = tr.n if max_samples is None else min(tr.n, max_samples)
     t0 = time.perf_counter()

@@ -97,7 +97,7 @@ def test_save_load_roundtrip(tiny_physics, tmp_path):
     m = tiny_physics
     m.save(tmp_path / "m")
     meta = json.loads((tmp_path / "m" / "model.json").read_text())
-    assert meta["schema"] == "satmd-inverse/1" and meta["kind"] == "physics"
+    assert meta["schema"] == "satmd-inverse/2" and meta["kind"] == "physics"
     assert len(meta["freq_hz"]) == 60 and len(meta["scaler"]["mean"]) == 240
     m2 = InverseModel.load(tmp_path / "m")
     test = pairs_dataset(BLIND_PAIRS)
