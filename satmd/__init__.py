@@ -3,7 +3,8 @@
 Forward model, grey-box identification, amortized inversion, explainability
 and missing-physics discovery from measured or simulated FRFs.
 """
-from .errors import DataError, FormatError, SatmdError
+from .errors import (DataError, DataWarning, FormatError, IdentifiabilityWarning, PinnedParameterWarning, PoorFitWarning,
+                     SatmdError)
 from .io import FRFData, load_frf, save_frf
 from .physics import (
     PAPER_GRID_HZ,
@@ -41,7 +42,8 @@ def __getattr__(name):
 __all__ = [
     "Rig", "frf", "effect", "Effect", "FRFData", "load_frf", "save_frf", "simulate", "PAPER_GRID_HZ",
     "SensorGain", "TimeDelay", "StructuralDamping", "DielectricLoss", "ShuntCapacitance", "ExtraMode",
-    "ParameterOffset", "SatmdError", "DataError", "FormatError", "identify", "identify_many", "FitResult",
+    "ParameterOffset", "SatmdError", "DataError", "FormatError", "DataWarning", "PoorFitWarning",
+    "PinnedParameterWarning", "IdentifiabilityWarning", "identify", "identify_many", "FitResult",
     "discover", "discover_many", "DiscoveryReport", "InverseModel", "tune", "TuneResult", "retune",
     "NonlinearElement", "nonlinear_element", "integrate",
 ]
