@@ -129,6 +129,9 @@ def _discover_frf(data: FRFData, rig, free, candidates, channels, alpha, max_eff
     candidates = tuple(candidates) if candidates else default_candidates()
 
     nominal_fit = identify(data, rig, free, channels, warn=False)
+    verdict = assess_fit(nominal_fit)  # can the SATMD model describe these data at all? (adequacy.py)
+    if not verdict.adequate:
+        return inadequate_report(verdict, nominal_fit, alpha, t0)
     noise, noise_dof = "given", None
     if data.estimator.get("noise_dof"):  # an estimated std (Welch averages, LPM residuals): F tests keep α
         noise_dof = data.estimator.get("noise_dof")
@@ -150,9 +153,6 @@ def _discover_frf(data: FRFData, rig, free, candidates, channels, alpha, max_eff
     search = Search(data, rig, free, channels, candidates)
 
     def significant(fit):
-    verdict = assess_fit(nominal_fit)  # can the SATMD model describe these data at all? (adequacy.py)
-    if not verdict.adequate:
-        return inadequate_report(verdict, nominal_fit, alpha, t0)
         return test_mismatch(fit, alpha, noise_dof).significant
 
     final = select_effects(search, nominal, significant, max_effects)
