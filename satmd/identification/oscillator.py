@@ -16,7 +16,7 @@ parameter: with y0 and k2 free it would shift the whole polynomial without chang
 >>> truth = PolynomialOscillator(k=w * w, c=2 * 0.05 * w, k3=3.0 * w * w, gain=w * w)
 >>> u = np.random.default_rng(0).normal(size=4000) * 0.1
 >>> fit = fit_oscillator(u, truth.simulate(u, 200.0), 200.0, delay=False)
->>> round(fit.model.k3 / truth.k3, 3)
+>>> round(float(fit.model.k3 / truth.k3), 3)
 1.0
 """
 from __future__ import annotations
