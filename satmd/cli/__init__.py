@@ -10,6 +10,7 @@ import argparse
 import importlib
 import pkgutil
 import sys
+from pathlib import Path
 
 from ..errors import SatmdError
 
@@ -70,7 +71,7 @@ def main(argv=None) -> int:
         os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
         return 0
     except SatmdError as exc:
-        return _refuse(args.command, str(exc))
+        return _refuse(args.command, _blame(args, str(exc)))
     except OSError as exc:
         return _refuse(args.command, os_message(exc))
     except ImportError as exc:
@@ -81,6 +82,17 @@ def main(argv=None) -> int:
     except KeyboardInterrupt:
         print("satmd: interrupted", file=sys.stderr)
         return 130
+
+
+def _blame(args, message: str) -> str:
+    """A refusal that names neither an input file nor an option is about the input: name it in front."""
+    inputs = []
+    for key in ("data", "recording", "model"):
+        value = getattr(args, key, None)
+        inputs += value if isinstance(value, list) else [value] if value else []
+    if not inputs or "--" in message or any(str(p) in message or Path(str(p)).name in message for p in inputs):
+        return message
+    return f"{inputs[0] if len(inputs) == 1 else ', '.join(map(str, inputs))}: {message}"
 
 
 def _refuse(command, message) -> int:

@@ -2,13 +2,11 @@
 from __future__ import annotations
 
 import argparse
-import contextlib
 import json
 import math
 import os
 import sys
 import time
-import warnings
 from numbers import Integral, Real
 from pathlib import Path
 
@@ -19,9 +17,8 @@ from ..conventions import DEFAULT_FREE
 from ..errors import FormatError, SatmdError
 from ..physics import Rig, effect
 
-# Upper bounds that keep memory bounded; refused up front with the number that was asked for.
-MAX_FREQ_POINTS = 1_000_000
-MAX_SAMPLES = 2 ** 24  # time samples per channel (3 channels of float64: 400 MB)
+# Upper bounds that keep memory bounded (one place: satmd.io.limits); refused up front with the number asked for.
+from ..io.limits import MAX_FREQ_POINTS, MAX_SAMPLES  # noqa: E402,F401 - the commands import them from here
 
 
 # --- option types: argparse names the option in its message ---------------------
@@ -202,27 +199,39 @@ def parse_freq(text: str) -> np.ndarray:
     return np.linspace(lo, hi, n)
 
 
-def parse_band(text: str | None):
+def parse_band(text: str | None, what: str = "--band"):
+    """'LO:HI' (either may be empty) -> (lo, hi) in Hz; ``what`` names the option in messages."""
     if not text:
         return None, None
     lo, sep, hi = text.partition(":")
     if not sep:
-        raise SatmdError(f"--band {text!r}: expected LO:HI in Hz")
-    lo = parse_number(lo, "--band LO") if lo else None
-    hi = parse_number(hi, "--band HI") if hi else None
+        raise SatmdError(f"{what} {text!r}: expected LO:HI in Hz")
+    lo = parse_number(lo, f"{what} LO") if lo else None
+    hi = parse_number(hi, f"{what} HI") if hi else None
     if lo is not None and hi is not None and lo >= hi:
-        raise SatmdError(f"--band {text!r}: LO must be below HI")
+        raise SatmdError(f"{what} {text!r}: LO must be below HI")
+    for x, end in ((lo, "LO"), (hi, "HI")):
+        if x is not None and not 0 <= x <= 1e9:
+            raise SatmdError(f"{what} {text!r}: {end} must lie in 0..1e9 Hz")
     return lo, hi
 
 
-def parse_kv(text: str, what: str) -> dict:
-    """'a=1,b=2' -> {'a': 1.0, 'b': 2.0}."""
+def parse_kv(text: str, what: str, lo: float | None = None, lo_open: bool = False) -> dict:
+    """'a=1,b=2' -> {'a': 1.0, 'b': 2.0}; a key given twice, or a value below ``lo``, is refused."""
     out = {}
     for item in filter(None, (s.strip() for s in text.split(","))):
         key, sep, value = item.partition("=")
         if not sep or not key.strip():
             raise SatmdError(f"{what}: {item!r} is not key=value")
-        out[key.strip()] = parse_number(value.strip(), f"{what} {key.strip()}")
+        key = key.strip()
+        if key in out:
+            raise SatmdError(f"{what}: {key} given twice")
+        x = parse_number(value.strip(), f"{what} {key}")
+        if lo is not None and (x < lo or (lo_open and x == lo)):
+            raise SatmdError(f"{what} {key}={value.strip()}: must be {'>' if lo_open else '>='} {lo:g}")
+        out[key] = x
+    if not out:
+        raise SatmdError(f"{what} {text!r}: give key=value pairs")
     return out
 
 
@@ -248,9 +257,13 @@ def parse_list(text: str | None) -> tuple[str, ...] | None:
 
 
 def name_list(text: str) -> str:
-    """An argparse ``type``: a comma-separated list that is not empty ('--free ""' is a mistake, not the default)."""
-    if not parse_list(text):
+    """An argparse ``type``: a comma-separated list, not empty ('--free ""' is a mistake), no name twice."""
+    names = parse_list(text)
+    if not names:
         raise argparse.ArgumentTypeError(f"{text!r} names nothing; give comma-separated names")
+    twice = sorted({n for n in names if names.count(n) > 1})
+    if twice:
+        raise argparse.ArgumentTypeError(f"{text!r} names {', '.join(twice)} twice (the data would count twice)")
     return text
 
 
@@ -290,39 +303,7 @@ def add_data_options(parser: argparse.ArgumentParser):
                         help="frequency axis in Hz for .txt files of complex values (one per line)")
 
 
-# the library names its parameters; the command line calls them by their flags
-_FLAGS = (("channel_map", "--map"), ("freq_axis", "--freq-axis"),
-          ("calibrate with scale (", "calibrate with --scale ("))
-
-
-def with_flags(text: str) -> str:
-    """Library parameter names in ``text`` replaced by the CLI's flags."""
-    for name, flag in _FLAGS:
-        text = text.replace(name, flag)
-    return text
-
-
-def cli_text(message) -> str:
-    """A library message on one line, in the CLI's words."""
-    return with_flags(" ".join(str(message).split()))
-
-
-@contextlib.contextmanager
-def one_line_warnings(command: str):
-    """Show warnings raised while loading data as one line each on stderr (no source lines)."""
-    from ..io import DataWarning
-
-    with warnings.catch_warnings(record=True) as caught:
-        warnings.simplefilter("always", DataWarning)  # others keep their default filters
-        try:
-            yield
-        finally:
-            seen = set()
-            for w in caught:
-                text = cli_text(w.message)
-                if text not in seen:
-                    seen.add(text)
-                    print(f"satmd {command}: warning: {text}", file=sys.stderr)
+from ._text import cli_text, one_line_warnings, safe_text, with_flags  # noqa: E402,F401 - shared by the commands
 
 
 def load_data(args):
@@ -343,7 +324,8 @@ def load_data(args):
             data = estimate_frf(rec, band=(lo, hi))
             from ..io.estimate import describe_estimate
 
-            print(f"satmd {command}: note: {args.data} is a time recording: FRFs estimated by "
+            check_usable(args.data, data)
+            print(f"satmd {command}: note: {safe_text(args.data)} is a time recording: FRFs estimated by "
                   f"{describe_estimate(data)} (use `satmd estimate-frf` for control)", file=sys.stderr)
             for finding in data.estimator.get("measurement", []):
                 print(f"satmd {command}: measurement: {finding['explanation']}; remedy: {finding['remedy']}",
@@ -355,9 +337,41 @@ def load_data(args):
         if getattr(args, "freq_axis", None):
             options["freq_axis"] = args.freq_axis
         data = load_frf(args.data, **options)
+    check_usable(args.data, data)
     for ch, s in data.std.items():  # every data command weights by the std: a zero is unusable
         if np.any(s == 0):
             k = int(np.argmax(s == 0))
             raise FormatError(args.data, f"{ch}_std is 0 in data row {k + 1} ({data.freq_hz[k]:.6g} Hz): a point "
                                          f"without noise cannot be weighted; drop the std columns or fix the row")
-    return data.band(lo, hi) if (lo is not None or hi is not None) else data
+    if lo is None and hi is None:
+        return data
+    try:
+        banded = data.band(lo, hi)
+    except SatmdError as exc:
+        raise SatmdError(f"--band {args.band}: {exc} in {safe_text(args.data)}") from None
+    if len(banded) < MIN_POINTS:
+        raise SatmdError(f"--band {args.band}: leaves {len(banded)} frequency point(s) of {safe_text(args.data)}; "
+                         f"the fitting commands need at least {MIN_POINTS}")
+    return banded
+
+
+MIN_POINTS = 2  # one frequency point cannot pin a resonance, whatever the channels
+
+
+def check_usable(path, data):
+    """Refuse FRFs no command can fit, naming the file: too few points, a channel that is zero everywhere."""
+    if len(data) < MIN_POINTS:
+        raise FormatError(path, f"{len(data)} frequency point(s): the fitting commands need at least {MIN_POINTS}")
+    from ..io.frfdata import MAX_ABS_VALUE
+
+    for ch, v in data.channels.items():
+        mag = np.abs(v)
+        if not np.any(mag):
+            raise FormatError(path, f"channel {ch} is zero at every frequency: nothing was measured")
+        k = int(np.argmax(mag))
+        if mag[k] > MAX_ABS_VALUE or mag[k] < 1e-100:
+            raise FormatError(path, f"channel {ch} peaks at |{ch}| = {mag[k]:.3g} ({data.freq_hz[k]:.6g} Hz): not an "
+                                    f"FRF in SI units (the fitting commands take 1e-100..1e100; a wrong unit?)")
+    for ch, s in data.std.items():
+        if np.max(s) > MAX_ABS_VALUE:
+            raise FormatError(path, f"{ch}_std reaches {np.max(s):.3g}: not a noise level in SI units")

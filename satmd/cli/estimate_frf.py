@@ -9,7 +9,7 @@ import numpy as np
 from ..errors import SatmdError
 from ..io.atomic import all_or_none
 from ._common import (add_rig_options, check_outputs, integer, one_line_warnings, parse_band, parse_kv, plot_suffixes,
-                      rig_from_args)
+                      rig_from_args, safe_text)
 
 
 def register(sub):
@@ -59,6 +59,13 @@ def _run(args):
 
     scale = parse_kv(args.scale, "--scale") if args.scale else None
     band = parse_band(args.band)
+    welch = {"--nperseg": args.nperseg, "--window": args.window, "--overlap": args.overlap}
+    given = [k for k, v in welch.items() if v is not None]
+    if args.width is not None and (args.estimator in ("H1", "H2") or given):
+        why = f"--estimator {args.estimator}" if args.estimator else ", ".join(given)
+        raise SatmdError(f"--width sets the lpm estimator's windows; it does not apply to Welch ({why})")
+    if args.estimator == "lpm" and given:
+        raise SatmdError(f"{', '.join(given)}: Welch settings, they do not apply to --estimator lpm")
     out = Path(args.out)
     with one_line_warnings("estimate-frf"):
         rec = load_recording(args.recording, channel_map=args.map, scale=scale)
@@ -76,6 +83,9 @@ def _run(args):
                                  f"--map a1=#N,a2=#M")
             if out.suffix.lower() != ".csv":
                 raise SatmdError(f"{out}: a transmissibility is written as .csv")
+            if args.width is not None:
+                raise SatmdError(f"--width: {safe_text(args.recording)} has no force channel; its transmissibility is "
+                                 "estimated by Welch, which has no lpm windows")
             if args.estimator == "lpm":
                 raise SatmdError(f"{args.recording}: an output-only recording gives a transmissibility, "
                                  f"estimated by Welch H1/H2, not lpm")
@@ -94,13 +104,22 @@ def _run(args):
                   file=sys.stderr)
     else:
         how = f"Welch {m['estimator']}, nperseg={m['nperseg']} ({m['resolution_hz']} Hz), {m['segments']} averages"
-    print(f"wrote {out}: {kind}, {len(freq)} points {freq[0]:.6g}..{freq[-1]:.6g} Hz, {how}, "
-          f"median coherence {np.median(np.concatenate(list(coh.values()))):.3f}")
+    median = float(np.median(np.concatenate(list(coh.values()))))
+    print(f"wrote {safe_text(out)}: {kind}, {len(freq)} points {freq[0]:.6g}..{freq[-1]:.6g} Hz, {how}, "
+          f"median coherence {median:.3f}")
+    low = {name: float(np.median(g)) for name, g in coh.items() if np.median(g) < LOW_COHERENCE}
+    if low:
+        print(f"satmd estimate-frf: warning: low coherence ({', '.join(f'{n} {g:.2f}' for n, g in low.items())}, "
+              f"median over the band): the responses are barely related to "
+              f"{'the force' if isinstance(data, FRFData) else 'each other'}; check the channels (--map), the "
+              "sensors and the excitation before trusting these FRFs", file=sys.stderr)
     if args.plot:
         plot_estimate(freq, curves, coh, args.plot, title=f"{Path(args.recording).name}: {kind}")
         print(f"plot: {args.plot}")
     return 0
 
+
+LOW_COHERENCE = 0.5  # a median ordinary coherence below this: mostly noise, or the wrong channels
 
 LABELS = {"a1": "A1 = acc1/force", "a2": "A2 = acc2/force", "T": "T = A2/A1"}
 

@@ -7,7 +7,7 @@ import numpy as np
 
 from ..conventions import TINY
 from ..errors import FormatError, SatmdError
-from ._common import one_line_warnings
+from ._common import one_line_warnings, safe_text
 
 _FORMATS = {".uff": "universal file (UFF)", ".unv": "universal file (UFF)", ".csv": "CSV", ".wav": "WAV audio",
             ".npz": "NumPy .npz archive", ".mat": "MATLAB file", ".txt": "text"}
@@ -41,7 +41,7 @@ def describe(path, channel_map=None, freq_axis=None) -> list[str]:
 
     path = Path(path)
     suffix = path.suffix.lower()
-    lines = [f"{path}: {_FORMATS.get(suffix, suffix or 'no suffix')}, {_size(path.stat().st_size)}"]
+    lines = [f"{safe_text(path)}: {_FORMATS.get(suffix, suffix or 'no suffix')}, {_size(path.stat().st_size)}"]
     if suffix in (".uff", ".unv"):
         return lines + _uff(path, channel_map)
     if suffix == ".txt":

@@ -37,22 +37,23 @@ def register(sub):
     p.add_argument("--noise", default=None, metavar="REL[:FLOOR]",
                    help="Gaussian noise with std = REL|A| + FLOOR max|A| on Re and Im; adds std columns")
     p.add_argument("--seed", type=SEED, default=None, help="random seed for the noise")
-    freq = p.add_argument("--freq", default="40:130:60", metavar="LO:HI:N", help="frequency grid (default 40:130:60)")
-    channels = p.add_argument("--channels", default="a1,a2", help="channels to write, from a1,a2,u1,u2,q (default a1,a2)")
+    freq = p.add_argument("--freq", default=None, metavar="LO:HI:N", help="frequency grid (default 40:130:60)")
+    channels = p.add_argument("--channels", default=None, help="channels to write, from a1,a2,u1,u2,q (default a1,a2)")
     p.add_argument("-o", "--out", required=True, metavar="OUT.csv",
                    help="output file (FRFs: .csv .uff .mat .npz; with --time: .csv .uff .wav .mat .npz)")
     t = OptionGroup(p.add_argument_group("time recordings (--time)"))
     t.add_argument("--time", action="store_true",
                    help="write a time recording (force, acc1, acc2) instead of FRFs: band-limited random force "
                         "through the linear model; --noise REL is then sensor noise relative to each channel's RMS")
-    t.add_argument("--duration", type=real(0, lo_open=True), default=60.0, metavar="S",
+    t.add_argument("--duration", type=real(0, lo_open=True), default=None, metavar="S",
                    help="recording length in s (default 60)")
-    t.add_argument("--fs", type=real(0, lo_open=True), default=1000.0, metavar="HZ",
+    t.add_argument("--fs", type=real(0, lo_open=True), default=None, metavar="HZ",
                    help="sample rate in Hz (default 1000)")
-    t.add_argument("--force-band", default="20:200", metavar="LO:HI",
+    t.add_argument("--force-band", default=None, metavar="LO:HI",
                    help="excitation band in Hz (default 20:200)")
-    t.add_argument("--force-rms", type=float, default=1.0, metavar="N", help="RMS force in N (default 1)")
-    t.add_argument("--excitation", default="random", choices=("random", "sweep", "multisine"),
+    t.add_argument("--force-rms", type=real(0, 1e12, lo_open=True), default=None, metavar="N",
+                   help="RMS force in N (default 1)")
+    t.add_argument("--excitation", default=None, choices=("random", "sweep", "multisine"),
                    help="random: band-limited non-periodic noise, rig at rest at t = 0 (default, as on a rig); "
                         "sweep: one log sine sweep; multisine: odd random-phase multisine with detection lines, "
                         "--realisations x --periods, each realisation from rest (first period: transient)")
@@ -64,13 +65,18 @@ def register(sub):
     t.add_argument("--periods", type=int, default=None, metavar="P", help="multisine periods per realisation (default 3)")
     t.add_argument("--realisations", type=int, default=None, metavar="M",
                    help="multisine realisations, each with new phases (default 4)")
-    t.add_argument("--force-noise", type=float, default=None, metavar="REL",
+    t.add_argument("--force-noise", type=real(0, MAX_NOISE), default=None, metavar="REL",
                    help="force-sensor noise relative to the force RMS (default: half of --noise)")
-    t.add_argument("--burn-in", type=float, default=0.0, metavar="S",
+    t.add_argument("--burn-in", type=real(0), default=None, metavar="S",
                    help="seconds of excitation before the record starts (default 0: starts at rest)")
     p.add_argument("--plot", default=None, metavar="OUT.png", help="also plot the FRFs")
     # options of one mode given in the other are refused, not ignored
     p.set_defaults(func=run, time_only=option_defaults(t.actions), frf_only=option_defaults([freq, channels]))
+
+
+MAX_NOISE = 1e3  # noise a thousand times the signal: beyond, the file holds nothing but noise
+TIME_DEFAULTS = {"duration": 60.0, "fs": 1000.0, "force_band": "20:200", "force_rms": 1.0, "excitation": "random",
+                 "burn_in": 0.0}
 
 
 def parse_noise(text):
@@ -80,6 +86,9 @@ def parse_noise(text):
     noise = (parse_number(rel, "--noise REL"), parse_number(floor, "--noise FLOOR") if floor else 0.0)
     if noise[0] < 0 or noise[1] < 0:
         raise SatmdError(f"--noise {text!r}: REL and FLOOR must be >= 0")
+    if noise[0] > MAX_NOISE or noise[1] > MAX_NOISE:
+        raise SatmdError(f"--noise {text!r}: REL and FLOOR must be <= {MAX_NOISE:g} (noise {MAX_NOISE:g} times the "
+                         "signal leaves nothing to fit)")
     return noise
 
 
@@ -92,8 +101,11 @@ def run(args):
     effects = [parse_effect(e) for e in args.effect]
     if args.time:
         return run_time(args, rig, effects)
-    freq = parse_freq(args.freq) if args.freq else PAPER_GRID_HZ
-    channels = parse_names(args.channels, CHANNELS, "--channels")
+    freq = parse_freq(args.freq) if args.freq is not None else PAPER_GRID_HZ
+    channels = parse_names(args.channels if args.channels is not None else "a1,a2", CHANNELS, "--channels")
+    twice = sorted({c for c in channels if channels.count(c) > 1})
+    if twice:
+        raise SatmdError(f"--channels {args.channels!r}: {', '.join(twice)} given twice")
     check_outputs([("-o", args.out, tuple(sorted(WRITERS))), ("--plot", args.plot, args.plot and plot_suffixes())])
     data = simulate(freq, rig, effects, channels, noise=parse_noise(args.noise), seed=args.seed)
     with all_or_none():
@@ -111,16 +123,24 @@ def run_time(args, rig, effects):
 
     if args.plot:
         raise SatmdError("--plot does not apply with --time (plot the estimate: satmd estimate-frf REC --plot FIG.png)")
+    for key, value in TIME_DEFAULTS.items():
+        if getattr(args, key) is None:
+            setattr(args, key, value)
     noise = parse_noise(args.noise)
     if noise and noise[1]:
         raise SatmdError("--noise with --time takes REL only (sensor noise relative to each channel's RMS)")
-    lo, hi = parse_band(args.force_band)
+    lo, hi = parse_band(args.force_band, "--force-band")
     if lo is None or hi is None:
         raise SatmdError(f"--force-band {args.force_band!r}: expected LO:HI in Hz")
     n = args.duration * args.fs
     if n > MAX_SAMPLES:
         raise SatmdError(f"--duration {args.duration:g} s at --fs {args.fs:g} Hz is {n:.3g} samples per channel; "
                          f"at most {MAX_SAMPLES} (e.g. --duration {MAX_SAMPLES // args.fs:g})")
+    from ..io.limits import check_memory
+    from ..io.timesim import recording_memory
+
+    check_memory(f"--fs {args.fs:g} Hz for --duration {args.duration:g} s",
+                 recording_memory(args.duration, args.fs, args.burn_in), "lower --fs or --duration")
     check_outputs([("-o", args.out, tuple(sorted(RECORDING_WRITERS)))])
     if args.nonlinear or args.excitation == "multisine" or args.level is not None:
         return run_nonlinear(args, rig, effects, noise, (lo, hi))

@@ -104,6 +104,7 @@ def _tune_options(args) -> dict:
         raise DataError(f"--band {args.band!r}: expected LO:HI in Hz")
     band = (parse_number(lo, "--band LO"), parse_number(hi, "--band HI"))
     Objective(args.objective, args.output, band)  # validates the band now, before any work
+    _check_work(args, band)
     design = parse_list(args.design)
     if not design:
         raise DataError("--design: give at least one rig parameter, e.g. R,L")
@@ -114,14 +115,17 @@ def _tune_options(args) -> dict:
         if not eq or not colon:
             raise DataError(f"--bounds {item!r}: expected NAME=LO:HI")
         bounds[name.strip()] = (parse_number(a, f"--bounds {name} LO"), parse_number(b, f"--bounds {name} HI"))
+        for x in bounds[name.strip()]:
+            _check_scale(f"--bounds {item}", name.strip(), x)
     DesignSpace.build(design, {n: 1.0 for n in design}, bounds)  # names and bounds checked before any work
     q = args.robust
     if q is not None and not 0.5 <= q < 1:
         raise DataError(f"--robust {q}: the quantile must lie in [0.5, 1)")
-    if args.draws < 16:
-        raise DataError(f"--draws {args.draws}: need at least 16")
-    current = parse_kv(args.current, "--current") if args.current else None
-    uncertainty = parse_kv(args.uncertainty, "--uncertainty") if args.uncertainty else None
+    current = parse_kv(args.current, "--current", lo=0.0) if args.current else None
+    uncertainty = parse_kv(args.uncertainty, "--uncertainty", lo=0.0, lo_open=True) if args.uncertainty else None
+    for flag, given in (("--current", current), ("--uncertainty", uncertainty)):
+        for name, x in (given or {}).items():
+            _check_scale(f"{flag} {name}={x:g}", name, x)
     if uncertainty and q is None:
         raise DataError("--uncertainty applies to --robust")
     return {"objective": args.objective, "output": args.output, "band": band, "design": design,
@@ -129,10 +133,40 @@ def _tune_options(args) -> dict:
             "current": current, "uncertainty": uncertainty}
 
 
+MAX_DRAWS = 4096  # about 4 minutes of robust tuning (55 s per 1000 draws, measured)
+SCALE = 1e6  # rig values within a factor 1e6 of the paper's rig: beyond, the optimiser's numbers overflow
+GRID_BYTES = 1.5e5  # memory per frequency of the tuning grid (measured: --band 1e-6:200, 4779 points, 670 MB)
+
+
+def _check_scale(where, name, x):
+    """A rig value (or bound, current setting, std) within a factor `SCALE` of the paper's rig."""
+    from ..physics import Rig
+
+    ref = Rig().as_dict().get(name)
+    if ref and x != 0 and not (abs(ref) / SCALE <= abs(x) <= abs(ref) * SCALE):
+        raise DataError(f"{where}: {x:g} is more than a factor {SCALE:g} from the paper's {name} = {ref:g}; "
+                        "check the unit (SI)")
+
+
+def _check_work(args, band):
+    """Refuse up front what would exhaust memory (the band's grid) or run for hours (--draws)."""
+    import math
+
+    from ..io.limits import check_memory
+
+    if not 16 <= args.draws <= MAX_DRAWS:
+        raise DataError(f"--draws {args.draws}: need 16..{MAX_DRAWS} (about 55 s per 1000 draws)")
+    points = math.log(band[1] / band[0]) / 0.004  # satmd.tuning.objective.band_grid's spacing
+    check_memory(f"--band {args.band} ({points:.3g} grid points)", points * GRID_BYTES, "narrow the band")
+
+
 def _model_rig(args):
     from ..physics import Rig
 
     changes = parse_kv(args.rig, "--rig") if args.rig else {}
+    for name, x in changes.items():
+        if x != 0:
+            _check_scale(f"--rig {name}={x:g}", name, x)
     try:
         return Rig().replace(**changes).validate()
     except ValueError as exc:

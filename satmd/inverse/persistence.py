@@ -79,6 +79,8 @@ def model_from_meta(cls, meta: dict, state: dict | None = None):
     """The model `model_meta` described, with weights ``state`` (net kinds); `SatmdError` for anything else."""
     from ..physics import Rig
 
+    if _depth(meta) > MAX_DEPTH:
+        raise DataError(f"nests deeper than {MAX_DEPTH} levels (not a file satmd wrote)")
     if not isinstance(meta, dict) or meta.get("schema") not in FORMATS:
         raise DataError(_schema_refusal(meta))
     if CHECKSUM in meta and meta[CHECKSUM] != _checksum(meta):  # models saved before the checksum have none
@@ -102,14 +104,16 @@ def model_from_meta(cls, meta: dict, state: dict | None = None):
     # a None where None is not allowed stands for "the default" in models saved by earlier versions
     params = {**FORMATS[meta["schema"]], **{k: v for k, v in meta["params"].items()
               if k in names and (v is not None or None in cls._parameter_constraints.get(k, ()))}}
-
     params["verbose"] = False
     try:
         if {k: tuple(map(float, v)) for k, v in meta["bounds"].items()} != {k: tuple(v) for k, v in BOUNDS.items()}:
             raise DataError(f"bounds {meta['bounds']} differ from eq. 20's {dict(BOUNDS)}")
         model = cls(**params, rig=Rig(**meta["rig"]).validate(), freq_hz=np.array(meta["freq_hz"], float))
         model.validate_params()
+        _check_numbers(meta["params"], model.freq_hz, meta["rig"])
         model.std_scale_ = np.array(meta["std_scale"], float).reshape(2)
+        if not (np.all(np.isfinite(model.std_scale_)) and np.all(model.std_scale_ > 0)):
+            raise DataError(f"std_scale {meta['std_scale']} must be two finite numbers > 0 (a std is never negative)")
         if strategy.has_net:
             from .training import Scaler
 
@@ -117,6 +121,9 @@ def model_from_meta(cls, meta: dict, state: dict | None = None):
             n_features = (4 * model.freq_hz.size,)
             if model.scaler_.mean.shape != n_features or model.scaler_.scale.shape != n_features:
                 raise DataError("input scaler does not fit the frequency grid")
+            if not (np.all(np.isfinite(model.scaler_.mean)) and np.all(np.isfinite(model.scaler_.scale))
+                    and np.all(model.scaler_.scale > 0)):
+                raise DataError("input scaler holds NaN, infinite or non-positive values")
     except (KeyError, TypeError, ValueError) as exc:
         if isinstance(exc, SatmdError):
             raise
@@ -128,6 +135,37 @@ def model_from_meta(cls, meta: dict, state: dict | None = None):
             raise DataError("a network model needs its weights")
         model.set_ensemble(_ensemble(meta["network"], state, model.freq_hz.size))
     return model
+
+
+MAX_DEPTH = 16  # nesting of model.json (satmd writes 4)
+MAX_MC_SAMPLES = 1024  # Monte Carlo draws per prediction a saved model may ask for
+MAX_REFINE_NFEV = 10_000
+MAX_GRID = 100_000  # frequencies of a saved model's grid
+
+
+def _depth(value, level=0) -> int:
+    """Nesting depth of JSON data, without recursing past `MAX_DEPTH`."""
+    if level > MAX_DEPTH or not isinstance(value, (dict, list)):
+        return level
+    items = value.values() if isinstance(value, dict) else value
+    return max([_depth(v, level + 1) for v in items] or [level])
+
+
+def _check_numbers(params: dict, freq_hz, rig: dict):
+    """Settings a file could set to make a prediction hang, allocate without bound or overflow."""
+    from ..physics import Rig
+
+    for key, ref in Rig().as_dict().items():
+        x = rig.get(key, ref)
+        if not isinstance(x, (int, float)) or (ref and x and not abs(ref) / 1e6 <= abs(x) <= abs(ref) * 1e6):
+            raise DataError(f"rig.{key} = {x!r} is more than a factor 1e6 from the paper's {ref:g}")
+    for key, top in (("mc_samples", MAX_MC_SAMPLES), ("refine_nfev", MAX_REFINE_NFEV)):
+        value = params.get(key)
+        if value is not None and not (isinstance(value, (int, float)) and 0 <= value <= top):
+            raise DataError(f"params.{key} = {value!r} is outside 0..{top}")
+    if not (1 <= freq_hz.size <= MAX_GRID and np.all(np.isfinite(freq_hz)) and np.all(freq_hz > 0)
+            and np.all(np.diff(freq_hz) > 0)):
+        raise DataError(f"freq_hz must be 1..{MAX_GRID} finite, positive, increasing frequencies")
 
 
 def _schema_refusal(meta) -> str:
@@ -186,10 +224,15 @@ def read_folder(cls, path):
     meta_file = path / META
     if not meta_file.is_file():
         raise SatmdError(f"{path}: not a saved inverse model (no {META})")
+    from ..io.limits import check_file
+
+    check_file(meta_file, 64 * 2 ** 20)  # satmd writes under 1 MB; a FIFO or a device is refused unopened
     try:
         meta = json.loads(meta_file.read_text(encoding="utf-8"))
     except json.JSONDecodeError as exc:
         raise DataError(f"{meta_file}: invalid JSON ({exc.msg}, line {exc.lineno})") from None
+    except RecursionError:
+        raise DataError(f"{meta_file}: JSON nested too deeply (not a file satmd wrote)") from None
     except (OSError, UnicodeDecodeError) as exc:
         raise DataError(f"{meta_file}: cannot read ({getattr(exc, 'strerror', None) or exc})") from None
     state = None
@@ -210,6 +253,9 @@ def _read_weights(file: Path) -> dict:
 
     if not file.is_file():
         raise DataError(f"{file}: missing (the model's weights)")
+    from ..io.limits import check_file
+
+    check_file(file, 2 * 2 ** 30)
     try:
         state = torch.load(file, map_location="cpu", weights_only=True)
     except (RuntimeError, EOFError, OSError, pickle.UnpicklingError, zipfile.BadZipFile, ValueError):

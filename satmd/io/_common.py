@@ -172,15 +172,26 @@ def parse_channel_map(spec, allowed, aliases=None) -> dict:
     for key, value in items:
         key = aliases.get(key.strip(), key.strip())
         if key not in allowed:
-            raise ValueError(f"channel map: unknown channel {key!r} (use {', '.join(allowed)})")
+            raise ValueError(f"channel_map: unknown channel {key!r} (use {', '.join(allowed)})")
         if not str(value).strip():
-            raise ValueError(f"channel map: {key}= needs NODE:DIR or #RECORD")
+            raise ValueError(f"channel_map: {key}= needs NODE:DIR or #RECORD")
         if key in out:
-            raise ValueError(f"channel map: {key} given twice")
+            raise ValueError(f"channel_map: {key} given twice")
         out[key] = parse_dof(str(value))
+        same = [k for k, v in out.items() if k != key and _same_source(v, out[key])]
+        if same:
+            raise ValueError(f"channel_map: {same[0]} and {key} both name {str(value).strip()} "
+                             "(one record or column cannot be two channels)")
     if not out:
-        raise ValueError("channel map is empty")
+        raise ValueError("channel_map is empty")
     return out
+
+
+def _same_source(a, b) -> bool:
+    """Two map entries naming the same record (#N) or the same node and axis."""
+    if a[0] != b[0]:
+        return False
+    return a[1] == b[1] if a[0] == "index" else (a[1], abs(a[2])) == (b[1], abs(b[2]))
 
 
 def channel_map_of(path, spec, allowed, aliases=None) -> dict:

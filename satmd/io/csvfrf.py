@@ -6,8 +6,9 @@ from pathlib import Path
 
 import numpy as np
 
-from ..errors import FormatError
-from ._common import decode_text, numeric_table, read_bytes, split_csv
+from ..errors import DataError, FormatError
+from ._common import numeric_table, read_text, split_csv, text_lines
+from .estmeta import validate_estimator
 from .atomic import atomic_write
 from .frfdata import CHANNELS, FRFData
 
@@ -19,7 +20,7 @@ ESTIMATOR_KEY = "satmd estimator"  # comment line holding FRFData.estimator as J
 def read_csv(path) -> FRFData:
     """Read a SPEC §7 file; any malformation raises FormatError (file, line, column)."""
     path = Path(path)
-    text = decode_text(path, read_bytes(path))
+    text = read_text(path)
     if text.lstrip().lower().startswith("# satmd-transmissibility"):  # say what the file is, not "unknown channel"
         raise FormatError(path, "holds a transmissibility A2/A1 (written by estimate-frf from an output-only "
                                 "recording), not FRFs per unit force; FRFs need a recording with a force channel",
@@ -53,15 +54,26 @@ def read_csv(path) -> FRFData:
                                   column=f"{cols['std'] + 1} ({ch}_std)")
             std[ch] = s
     meta.setdefault("source", str(path))
-    estimator = {}
-    if ESTIMATOR_KEY in meta:
-        try:
-            estimator = json.loads(meta.pop(ESTIMATOR_KEY))
-        except ValueError:
-            raise FormatError(path, f"the '# {ESTIMATOR_KEY}:' comment is not JSON") from None
-        if not isinstance(estimator, dict):
-            raise FormatError(path, f"the '# {ESTIMATOR_KEY}:' comment is not a JSON object")
+    estimator = _estimator(path, text, meta, float(freq[-1]))
     return FRFData(freq, chans, std, meta, estimator=estimator)
+
+
+def _estimator(path, text, meta, freq_max) -> dict:
+    """The ``# satmd estimator: {...}`` comment, parsed and checked against the schema (`satmd.io.estmeta`)."""
+    if ESTIMATOR_KEY not in meta:
+        return {}
+    raw = meta.pop(ESTIMATOR_KEY)
+    line = next((k for k, ln in enumerate(text_lines(text), start=1)
+                 if ln.strip().lstrip("#").strip().startswith(ESTIMATOR_KEY + ":")), None)
+    try:
+        estimator = json.loads(raw)
+    except (ValueError, RecursionError):
+        raise FormatError(path, f"the '# {ESTIMATOR_KEY}:' comment is not JSON (or nests too deeply)",
+                          line=line) from None
+    try:
+        return validate_estimator(estimator, freq_max)
+    except DataError as exc:
+        raise FormatError(path, f"the '# {ESTIMATOR_KEY}:' comment: {exc}", line=line) from None
 
 
 def _parse_header(path, header, lineno):

@@ -9,7 +9,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import DataError, FormatError
-from ._common import decode_text, numeric_table, read_bytes, split_csv
+from ._common import numeric_table, read_text, split_csv
 from .atomic import atomic_write
 from .recdata import ROLES, SI_UNITS, Recording, uniform_rate, warn_clipping
 
@@ -19,7 +19,7 @@ CSV_MAGIC = "# satmd-recording v1"
 def read_recording_csv(path) -> Recording:
     """A ``time_s,force,acc1,acc2`` CSV (SI units); malformed input names file, line and column."""
     path = Path(path)
-    text = decode_text(path, read_bytes(path))
+    text = read_text(path)
     header, header_line, rows, meta = split_csv(path, text, "satmd-recording")
     if header is None:
         raise FormatError(path, "no column header (expected time_s,force,acc1,acc2)")

@@ -7,8 +7,12 @@ import numpy as np
 
 from ..conventions import ACCEL_CHANNELS
 from ..errors import DataError
+from .estmeta import validate_estimator
 
 CHANNELS = ("a1", "a2", "u1", "u2", "q")
+MAX_FREQ_HZ = 1e9  # no structural FRF reaches a GHz; beyond, ω² overflows in the models
+MIN_FREQ_HZ = 1e-9
+MAX_ABS_VALUE = 1e100  # no FRF in SI units reaches this; the fitting commands refuse it (squares overflow)
 UNITS = {"a1": "m/s²/N", "a2": "m/s²/N", "u1": "m/N", "u2": "m/N", "q": "C/N"}
 
 
@@ -48,6 +52,10 @@ class FRFData:
             raise DataError(f"freq_hz must be a non-empty 1-D array, got shape {f.shape}")
         if not np.all(np.isfinite(f)) or np.any(f <= 0) or np.any(np.diff(f) <= 0):
             raise DataError("freq_hz must be finite, > 0 and strictly increasing")
+        if f[-1] > MAX_FREQ_HZ or f[0] < MIN_FREQ_HZ:
+            x = f[-1] if f[-1] > MAX_FREQ_HZ else f[0]
+            raise DataError(f"frequency {x:.3g} Hz is outside {MIN_FREQ_HZ:g}..{MAX_FREQ_HZ:g} Hz: a wrong unit or a "
+                            f"damaged file?")
         if not self.channels:
             raise DataError("FRFData needs at least one channel")
         chans = {}
@@ -68,7 +76,7 @@ class FRFData:
         object.__setattr__(self, "std", stds)
         object.__setattr__(self, "meta", dict(self.meta or {}))
         object.__setattr__(self, "coherence", cohs)
-        object.__setattr__(self, "estimator", dict(self.estimator or {}))
+        object.__setattr__(self, "estimator", validate_estimator(self.estimator, float(f[-1])))
         corr = {}
         for key, r in (self.correlation or {}).items():
             pair = key.split(",")
@@ -154,3 +162,17 @@ def _per_channel(what, given, chans, shape, valid, rule) -> dict:
             raise DataError(f"{what} of {name} {rule}")
         out[name] = s
     return out
+
+
+def require_data(value, name: str, *types):
+    """Raise a `TypeError` naming argument ``name`` unless ``value`` is one of ``types`` (default `FRFData`).
+
+    The public entry points call this first, so ``identify([1, 2, 3])`` says
+    what it wanted instead of failing deep inside with an AttributeError.
+    """
+    types = types or (FRFData,)
+    if not isinstance(value, types):
+        wanted = " or ".join(t.__name__ for t in types)
+        raise TypeError(f"{name} must be {wanted} (e.g. satmd.io.load_frf(path) or load_recording(path)), "
+                        f"got {type(value).__name__}")
+    return value

@@ -19,6 +19,7 @@ Other variables are ignored with a warning. ``.npz`` files are opened with
 from __future__ import annotations
 
 import io as _io
+import math
 import struct
 import zipfile
 import zlib
@@ -29,6 +30,7 @@ import numpy as np
 from ..errors import DataError, FormatError
 from ._common import read_bytes, short_error, warn
 from .atomic import atomic_write
+from .limits import MAX_BINARY_BYTES, check_samples, size_text
 from .frfdata import CHANNELS, FRFData
 
 RECORDING_NAMES = ("force", "acc1", "acc2")
@@ -44,6 +46,10 @@ def load_variables(path) -> dict:
             if not hasattr(z, "files"):
                 raise FormatError(path, "a single .npy array, not an .npz archive of named arrays")
             with z:
+                total = sum(info.file_size for info in z.zip.infolist())
+                if total > MAX_BINARY_BYTES:
+                    raise FormatError(path, f"the archive unpacks to {size_text(total)}: more than the "
+                                            f"{size_text(MAX_BINARY_BYTES)} satmd reads from one file")
                 return {k: np.asarray(z[k]) for k in z.files}
         except FormatError:
             raise
@@ -77,11 +83,12 @@ def read_mat5(path, raw: bytes) -> dict:
     order = {b"IM": "<", b"MI": ">"}.get(raw[126:128])
     if order is None:
         raise FormatError(path, "corrupt MATLAB header (no endian indicator)")
-    out, pos = {}, 128
+    out, pos, inflated = {}, 128, 0
     while pos < len(raw):
         etype, data, pos = _element(path, raw, pos, order)
         if etype == 15:  # miCOMPRESSED: zlib stream holding one or more elements
-            inner = _inflate(path, data)
+            inner = _inflate(path, data, _MAX_BYTES - inflated)
+            inflated += len(inner)
             ipos = 0
             while ipos < len(inner):
                 itype, idata, ipos = _element(path, inner, ipos, order)
@@ -112,14 +119,15 @@ def _element(path, buf, pos, order):
     return etype, buf[pos + 8:end], min(padded, len(buf))
 
 
-def _inflate(path, data) -> bytes:
+def _inflate(path, data, budget) -> bytes:
     z = zlib.decompressobj()
     try:
-        inner = z.decompress(data, _MAX_BYTES)
+        inner = z.decompress(data, max(budget, 1))
     except zlib.error as exc:
         raise FormatError(path, f"corrupt compressed MATLAB variable ({exc})") from None
-    if z.unconsumed_tail:
-        raise FormatError(path, "compressed MATLAB variable larger than 1 GiB")
+    if z.unconsumed_tail or budget <= 0:
+        raise FormatError(path, f"compressed MATLAB variables unpack to more than {size_text(_MAX_BYTES)}, "
+                                "the most satmd reads from one file")
     return inner
 
 
@@ -146,7 +154,7 @@ def _matrix(path, data, order, out):
         raise FormatError(path, f"corrupt MATLAB variable {name!r} (dimensions {dims})")
     if cls not in _NUMERIC_CLASSES and cls != _CHAR_CLASS:
         return  # cell, struct, object, sparse: nothing satmd reads
-    count = int(np.prod(dims, dtype=np.int64))
+    count = math.prod(dims)  # Python integers: dimensions whose product overflows int64 are refused below
 
     def values(k):
         if len(parts) <= k:
@@ -238,6 +246,7 @@ def read_recording_variables(path):
     if not signals:
         raise FormatError(path, f"no signal variable (any of {', '.join(RECORDING_NAMES)})")
     lengths = {n: s.size for n, s in signals.items()}
+    check_samples(path, max(lengths.values()), len(signals), path=path)
     if len(set(lengths.values())) > 1:
         raise FormatError(path, "signals have different lengths: " + ", ".join(f"{n} {k}" for n, k in lengths.items()))
     _warn_unused(path, v, set(signals) | {"fs_hz", "time_s", "meta"})

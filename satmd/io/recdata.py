@@ -16,9 +16,12 @@ import numpy as np
 from ..conventions import RECORDING_CHANNELS
 from ..errors import DataError, FormatError
 from ._common import warn
+from .limits import check_samples
 
 ROLES = ("force", "acc1", "acc2")
-MAX_ABS_SAMPLE = 1e100  # no sensor reads this; beyond it spectra overflow
+MAX_ABS_SAMPLE = 1e15  # no force (N) or acceleration (m/s²) reaches this; float32's 3.4e38 is a glitch
+GLITCH_RATIO = 1e6  # a sample this many times the channel's 99.9th percentile is a glitch, not a measurement
+MIN_RATE_HZ = 20.0  # a structural FRF needs a Nyquist frequency of at least 10 Hz
 SI_UNITS = {"force": "N", "acc1": "m/s^2", "acc2": "m/s^2"}
 MAP_ALIASES = {ch: name for name, ch in RECORDING_CHANNELS.items()}
 
@@ -67,6 +70,7 @@ class Recording:
             chans[name] = v
         if n < 2:
             raise DataError(f"a recording needs at least 2 samples, has {n}")
+        check_samples("recording", n, len(chans))
         object.__setattr__(self, "fs_hz", fs)
         object.__setattr__(self, "channels", chans)
         object.__setattr__(self, "units", {k: str(v) for k, v in (self.units or {}).items() if k in chans})
@@ -144,10 +148,25 @@ def clipped_channels(rec: Recording, extremes: dict | None = None) -> dict:
 
 
 def warn_clipping(path, rec, extremes=None):
-    """A `DataWarning` per channel that `clipped_channels` finds (every reader calls this)."""
+    """A `DataWarning` per channel that `clipped_channels` finds, or that holds a glitch (every reader calls this)."""
     for name, count in clipped_channels(rec, extremes).items():
         warn(path, f"channel {name} looks clipped: {count} samples sit at its extremes "
                    f"({100 * count / rec.n_samples:.2g} %); FRFs near those peaks are unreliable")
+    for name, v in rec.channels.items():
+        mag = np.abs(v)
+        typical = np.percentile(mag, 99.9) if mag.size >= 1000 else np.median(mag)
+        k = int(np.argmax(mag))
+        if mag[k] > GLITCH_RATIO * typical and typical > 0:
+            warn(path, f"channel {name}: sample {k} (t = {k / rec.fs_hz:g} s) is {v[k]:.3g}, {mag[k] / typical:.2g} "
+                       f"times the channel's typical level: a glitch? It dominates every spectrum of the record")
+
+
+def check_rate(path, fs_hz: float):
+    """Refuse (`FormatError`) a sample rate too slow for structural FRFs (time in ms read as s, a wrong step)."""
+    if fs_hz < MIN_RATE_HZ:
+        raise FormatError(path, f"sample rate {fs_hz:.4g} Hz (time step {1 / fs_hz:.4g} s) is below the "
+                                f"{MIN_RATE_HZ:g} Hz a structural FRF needs: is the time axis in milliseconds, "
+                                f"or the step wrong?")
 
 
 # --- time axes ------------------------------------------------------------------

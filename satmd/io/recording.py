@@ -28,9 +28,10 @@ from __future__ import annotations
 from pathlib import Path
 
 from ..errors import DataError, FormatError
-from ._common import decode_text, read_bytes
+from ._common import read_text, text_lines
+from .limits import MAX_BINARY_BYTES, check_file
 from .csvrec import CSV_MAGIC, read_recording_csv, write_recording_csv
-from .recdata import MAX_ABS_SAMPLE, ROLES, SI_UNITS, Recording, clipped_channels, warn_clipping
+from .recdata import MAX_ABS_SAMPLE, ROLES, SI_UNITS, Recording, check_rate, clipped_channels, warn_clipping
 from .uffrec import read_recording_uff, write_recording_uff
 from .wavrec import read_recording_wav, write_recording_wav
 
@@ -95,10 +96,7 @@ def load_recording(path, channel_map=None, scale=None) -> Recording:
         sampling, ...).
     """
     path = Path(path)
-    if not path.exists():
-        raise FormatError(path, "no such file")
-    if path.is_dir():
-        raise FormatError(path, "is a directory, not a file")
+    check_file(path, MAX_BINARY_BYTES)  # missing, a folder, a FIFO or a device: refused before any reader
     suffix = path.suffix.lower()
     reader = RECORDING_READERS.get(suffix)
     if reader is None:
@@ -113,7 +111,9 @@ def load_recording(path, channel_map=None, scale=None) -> Recording:
         if suffix != ".wav":
             raise FormatError(path, "scale applies to WAV files only (the others carry units)")
         options["scale"] = scale
-    return reader(path, **options)
+    rec = reader(path, **options)
+    check_rate(path, rec.fs_hz)
+    return rec
 
 
 def save_recording(rec: Recording, path) -> Path:
@@ -174,8 +174,8 @@ def is_recording(path) -> bool:
     if suffix == ".wav":
         return True
     if suffix == ".csv":
-        text = decode_text(path, read_bytes(path))
-        for line in text.splitlines():
+        text = read_text(path)
+        for line in text_lines(text):
             s = line.strip()
             if s and not s.startswith("#"):
                 return s.split(",")[0].strip() == "time_s"

@@ -13,16 +13,16 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import DataError, FormatError
-from ._common import decode_text, read_bytes, warn
+from ._common import read_text, text_lines, warn
 from .frfdata import CHANNELS, FRFData
 
 
 def read_values(path) -> np.ndarray:
     """The complex values, refusing anything else with file and line."""
     path = Path(path)
-    text = decode_text(path, read_bytes(path))
+    text = read_text(path)
     values = []
-    for lineno, line in enumerate(text.splitlines(), start=1):
+    for lineno, line in enumerate(text_lines(text), start=1):
         s = line.strip()
         if not s or s.startswith("#"):
             continue
@@ -44,9 +44,12 @@ def parse_freq_axis(spec):
         start, step = (spec.split(":") if isinstance(spec, str) else spec)
         start, step = float(start), float(step)
     except (ValueError, TypeError):
-        raise DataError(f"frequency axis {spec!r}: expected START:STEP in Hz, e.g. 0:1") from None
-    if not (math.isfinite(start) and math.isfinite(step) and step > 0):
-        raise DataError(f"frequency axis {spec!r}: STEP must be > 0")
+        raise DataError(f"freq_axis {spec!r}: expected START:STEP in Hz, e.g. 0:1") from None
+    for name, x in (("START", start), ("STEP", step)):
+        if not math.isfinite(x):
+            raise DataError(f"freq_axis {spec!r}: {name} {x} is not a finite number")
+    if not step > 0:
+        raise DataError(f"freq_axis {spec!r}: STEP must be > 0, got {step:g}")
     return start, step
 
 

@@ -61,7 +61,7 @@ def read_uff(path, channel_map=None) -> FRFData:
         found = ", ".join(kinds) if kinds else "no dataset 58"
         raise FormatError(path, f"no FRF records (UFF 58, function type 4); found: {found}")
     if all(r.tag for r in records):
-        return _read_tagged(path, records)
+        return _read_tagged(path, records, channel_map and _map_channels(path, frfs, channel_map))
     chosen = _map_channels(path, frfs, channel_map)
     freq = _common_axis(path, [rec for rec, _ in chosen.values()])
     keep, freq = _positive(path, freq)
@@ -80,8 +80,8 @@ def read_uff(path, channel_map=None) -> FRFData:
         raise FormatError(path, str(exc)) from None
 
 
-def _read_tagged(path, records) -> FRFData:
-    """A file written by `write_uff`: names come from the tags, values are SI already."""
+def _read_tagged(path, records, chosen=None) -> FRFData:
+    """A file written by `write_uff`: names come from the tags (or ``chosen``, a checked map), values are SI."""
     by_tag = {}
     for r in records:
         if r.tag in by_tag:
@@ -102,6 +102,11 @@ def _read_tagged(path, records) -> FRFData:
             std[name] = r.data.real.astype(float)
         else:
             coherence[name] = r.data.real.astype(float)
+    if chosen:  # a channel map renames the tagged FRF records; their std and coherence follow them
+        renamed = {ch: rec.tag for ch, (rec, _) in chosen.items()}
+        channels = {ch: channels[tag] for ch, tag in renamed.items()}
+        std = {ch: std[tag] for ch, tag in renamed.items() if tag in std}
+        coherence = {ch: coherence[tag] for ch, tag in renamed.items() if tag in coherence}
     meta = {"source": str(path), "format": "UFF 58 (satmd)"}
     try:
         return FRFData(freq, channels, std, meta, coherence=coherence)
@@ -139,6 +144,12 @@ def _map_channels(path, frfs, channel_map) -> dict:
     else:
         raise FormatError(path, f"{len(frfs)} FRF records ({listing}): say which are A1 and A2 with "
                                 f"channel_map a1=NODE:DIR,a2=NODE:DIR (or a1=#N,a2=#M)")
+    seen = {}
+    for ch, (rec, _) in chosen.items():
+        if rec.index in seen:
+            raise FormatError(path, f"channel_map: {seen[rec.index]} and {ch} both name dataset {rec.index}; "
+                                    "one record cannot be two channels")
+        seen[rec.index] = ch
     refs = {r.ref for r, _ in chosen.values()}
     if len(refs) > 1:
         warn(path, "the chosen FRF records have different reference DOFs "

@@ -104,6 +104,9 @@ def _uff_roles(path, times, channel_map) -> dict:
             if len(hits) != 1:
                 what = "no time record" if not hits else f"{len(hits)} time records"
                 raise FormatError(path, f"channel_map {role}: {what} match (records: {listing}); use {role}=#N")
+            if names[hits[0].index] in ROLES:
+                raise FormatError(path, f"channel_map: {names[hits[0].index]} and {role} both name dataset "
+                                        f"{hits[0].index}; one record cannot be two channels")
             names[hits[0].index] = role
         return names
     # no map: one force (or none) and exactly two accelerometers, in file order
