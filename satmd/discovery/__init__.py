@@ -28,7 +28,7 @@ from typing import Sequence
 from ..conventions import ACCEL_CHANNELS, DEFAULT_FREE
 from .._fleet import fleet_map
 from ..identification import identify
-from ..io.frfdata import FRFData
+from ..io.frfdata import FRFData, require_data
 from ..physics import Rig
 from .adequacy import after_search, assess_fit, inadequate_report, withdraw_if_inadequate
 from .candidates import default_candidates
@@ -78,6 +78,7 @@ def discover(
 
     from ..io.recording import Recording
 
+    require_data(data, "data", FRFData, Recording)
     if isinstance(data, Recording):
         from ..io.estimate import estimate_frf
 
@@ -115,6 +116,12 @@ def discover_many(datas: Sequence, executor=None, progress: bool = False, chunks
     list of DiscoveryReport
         In input order.
     """
+    from ..io.recording import Recording
+
+    datas = list(datas)
+    for i, d in enumerate(datas):
+        for j, part in enumerate(d if isinstance(d, (list, tuple)) else [d]):
+            require_data(part, f"datas[{i}]" + (f"[{j}]" if isinstance(d, (list, tuple)) else ""), FRFData, Recording)
     return fleet_map(partial(_discover_one, kwargs=kwargs), datas, executor, chunksize, progress, "discover",
                      "dataset")
 

@@ -11,7 +11,7 @@ from ..validation import Interval, Whole, validate_params
 from ..numerics import distinct_best
 from ..conventions import DEFAULT_FREE
 from ..errors import DataError
-from ..io.frfdata import FRFData
+from ..io.frfdata import FRFData, require_data
 from ..physics import Rig
 from ..physics.effects import Effect
 from .problem import SEARCH_RANGES, Problem
@@ -98,6 +98,7 @@ def identify(
         points than free parameters, non-physical magnitudes, ``reg < 0``,
         start values outside the bounds, invalid search settings.
     """
+    require_data(data, "data")
     t0 = time.perf_counter()
     n_search, n_refine = int(n_search), int(n_refine)
     max_nfev = None if max_nfev is None else int(max_nfev)

@@ -5,7 +5,7 @@ from functools import partial
 from typing import TYPE_CHECKING, Sequence
 
 from .._fleet import fleet_map
-from ..io.frfdata import FRFData
+from ..io.frfdata import FRFData, require_data
 from .fit import identify
 
 if TYPE_CHECKING:  # only for the annotation: concurrent.futures would cost start-up time
@@ -39,4 +39,7 @@ def identify_many(datas: Sequence[FRFData], executor: Executor | None = None, pr
     list of FitResult
         In input order.
     """
+    datas = list(datas)
+    for i, d in enumerate(datas):
+        require_data(d, f"datas[{i}]")
     return fleet_map(partial(_fit_one, kwargs=kwargs), datas, executor, chunksize, progress, "identify", "FRF")

@@ -243,3 +243,54 @@ def check_message(check: dict, R, L, rig: Rig | None) -> str | None:
             f"{check['residual_expected'][k]:.2g} that the model's accuracy and the noise explain; the data may come "
             f"from a rig unlike the training rig (m2 {float(rig.m2):g} kg, kp {float(rig.kp):g} N/m) or hold "
             f"effects the model lacks: do not trust R, L")
+
+
+MAX_STD_SCALE = 1e3  # a calibration factor beyond this: the ensemble had no spread of its own to calibrate
+
+
+def trust_check(out: dict, bounds: dict, std_scale) -> str | None:
+    """Keep every std finite and >= 0 and withdraw ``explained`` where the std says nothing; returns a note or None.
+
+    Parameters
+    ----------
+    out : dict
+        A prediction with arrays ``R_std``, ``L_std`` and (after `forward_check`)
+        ``explained``; updated in place.
+    bounds : dict
+        ``{"R": (lo, hi), "L": (lo, hi)}`` of the training box.
+    std_scale : array (2,)
+        The model's std calibration factors for R and L.
+
+    Returns
+    -------
+    str or None
+        Why some predictions are not to be trusted: a std that is not finite
+        (set to the box width), one as wide as the whole box, or a model whose
+        calibration factor exceeds `MAX_STD_SCALE` (badly trained: too few
+        members or epochs).
+    """
+    notes, distrust = [], None
+    for k, name in enumerate(("R", "L")):
+        span = float(bounds[name][1] - bounds[name][0])
+        s = np.asarray(out[f"{name}_std"], dtype=float)
+        bad = ~np.isfinite(s) | (s < 0)
+        if bad.any():
+            notes.append(f"{name}_std not finite: set to the box width {span:g}")
+            s = np.where(bad, span, s)
+        out[f"{name}_std"] = s
+        wide = bad | (s >= span)
+        if wide.any() and not bad.any():
+            notes.append(f"{name}_std {float(np.max(s)):.3g} spans the whole training box ({span:g})")
+        distrust = wide if distrust is None else distrust | wide
+    scale = float(np.max(np.asarray(std_scale, dtype=float)))
+    if scale > MAX_STD_SCALE:
+        notes.append(f"the model's std calibration factor is {scale:.3g}: its ensemble has no spread of its own "
+                     "(too few members or epochs), so its std means nothing; retrain it")
+        distrust = np.ones_like(distrust)
+    residual = np.asarray(out.get("residual", 0.0), dtype=float)
+    if not np.all(np.isfinite(residual)):
+        notes.append("the forward check is not finite (the model's rig cannot be computed)")
+        distrust = distrust | ~np.isfinite(residual)
+    if "explained" in out:
+        out["explained"] = np.asarray(out["explained"]) & ~distrust
+    return "; ".join(notes) + ": do not trust R, L" if notes else None

@@ -294,7 +294,7 @@ class InverseModel:
         import warnings
 
         from ..io import DataWarning
-        from .inputs import DEFAULT_RESIDUAL_REF, check_message, forward_check
+        from .inputs import DEFAULT_RESIDUAL_REF, check_message, forward_check, trust_check
 
         self._check_fitted()
         inputs = self._prepare(x)
@@ -305,6 +305,9 @@ class InverseModel:
             message = check_message(out, out["R"], out["L"], self.rig_or_default)
             if message:
                 warnings.warn(message, DataWarning, stacklevel=2)
+        message = trust_check(out, self.bounds, self.std_scale_)  # std finite, >= 0 and saying something
+        if message:
+            warnings.warn(message, DataWarning, stacklevel=2)
         return out
 
     def predict_one(self, x) -> dict:

@@ -12,7 +12,8 @@ import numpy as np
 from ..conventions import RECORDING_CHANNELS
 from ..errors import DataError
 from ._common import warn
-from .frfdata import FRFData
+from .frfdata import FRFData, require_data
+from .recdata import check_rate
 from .recording import Recording
 from .transmissibility import Transmissibility, model_transmissibility, save_transmissibility, transmissibility
 from .welch import (
@@ -60,6 +61,7 @@ def estimate_frf(recording: Recording, nperseg: int | None = None, window=None, 
         With ``std``, ``coherence`` and ``estimator`` (method, settings,
         ``noise_dof``, and ``measurement`` findings, see `satmd.io.chain`).
     """
+    require_data(recording, "recording", Recording)
     welch_given = any(v is not None for v in (nperseg, window, overlap))
     method = ("H1" if welch_given else "lpm") if estimator is None else str(estimator)
     if method.lower() == "lpm":
@@ -92,6 +94,11 @@ def _check_force(recording: Recording):
     responses = [r for r in RECORDING_CHANNELS if r in recording.channels]
     if not responses:
         raise DataError(f"{source}: no acc1 or acc2 channel (has {', '.join(recording.channels)})")
+    check_rate(source, recording.fs_hz)
+    for name in ("force", *responses):
+        if np.ptp(recording[name]) == 0:
+            raise DataError(f"{source}: channel {name} is constant ({recording[name][0]:g} throughout): "
+                            f"{'nothing excited the rig' if name == 'force' else 'the sensor recorded nothing'}")
     return source, responses
 
 

@@ -224,6 +224,9 @@ def lpm(recording, band=None, width_hz: float | None = None, degree: int = 2, sm
     LPMEstimate
     """
     from .chain import sharpest_resonance
+    from .recdata import check_rate
+
+    check_rate(recording.meta.get("source", "recording"), recording.fs_hz)  # entry check (time in ms, ...)
 
     fs, n = recording.fs_hz, recording.n_samples
     x = recording["force"]

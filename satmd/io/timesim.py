@@ -33,6 +33,7 @@ import numpy as np
 from ..conventions import ACCEL_CHANNELS, RECORDING_CHANNELS
 from ..errors import DataError
 from ..physics import Rig, frf
+from .limits import check_memory
 from .recording import Recording
 
 EXCITATIONS = ("random", "sweep", "multisine")
@@ -92,6 +93,8 @@ def simulate_recording(duration_s: float = 60.0, fs_hz: float = 1000.0, rig: Rig
         raise DataError(f"excitation must be one of {', '.join(EXCITATIONS)}, got {excitation!r}")
     n = int(round(duration_s * fs_hz))
     burn = int(round(burn_in_s * fs_hz))
+    check_memory(f"a recording of {duration_s:g} s (+ {burn_in_s:g} s burn-in) at {fs_hz:g} Hz",
+                 recording_memory(duration_s, fs_hz, burn_in_s), "lower the sample rate or the duration")
     if n + burn > MAX_SAMPLES:
         raise DataError(f"{duration_s:g} s (+ {burn_in_s:g} s burn-in) at {fs_hz:g} Hz is {n + burn} samples; "
                         f"the simulator takes at most {MAX_SAMPLES}")
@@ -127,6 +130,12 @@ def simulate_recording(duration_s: float = 60.0, fs_hz: float = 1000.0, rig: Rig
     for eff in effects:
         meta[f"effect {eff.name}"] = ", ".join(f"{k}={float(v):.12g}" for k, v in eff.params.items())
     return Recording(fs_hz, signals, {"force": "N", "acc1": "m/s^2", "acc2": "m/s^2"}, meta)
+
+
+def recording_memory(duration_s: float, fs_hz: float, burn_in_s: float = 0.0) -> float:
+    """Bytes `simulate_recording` needs (measured): the impulse response is found on a 120 s grid at
+    ``fs_hz`` (about 20 kB per Hz of sample rate), the force and its convolution take about 400 bytes a sample."""
+    return 2.0e4 * fs_hz + 400.0 * ((duration_s + burn_in_s) * fs_hz + fs_hz)
 
 
 def _random_force(n, fs_hz, lo, hi, rng) -> np.ndarray:
