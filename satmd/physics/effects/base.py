@@ -183,7 +183,9 @@ class Effect:
             if not np.all(np.isfinite(arr)):
                 raise DataError(f"effect {self.name}: {p} is not finite")
             if np.any(arr < lo) or np.any(arr > hi):
-                raise DataError(f"effect {self.name}: {p}={_fmt(v)} outside [{lo:g}, {hi:g}]")
+                bad = np.flatnonzero((arr.reshape(-1) < lo) | (arr.reshape(-1) > hi))
+                where = f" (element {bad[0]} of {arr.size})" if arr.size > 1 else ""
+                raise DataError(f"effect {self.name}: {p}={arr.reshape(-1)[bad[0]]:g}{where} outside [{lo:g}, {hi:g}]")
 
     def hard_bounds(self) -> dict:
         """Physically admissible range of each parameter."""
