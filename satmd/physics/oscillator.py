@@ -10,7 +10,9 @@ equation is integrated by classical RK4 at ``substeps`` steps per sample, vector
 trajectories at once (parameter sets × record segments), so a Jacobian by finite differences costs
 one pass. A long record is cut into segments simulated side by side, each started from rest
 ``warmup`` samples early: for a damped system the start is forgotten (fading memory), so this is
-the serial simulation to within exp(−ζω·warmup/fs) of the state.
+the serial simulation to within about exp(−ζω·warmup/fs) of the state. A strongly driven hardening
+oscillator may have coexisting responses (the jump of the Duffing curve) and settle on another one
+from rest: there, simulate serially (``warmup=None``).
 
 >>> import numpy as np
 >>> osc = PolynomialOscillator(k=(2 * np.pi * 10) ** 2, c=2 * 0.05 * 2 * np.pi * 10, k3=0.0)
