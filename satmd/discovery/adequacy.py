@@ -20,7 +20,8 @@ from __future__ import annotations
 
 import math
 
-from ..identification.adequacy import Adequacy, Reason, assess_fit, implausible_values
+from ..identification.adequacy import Adequacy, Reason, implausible_values
+from ..identification.adequacy import assess_fit as assess_one
 from ..identification.statistics import POOR_REL_ERROR
 
 __all__ = ["Adequacy", "Reason", "assess_fit", "after_search", "effects_at_edge", "inadequate_report",
@@ -28,6 +29,15 @@ __all__ = ["Adequacy", "Reason", "assess_fit", "after_search", "effects_at_edge"
 
 STRUCTURE_REL_ERROR = 0.15  # misfit left by the best vocabulary model beyond which it is another structure
 EDGE = 0.005  # share of a search range (log width for ranges over a decade) that counts as its edge
+
+
+def assess_fit(fit) -> Adequacy:
+    """The verdict of the nominal fit: `FitResult.adequacy`, with the readings that name a mistake."""
+    if fit.adequacy is not None:
+        return fit.adequacy
+    from ..identification import identify
+
+    return assess_one(fit, refit=identify)
 
 
 def effects_at_edge(effects, rig) -> list:

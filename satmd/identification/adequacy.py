@@ -26,9 +26,11 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..numerics import lag1_autocorrelation
-from .problem import SEARCH_RANGES
+from .problem import SEARCH_RANGES, Problem
 from .statistics import POOR_REL_ERROR
 
+SCREEN_REL_ERROR = 0.6  # a reading (or a channel subset) is refitted only when a coarse design comes this near
+SCREEN_POINTS, SCREEN_DESIGN_LOG2 = 256, 10  # the screen's frequencies and design size (2^10 rigs)
 SCALE_SLACK = 10.0  # a reading is fitted only when it brings the data within this factor of the model's size
 GOOD_REL_ERROR = 0.2  # an alternative reading must reproduce the data at least this well ...
 MUCH_BETTER = 0.3  # ... and cut the relative error to below this share of the data as given
@@ -114,7 +116,7 @@ class Adequacy:
         return Adequacy(False, self.reasons + reasons)
 
 
-def assess_fit(fit, readings: bool = True) -> Adequacy:
+def assess_fit(fit, readings: bool = True, refit=None) -> Adequacy:
     """The adequacy verdict of one fit (see the module docstring).
 
     Parameters
@@ -123,6 +125,8 @@ def assess_fit(fit, readings: bool = True) -> Adequacy:
         A fit of the SATMD model (with any effects) by `satmd.identify`.
     readings : when the fit fails, refit the data read as the usual mistakes would leave them,
         to name the mistake (a few extra global fits, only for a failed fit).
+    refit : the fitting function (`satmd.identify`, which hands itself in: no import cycle);
+        None: no readings.
 
     Returns
     -------
@@ -140,8 +144,8 @@ def assess_fit(fit, readings: bool = True) -> Adequacy:
                               {"rel_error": rel, "chi2_reduced": float(fit.chi2_reduced)}))
     if not reasons:
         return Adequacy(True)
-    if readings:
-        reasons = _explain_failure(fit, rel) + reasons
+    if readings and refit is not None:
+        reasons = _explain_failure(fit, rel, refit) + reasons
     return Adequacy(False, tuple(reasons))
 
 
@@ -158,9 +162,7 @@ def implausible_values(fit) -> dict:
     return out
 
 
-def _refit(fit, data, channels=None):
-    from .fit import identify
-
+def _refit(identify, fit, data, channels=None):
     p = fit._problem  # noqa: SLF001 - same package: the fitted problem's rig, free names and effects
     chans = tuple(channels or p.channels)
     try:
@@ -169,7 +171,7 @@ def _refit(fit, data, channels=None):
         return None
 
 
-def _explain_failure(fit, rel) -> list:
+def _explain_failure(fit, rel, identify) -> list:
     """Readings of the data that the model fits far better, and channel / noise evidence."""
     data = fit.data.select(fit.channels)
     out = []
@@ -193,7 +195,9 @@ def _explain_failure(fit, rel) -> list:
         size = np.median(np.concatenate([np.abs(data_alt[c]) for c in data_alt.names]))
         if not typical / SCALE_SLACK < size < typical * SCALE_SLACK:
             continue  # read so the data are still nowhere near the model's size: no need to fit
-        alt = _refit(fit, data_alt)
+        if _design_rel(fit, data_alt) > SCREEN_REL_ERROR:
+            continue  # no point of a coarse design over the plausible rigs comes near: not this reading
+        alt = _refit(identify, fit, data_alt)
         if alt is not None and alt.rel_error < GOOD_REL_ERROR and alt.rel_error < MUCH_BETTER * rel:
             out.append(Reason(kind, f"the data look like {label}: read so, the SATMD model fits them with relative "
                                     f"error {alt.rel_error:.3g} instead of {rel:.3g} ({fix})",
@@ -203,7 +207,9 @@ def _explain_failure(fit, rel) -> list:
     if len(names) > 1:
         for c in names:
             rest = [n for n in names if n != c]
-            alt = _refit(fit, data.select(rest), rest)
+            if _design_rel(fit, data.select(rest), rest) > SCREEN_REL_ERROR:
+                continue
+            alt = _refit(identify, fit, data.select(rest), rest)
             if alt is not None and alt.rel_error < GOOD_REL_ERROR:
                 out.append(Reason("channel", f"without channel {c} the SATMD model fits the rest (relative error "
                                              f"{alt.rel_error:.3g} instead of {rel:.3g}): {c} is not what the "
@@ -211,6 +217,30 @@ def _explain_failure(fit, rel) -> list:
                                   {"channel": c, "rel_error_without": float(alt.rel_error)}))
                 return out
     return out
+
+
+def _design_rel(fit, data, channels=None) -> float:
+    """Smallest relative error over a coarse Sobol design of the plausible rigs (one batched model call):
+    a cheap screen before a full refit."""
+    from scipy.stats import qmc
+
+    p = fit._problem  # noqa: SLF001 - same package
+    try:
+        prob = Problem(data, p.rig, p.names, tuple(channels or p.channels), p.effects).thinned(SCREEN_POINTS)
+    except Exception:  # data this reading cannot even pose as a problem
+        return np.inf
+    idx = [i for i, n in enumerate(prob.names) if n in SEARCH_RANGES]
+    base = prob.values()
+    if not idx:
+        thetas = base[None, :]
+    else:
+        lo = np.log([SEARCH_RANGES[prob.names[i]][0] for i in idx])
+        hi = np.log([SEARCH_RANGES[prob.names[i]][1] for i in idx])
+        u = qmc.Sobol(len(idx), scramble=True, seed=0).random_base2(SCREEN_DESIGN_LOG2)
+        thetas = np.repeat(base[None, :], u.shape[0], axis=0)
+        thetas[:, idx] = np.exp(lo + u * (hi - lo))
+    power = float(np.sum(np.abs(prob.target / prob.sigma) ** 2))
+    return float(np.sqrt(np.nanmin(prob.batch_cost(thetas)) / power)) if power > 0 else np.inf
 
 
 def _typical_magnitude(fit, data) -> float:

@@ -2,6 +2,8 @@
 from __future__ import annotations
 
 import time
+from dataclasses import replace
+from functools import partial
 from numbers import Real
 from typing import Sequence
 
@@ -14,6 +16,7 @@ from ..errors import DataError
 from ..io.frfdata import FRFData, require_data
 from ..physics import Rig
 from ..physics.effects import Effect
+from .adequacy import assess_fit
 from .problem import SEARCH_RANGES, Problem
 from .result import FitResult
 from .statistics import build_result, emit_warnings
@@ -127,6 +130,7 @@ def identify(
         nfev += best.nfev
     theta = problem.values_from_x(best.x, nominal)
     result = build_result(problem, theta, nominal, nfev, time.perf_counter() - t0, best, reg)
+    result = replace(result, _assessor=partial(assess_fit, refit=identify))  # FitResult.adequacy, on first use
     if warn:
         emit_warnings(result)
     return result

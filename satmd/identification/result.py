@@ -63,6 +63,7 @@ class FitResult:
     reg: float = 0.0
     pinned: tuple = ()
     _problem: object = field(default=None, repr=False, compare=False)
+    _assessor: object = field(default=None, repr=False, compare=False)  # fit -> Adequacy (set by identify)
 
     # --- derived views -----------------------------------------------------
     @property
@@ -102,16 +103,15 @@ class FitResult:
 
     @cached_property
     def adequacy(self):
-        """Whether the SATMD model can describe these data at all (`satmd.identification.adequacy`);
+        """Whether the SATMD model can describe these data at all (an `Adequacy` of
+        `satmd.identification.adequacy`, set up by `identify`; None for a result made otherwise);
         computed on first use (a failed fit is refitted under the usual reading mistakes to name one)."""
-        from .adequacy import assess_fit
-
-        return assess_fit(self)
+        return None if self._assessor is None else self._assessor(self)
 
     @property
     def model_adequate(self) -> bool:
         """``adequacy.adequate``: False when the model cannot describe the data (see `adequacy`)."""
-        return self.adequacy.adequate
+        return self.adequacy is None or self.adequacy.adequate
 
     # --- public views of the fitted problem (callers never reach into _problem) ---
     @property
@@ -176,7 +176,7 @@ class FitResult:
             "covariance": "jacobian" if self.weighted else "sandwich (HC3), Student-t intervals",
             "condition_number": num(self.condition_number, "condition_number", "singular Jacobian"),
             "warnings": list(self.warnings),
-            **self.adequacy.to_dict(),
+            **(self.adequacy.to_dict() if self.adequacy is not None else {}),
             "nfev": self.nfev,
             "wall_time_s": self.wall_time,
             "success": self.success,
@@ -189,7 +189,7 @@ class FitResult:
     def report(self) -> str:
         """Plain-text fit report (in the spirit of lmfit's fit_report; formatted by `fit_report`)."""
         text = fit_report(self)
-        return text if self.adequacy.adequate else text + "\n" + self.adequacy.report()
+        return text if self.model_adequate else text + "\n" + self.adequacy.report()
 
     def __str__(self):
         return self.report()

@@ -14,6 +14,29 @@ def _row(label, truth, rep):
             f"{rep.fit_after['chi2_reduced']:.3g} | {rep.fit_before['rel_error']:.3g} | {rep.wall_time:.2f} s |")
 
 
+def _inadequate_rows(grid) -> list:
+    """Data the SATMD model cannot describe: the verdict (SPEC §9 ``model_adequate``) instead of physics."""
+    from ..discovery import discover
+    from ..io.frfdata import FRFData
+    from ..physics import Rig
+    from ..simulation import simulate
+
+    d = simulate(grid, Rig(m2=0.52, kp=1.0e5, R=25.0, L=0.12), noise=(0.01, 0.002), seed=13)
+    rng = np.random.default_rng(13)
+    cases = [("conjugated (e^{-iωt} convention)", {c: np.conj(d[c]) for c in d.names}),
+             ("accelerations in g", {c: d[c] / 9.80665 for c in d.names}),
+             ("white noise", {c: rng.standard_normal(grid.size) + 1j * rng.standard_normal(grid.size)
+                              for c in d.names})]
+    lines = ["", "Data the SATMD model cannot describe get a verdict and its evidence, never physics "
+                 "(`model_adequate`, SPEC §9):", "", "| data | model adequate | effects | why |", "|---|---|---|---|"]
+    for label, chans in cases:
+        rep = discover(FRFData(grid, chans))
+        why = rep.adequacy.summary if rep.adequacy is not None else ""
+        lines.append(f"| {label} | {'yes' if rep.model_adequate else 'no'} | "
+                     f"{', '.join(rep.effect_names) or 'none'} | {why} |")
+    return lines
+
+
 def build(ctx) -> str:
     from ..discovery import discover
     from ..discovery.scenarios import concealed_case
@@ -48,6 +71,7 @@ def build(ctx) -> str:
     lines.append(_row("two effects", ", ".join(repr(e) for e in pair), rep2))
     null = discover(concealed_case(3, n_effects=0).data)
     lines.append(_row("null data", "nothing", null))
+    lines += _inadequate_rows(grid)
     lines += ["", "Plain-language report for the two-effect case:", "", "```", rep2.report(), "```", "",
               ctx.figure(rep2.figure(), "discover_two_effects.png"), ""]
 
