@@ -49,11 +49,13 @@ def _recording(force, a1, a2, noise, colour, rng):
     return Recording(FS, chans, {"force": "N", "acc1": "m/s^2", "acc2": "m/s^2"})
 
 
-def _verdict(recs):
+def _verdict(recs, tests=None):
     from satmd.discovery.nonlinear_findings import analyse_recordings
 
     rep = analyse_recordings(recs)
     name = rep.findings[0]["name"] if rep.findings else None
+    if tests is not None:
+        tests.extend((t.name, float(t.p_value)) for t in rep.tests)
     return bool(rep.detected), name
 
 
@@ -83,9 +85,11 @@ def nulls(n, seed):
             noise = float(rng.uniform(0.01, 0.04))
             hi_rec = _recording(forces[2 * j], a1[2 * j], a2[2 * j], noise, colour, rng)
             lo_rec = _recording(forces[2 * j + 1], a1[2 * j + 1], a2[2 * j + 1], noise, colour, rng)
-            case = {"sim": "independent", "T": int(T), "shape": shape, "colour": colour, "noise": noise}
-            out["single"].append(case | {"flagged": _verdict([hi_rec])[0]})
-            out["pair"].append(case | {"flagged": _verdict([lo_rec, hi_rec])[0]})
+            case = {"sim": "independent", "T": int(T), "shape": shape, "colour": colour, "noise": noise, "band": [lo, hi]}
+            t1, t2 = [], []
+            out["single"].append(case | {"flagged": _verdict([hi_rec], t1)[0], "tests": t1})
+            out["pair"].append(case | {"flagged": _verdict([lo_rec, hi_rec], t2)[0], "tests": t2})
+            _show(out)
     # satmd's simulator (linear): its own force and white noise, then extra coloured noise
     for k in range(n - half):
         T = float(rng.choice([10, 20, 30]))
@@ -97,10 +101,20 @@ def nulls(n, seed):
             r = simulate(time=True, level=level, duration_s=T, fs_hz=FS, band_hz=band, noise=0.0,
                          seed=int(rng.integers(1 << 30)))
             recs.append(_recording(r["force"], r["acc1"], r["acc2"], noise, colour, rng))
-        case = {"sim": "satmd", "T": T, "colour": colour, "noise": noise}
-        out["single"].append(case | {"flagged": _verdict([recs[1]])[0]})
-        out["pair"].append(case | {"flagged": _verdict(recs)[0]})
+        case = {"sim": "satmd", "T": T, "colour": colour, "noise": noise, "band": list(band)}
+        t1, t2 = [], []
+        out["single"].append(case | {"flagged": _verdict([recs[1]], t1)[0], "tests": t1})
+        out["pair"].append(case | {"flagged": _verdict(recs, t2)[0], "tests": t2})
+        _show(out)
     return out
+
+
+def _show(out):
+    """Print a flagged null as it happens (the false alarms are what one wants to read)."""
+    for kind in ("single", "pair"):
+        c = out[kind][-1]
+        if c["flagged"]:
+            print(f"  null flagged ({kind}): {json.dumps(c)}", flush=True)
 
 
 # --- 2. elements -------------------------------------------------------------------------------------------

@@ -11,6 +11,9 @@ def register(sub):
                        description="Fit the nominal model, test the mismatch against the noise, and explain it "
                                    "with the missing-physics vocabulary (SPEC §8); report as SPEC §9.")
     add_data_options(p)
+    p.add_argument("more", nargs="*", metavar="DATA2",
+                   help="more recordings (or FRF files with std) of the same rig, at other levels or repeated: "
+                        "judged together, with a level-dependence test and the nonlinear block (SPEC §9)")
     add_model_options(p, "parameters fitted in every model (default m2,kp,R,L)")
     p.add_argument("--candidates", default=None, help="comma-separated effect names (default: all)")
     p.add_argument("--alpha", type=real(0, 1, lo_open=True, hi_open=True), default=1e-3,
@@ -24,11 +27,16 @@ def register(sub):
 def run(args):
     from ..discovery import discover
 
-    data = load_data(args)
     free = parse_list(args.free) or DEFAULT_FREE
     candidates = parse_names(args.candidates, registered_names(), "--candidates") if args.candidates else None
     channels = parse_list(args.channels)
-    rep = discover(data, free=free, candidates=candidates, channels=channels, alpha=args.alpha)
+    if args.more:  # several recordings of one rig (issue 26)
+        items = [_load_one(args, path) for path in (args.data, *args.more)]
+        rep = discover(items, free=free, candidates=candidates, channels=channels, alpha=args.alpha)
+    else:
+        data = load_data(args)
+        rep = discover(data, free=free, candidates=candidates, channels=channels, alpha=args.alpha)
+        rep = _check_linearity(args, rep, free)
     if args.plot:
         rep.plot(args.plot)
     if args.json:
@@ -36,3 +44,25 @@ def run(args):
     else:
         print(rep.report())
     return 0
+
+
+def _load_one(args, path):
+    """One of several DATA: a Recording as it is (the FRFs are estimated together), or FRFs in --band."""
+    from ..io import is_recording, load_frf, load_recording
+    from ._common import parse_band
+
+    if is_recording(path):
+        return load_recording(path, channel_map=getattr(args, "map", None))
+    lo, hi = parse_band(getattr(args, "band", None))
+    data = load_frf(path)
+    return data.band(lo, hi) if (lo is not None or hi is not None) else data
+
+
+def _check_linearity(args, rep, free):
+    """A single time recording is also tested for nonlinear distortion (the FRF path estimated it already)."""
+    from ..discovery.nonlinear_discover import check_one
+    from ..io import is_recording, load_recording
+
+    if not is_recording(args.data):
+        return rep
+    return check_one(rep, load_recording(args.data, channel_map=getattr(args, "map", None)), args.alpha, None, free)

@@ -110,8 +110,8 @@ def distortion_test(recording, band=None, alpha: float = 1e-3) -> NonlinearTest:
     accs = [c for c in ("acc1", "acc2") if c in recording.channels]
     if accs:
         responses = {ch: recording[c] for c, ch in zip(("acc1", "acc2"), ACCEL_CHANNELS) if c in recording.channels}
-        a1 = recording["acc1"] if "acc1" in recording.channels else None
-        a2 = recording["acc2"] if "acc2" in recording.channels else None
+        predicted = linear_prediction(recording, band)
+        a1, a2 = predicted.get(ACCEL_CHANNELS[0]), predicted.get(ACCEL_CHANNELS[1])
         signals, shapes = {}, {}
         if a1 is not None:
             signals["u1"], shapes["u1"] = integrate(a1, fs, 2, band), ("cube",)
@@ -126,6 +126,95 @@ def distortion_test(recording, band=None, alpha: float = 1e-3) -> NonlinearTest:
         shapes = {"y": ("square", "cube"), "dy": ("cube", "absv")}
     regs = distortion_regressors(signals, shapes)
     return linearity_test(x, responses, fs, regs, band=band, alpha=alpha)
+
+
+def is_multisine(recording) -> bool:
+    """True for a periodic multisine recording that says its layout (``period_samples``, ``lines`` in meta)."""
+    meta = getattr(recording, "meta", {}) or {}
+    return "period_samples" in meta and "lines" in meta
+
+
+def multisine_arrays(recording):
+    """(u, {channel: y}, lines): (M, P, N) steady-state periods of a multisine recording (transient dropped)."""
+    meta = recording.meta
+    n = int(meta["period_samples"])
+    per = int(meta.get("periods", recording.n_samples // n))
+    m = int(meta.get("realisations", 1))
+    skip = int(meta.get("transient_periods", 1 if per > 1 else 0))
+    lines = np.array([int(k) for k in str(meta["lines"]).split(",") if k.strip()])
+
+    def shape(x):
+        return np.asarray(x, float)[: m * per * n].reshape(m, per, n)[:, skip:]
+
+    outs = {ch: shape(recording[c]) for c, ch in zip(("acc1", "acc2"), ACCEL_CHANNELS) if c in recording.channels}
+    if not outs:
+        outs = {c: shape(recording[c]) for c in recording.channels if c != "force"}
+    return shape(recording["force"]), outs, lines
+
+
+def multisine_test(recording, alpha: float = 1e-3) -> NonlinearTest:
+    """Detection-line test of a multisine recording, every output channel (Bonferroni over them).
+
+    Parameters
+    ----------
+    recording : Recording with multisine meta (see `is_multisine`)
+    alpha : level
+
+    Returns
+    -------
+    NonlinearTest
+        ``distortion_lines``; ``details`` per channel with the odd and even ratios.
+    """
+    from .nonlinear_periodic import detection_lines_test
+
+    u, outs, lines = multisine_arrays(recording)
+    hi = lines.max() * recording.fs_hz / u.shape[-1]
+    tests = {c: detection_lines_test(u, y, lines, recording.fs_hz, band=(0.0, 1.5 * hi), alpha=alpha / len(outs))
+             for c, y in outs.items()}
+    worst = min(tests.values(), key=lambda t: t.p_value)
+    p = min(1.0, worst.p_value * len(tests))
+    details = {c: t.details for c, t in tests.items()} | {"explained": {}}
+    return NonlinearTest("distortion_lines", p, worst.bands_hz, alpha, details)
+
+
+def multisine_frf(recording):
+    """FRFData: the best linear approximation of a multisine recording, std from noise + distortion."""
+    from ..io.frfdata import FRFData
+    from .nonlinear_periodic import multisine_bla
+
+    u, outs, lines = multisine_arrays(recording)
+    chans, std, info = {}, {}, {}
+    for c, y in outs.items():
+        b = multisine_bla(u, y, lines, recording.fs_hz)
+        chans[c], std[c] = b["bla"], b["std"]
+        info[f"var_nl/var_total {c}"] = float(np.nanmedian(b["var_nl"] / np.maximum(b["var_total"], 1e-300)))
+    meta = {"estimator": "multisine_bla", "realisations": str(u.shape[0]), "periods": str(u.shape[1])}
+    meta.update({k: f"{v:.3g}" for k, v in info.items()})
+    if "force_rms" in recording.meta:
+        meta["force_rms"] = recording.meta["force_rms"]
+    return FRFData(b["freq_hz"], chans, std, meta)
+
+
+def linear_prediction(recording, band) -> dict:
+    """The accelerations the best linear approximation predicts from the force alone (LPM FRF x force spectrum).
+
+    Regressors built from these, not from the measured responses, hold no response noise: the
+    distortion test's residual (which is that noise under the null) is then independent of them.
+    """
+    from ..io.lpm import lpm
+
+    est = lpm(recording, band=band)
+    n, fs = recording.n_samples, recording.fs_hz
+    x = recording["force"]
+    X = np.fft.rfft(x - x.mean())
+    f = np.fft.rfftfreq(n, 1.0 / fs)
+    keep = (f >= est.freq_hz[0]) & (f <= est.freq_hz[-1])
+    out = {}
+    for ch, h in est.frf.items():
+        H = np.zeros(f.size, complex)
+        H[keep] = np.interp(f[keep], est.freq_hz, h.real) + 1j * np.interp(f[keep], est.freq_hz, h.imag)
+        out[ch] = np.fft.irfft(H * X, n)
+    return out
 
 
 def strongest_regressor(test: NonlinearTest) -> str | None:
@@ -149,12 +238,38 @@ def common_frfs(recordings) -> list:
     from ..io.estimate import estimate_frf
     from ..io.lpm import excited_band
 
+    if all(is_multisine(r) for r in recordings):
+        return [multisine_frf(r) for r in recordings]
     bands = [excited_band(r["force"], r.fs_hz)[:2] for r in recordings]
     band = (max(b[0] for b in bands), min(b[1] for b in bands))
     first = estimate_frf(recordings[0], band=band)
     width = first.estimator.get("window_hz") or first.estimator.get("settings", {}).get("window_hz")
     out = [estimate_frf(r, band=band, width_hz=width) for r in recordings]
-    return out
+    return [_with_model_error(d, r, band, width) for d, r in zip(out, recordings)]
+
+
+def _with_model_error(data, recording, band, width):
+    """Attach the local-polynomial model error (degree 2 vs 3 on the same windows) as ``meta['model_error']``."""
+    from dataclasses import replace
+
+    from ..io.lpm import lpm
+
+    try:
+        e2 = lpm(recording, band=band, width_hz=width, degree=2)
+        e3 = lpm(recording, band=band, width_hz=width, degree=3)
+    except Exception:  # noqa: BLE001 - too few bins for degree 3: no model-error estimate
+        return data
+    if e2.freq_hz.shape != e3.freq_hz.shape or not np.allclose(e2.freq_hz, e3.freq_hz):
+        return data
+    # the difference is bias + noise (nested fits: its noise variance is var3 - var2); keep what stands out
+    err = {c: np.maximum(np.abs(e2.frf[c] - e3.frf[c])
+                         - 3.0 * np.sqrt(2.0 * np.maximum(e3.std[c] ** 2 - e2.std[c] ** 2, 0.0)), 0.0) for c in e2.frf}
+    j = np.searchsorted(e2.freq_hz, data.freq_hz)
+    ok = bool(np.all(j < e2.freq_hz.size)) and np.allclose(e2.freq_hz[np.clip(j, 0, e2.freq_hz.size - 1)],
+                                                           data.freq_hz)
+    if not ok:
+        return data
+    return replace(data, meta=dict(data.meta, model_error={c: v[j] for c, v in err.items()}))
 
 
 def on_common_grid(datas):
@@ -177,7 +292,10 @@ def _take(d, freqs):
     from dataclasses import replace
 
     j = np.searchsorted(d.freq_hz, freqs)
-    return replace(d, freq_hz=d.freq_hz[j], channels={c: v[j] for c, v in d.channels.items()},
+    meta = dict(d.meta)
+    if isinstance(meta.get("model_error"), dict):
+        meta["model_error"] = {c: v[j] for c, v in meta["model_error"].items()}
+    return replace(d, freq_hz=d.freq_hz[j], meta=meta, channels={c: v[j] for c, v in d.channels.items()},
                    std={c: v[j] for c, v in d.std.items()}, coherence={c: v[j] for c, v in d.coherence.items()},
                    correlation={k: v[j] for k, v in d.correlation.items()})
 

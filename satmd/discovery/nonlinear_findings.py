@@ -18,6 +18,8 @@ from .nonlinear import (
     common_frfs,
     concentrated_bands,
     distortion_test,
+    is_multisine,
+    multisine_test,
     on_common_grid,
 )
 from .nonlinear_stats import NonlinearTest, level_dependence
@@ -37,20 +39,21 @@ def _distortion_tests(recordings, alpha):
     k = len(recordings)
     tests = []
     for i, r in enumerate(recordings):
-        t = distortion_test(r, alpha=alpha / k)
-        name = "distortion" if k == 1 else f"distortion#{i + 1}"
+        t = multisine_test(r, alpha / k) if is_multisine(r) else distortion_test(r, alpha=alpha / k)
+        name = t.name if k == 1 else f"{t.name}#{i + 1}"
         p = min(1.0, t.p_value)
         tests.append(NonlinearTest(name, p, concentrated_bands(t), alpha / k, t.details))
     return tests
 
 
 def _hint(test: NonlinearTest) -> str:
-    """Which regressor group carries the distortion, in words."""
-    scores = {}
-    for name in test.details.get("regressors", []):
-        scores.setdefault(name.split(":")[0], 0)
-    expl = test.details.get("explained", {})
+    """Where the distortion is and what carries it, in words."""
     where = ", ".join(f"{a:.1f}–{b:.1f} Hz" for a, b in test.bands_hz) or "the band"
+    ratios = [(c, d) for c, d in test.details.items() if isinstance(d, dict) and "odd_ratio" in d]
+    if ratios:
+        parts = ", ".join(f"{c}: odd {d['odd_ratio']:.3g}x, even {d['even_ratio']:.3g}x the noise" for c, d in ratios)
+        return f"distortion at {where}; at the detection lines {parts} (odd: a symmetric nonlinearity)"
+    expl = test.details.get("explained", {})
     chans = ", ".join(f"{c} {100 * v:.0f} %" for c, v in expl.items())
     return f"distortion at {where}; nonlinear functions of the responses explain {chans} of the local residual"
 
@@ -84,7 +87,8 @@ def analyse_recordings(recordings, rig=None, free=DEFAULT_FREE, alpha: float = 1
         grid = on_common_grid(datas)
         if grid is not None:
             freq, datas = grid
-            lt = level_dependence(freq, [d.channels for d in datas], [d.std for d in datas], alpha / 2)
+            lt = level_dependence(freq, [d.channels for d in datas], [d.std for d in datas], alpha / 2,
+                                  model_errors=[d.meta.get("model_error") for d in datas])
             level_test = NonlinearTest(lt.name, lt.p_value, concentrated_bands(lt), lt.alpha, lt.details)
             tests.append(level_test)
     detected = any(t.significant for t in tests)

@@ -214,31 +214,36 @@ def fit_strength(cls, values, stds, rigs, forces, fs_hz):
     if cls.strength == "Fc":  # v0 well below the slowest level's velocity: Coulomb-like, as a rub is
         extra["v0"] = 0.05 * min(float(r["v"]) for r in rms)
     base_rig = rigs[0]
+    positive = cls.strength != "k3"  # k3 takes either sign; Fc, c2, isat are fitted on a log scale
+
+    def strength(raw):
+        return float(np.exp(raw)) if positive else float(raw)
 
     def model(theta):
-        nominal, s = theta[0], theta[1]
-        rig0 = base_rig.replace(**{p: nominal})
-        el = cls(**{cls.strength: s}, **extra)
+        rig0 = base_rig.replace(**{p: theta[0]})
+        el = cls(**{cls.strength: strength(theta[1])}, **extra)
         return np.array([float(el.equivalent_value(rig0, r)) for r in rms])
 
     best = None
+    nominal0 = float(values.min() if p != "L" else values.max())
     for s0 in _strength_starts(cls, rms, values):
-        sol = least_squares(lambda t: (model(t) - values) / stds, [float(values.min() if p != "L" else values.max()), s0],
-                            x_scale="jac", max_nfev=200)
+        raw0 = np.log(max(s0, 1e-300)) if positive else s0
+        lo_b = [1e-6 * abs(nominal0), np.log(1e-10) if positive else -np.inf]
+        hi_b = [1e3 * abs(nominal0), np.log(1e10) if positive else np.inf]
+        raw0 = float(np.clip(raw0, lo_b[1] + 1, hi_b[1] - 1))
+        sol = least_squares(lambda t: (model(t) - values) / stds, [nominal0, raw0], bounds=(lo_b, hi_b),
+                            x_scale="jac", max_nfev=400)
         if best is None or sol.cost < best.cost:
             best = sol
     try:
-        cov = np.linalg.inv(best.jac.T @ best.jac)
-        sd = float(np.sqrt(max(cov[1, 1], 0.0)))
+        sd = float(np.sqrt(max(np.linalg.inv(best.jac.T @ best.jac)[1, 1], 0.0)))
     except np.linalg.LinAlgError:
         sd = float("nan")
-    s = float(best.x[1])
-    el = cls(**{cls.strength: s}, **extra)
-    lo, hi = s - 1.96 * sd, s + 1.96 * sd
-    if cls.strength == "isat":
-        lo = max(lo, 0.0)
+    raw = float(best.x[1])
+    el = cls(**{cls.strength: strength(raw)}, **extra)
+    ci = [strength(raw - 1.96 * sd), strength(raw + 1.96 * sd)]
     sig = cls.reads[0]
-    return el, {cls.strength: [lo, hi]}, float(best.x[0]), [float(r[sig]) for r in rms]
+    return el, {cls.strength: ci}, float(best.x[0]), [float(r[sig]) for r in rms]
 
 
 def _strength_starts(cls, rms, values):
@@ -252,4 +257,4 @@ def _strength_starts(cls, rms, values):
         return [max(dv / (np.sqrt(8 / np.pi) * max(r.max() - r.min(), 1e-300)), 1e-6)]
     if cls.strength == "Fc":
         return [max(-dv / (np.sqrt(2 / np.pi) * max(1 / r.min() - 1 / r.max(), 1e-300)), 1e-6)]
-    return [r.max() * f for f in (1.0, 2.0, 4.0, 10.0)]
+    return [r.max() * f for f in (1.0, 2.0, 4.0, 10.0, 30.0)]

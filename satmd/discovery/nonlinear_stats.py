@@ -152,7 +152,7 @@ def linearity_test(force, responses: dict, fs_hz: float, regressors: dict, band=
     fs_hz : sample rate
     regressors : {name: (n,) samples} nonlinear regressors (e.g. `hermite_regressors` of the responses)
     band : (lo, hi) Hz analysed (default: where the force has power)
-    window_bins : bins per local window (default: enough for 8 noise dof above the parameters, ≥ 0.4 Hz)
+    window_bins : bins per local window (default: twice the local parameters, + 1)
     degree : polynomial degree of H and of the transient in each window
     alpha : level
 
@@ -172,7 +172,7 @@ def linearity_test(force, responses: dict, fs_hz: float, regressors: dict, band=
     lo, hi = band if band is not None else _power_band(X, df)
     nz = 0 if Z is None else Z.shape[1]
     p_h = 2 * (degree + 1)
-    width = max(window_bins, p_h + nz + 9, int(np.ceil(0.4 / df)) | 1)
+    width = max(window_bins, 2 * (p_h + nz) + 1)
     width += 1 - width % 2
     half = width // 2
     first, last = int(np.ceil(lo / df)), int(np.floor(hi / df))
@@ -239,8 +239,11 @@ def integrate(signal, fs_hz, times: int, band):
 
 
 # --- several records: level dependence -------------------------------------------------------------------
+REL_FLOOR = 0.001  # relative error an FRF estimate carries beyond its noise std (local-polynomial model error)
+
+
 def level_dependence(freq, frfs: list, stds: list, alpha: float = 1e-3, name: str = "level_dependence",
-                     dof_noise: float | None = None) -> NonlinearTest:
+                     dof_noise: float | None = None, rel_floor: float = REL_FLOOR, model_errors=None) -> NonlinearTest:
     """Do several FRF estimates on one grid differ beyond their noise? (see the module docstring)
 
     Parameters
@@ -251,6 +254,17 @@ def level_dependence(freq, frfs: list, stds: list, alpha: float = 1e-3, name: st
     alpha : level
     name : test name in the report
     dof_noise : degrees of freedom behind the stds (None: known)
+    rel_floor : relative error added to each std (estimator model error: ``rel_floor |H|``)
+    model_errors : optional list over records of {channel: (M,) estimated model error of the estimate}
+        (e.g. local polynomial degree 2 vs 3), added to the std in quadrature
+
+    Notes
+    -----
+    Two guards keep the level on real estimates: the stds are inflated by
+    the median per-point score over its null median (at most ×2: a std
+    estimate that is a few per cent low over hundreds of points would
+    otherwise reject), and the band scan starts at 3 neighbouring points (a
+    single point at the sharpest resonance carries the estimator's own bias).
 
     Returns
     -------
@@ -267,7 +281,11 @@ def level_dependence(freq, frfs: list, stds: list, alpha: float = 1e-3, name: st
     worst = {}
     for c in chans:
         H = np.stack([f[c] for f in frfs])
-        w = 1.0 / np.maximum(np.stack([s[c] for s in stds]) ** 2, 1e-300)
+        sd = np.stack([s[c] for s in stds])
+        if model_errors is not None:
+            sd = np.hypot(sd, np.stack([np.asarray((m or {}).get(c, 0.0), float) * np.ones(len(freq))
+                                        for m in model_errors]))
+        w = 1.0 / np.maximum(sd ** 2 + (rel_floor * np.abs(H)) ** 2, 1e-300)
         mean = np.sum(w * H, axis=0) / np.sum(w, axis=0)  # weighted mean, the "one linear system" estimate
         chi = np.sum(w * np.abs(H - mean) ** 2, axis=0)  # χ² with 2(k-1) dof per point
         if dof_noise:
@@ -277,6 +295,10 @@ def level_dependence(freq, frfs: list, stds: list, alpha: float = 1e-3, name: st
         z = np.abs(H - mean) * np.sqrt(w)
         i = int(np.argmax(chi))
         worst[c] = {"freq_hz": float(freq[i]), "chi2": float(chi[i]), "max_z": float(z[:, i].max())}
-    p_value, bands, p_global, p_band = band_scan(freq, scores, dof, alpha)
+    null_median = stats.chi2.median(dof)
+    inflation = float(np.clip(np.median(scores) / null_median, 1.0, 2.0))
+    scores = scores / inflation
+    p_value, bands, p_global, p_band = band_scan(freq, scores, dof, alpha, widths=WIDTHS[1:])
     return NonlinearTest(name, p_value, bands, alpha, {"p_global": p_global, "p_band": p_band, "scores": scores,
-                                                       "freq_hz": np.asarray(freq), "dof": dof, "worst": worst})
+                                                       "freq_hz": np.asarray(freq), "dof": dof, "worst": worst,
+                                                       "inflation": inflation})
