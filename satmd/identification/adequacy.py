@@ -32,8 +32,8 @@ from .statistics import POOR_REL_ERROR
 SCREEN_REL_ERROR = 0.6  # a reading (or a channel subset) is refitted only when a coarse design comes this near
 SCREEN_POINTS, SCREEN_DESIGN_LOG2 = 256, 10  # the screen's frequencies and design size (2^10 rigs)
 SCALE_SLACK = 10.0  # a reading is fitted only when it brings the data within this factor of the model's size
-GOOD_REL_ERROR = 0.2  # an alternative reading must reproduce the data at least this well ...
-MUCH_BETTER = 0.3  # ... and cut the relative error to below this share of the data as given
+GOOD_REL_ERROR = 0.1  # an alternative reading must reproduce the data at least this well ...
+MUCH_BETTER = 0.2  # ... and cut the relative error to below this share of the data as given
 NOISE_LAG1 = 0.3  # data whose lag-1 autocorrelation along frequency stays below this are noise-like
 G = 9.80665
 
@@ -182,8 +182,9 @@ def _explain_failure(fit, rel, identify) -> list:
                 out.append(Reason("channel", f"channel {b} is a copy of channel {a}: one sensor is missing or "
                                              "mislabelled", {"channels": [a, b]}))
                 return out
-    lag = {c: lag1_autocorrelation(np.stack([data[c].real - data[c].real.mean(),
-                                             data[c].imag - data[c].imag.mean()])) for c in names}
+    # noise has neither smooth parts nor a smooth magnitude (a long delay turns a smooth FRF's phase fast,
+    # so its parts alone may look rough while its magnitude stays smooth)
+    lag = {c: max(_lag1(data[c].real, data[c].imag), _lag1(np.abs(data[c]))) for c in names}
     if len(data) > 8 and all(v < NOISE_LAG1 for v in lag.values()):
         out.append(Reason("noise_like", "the data are noise-like, with no smooth structure along frequency "
                                         f"(lag-1 autocorrelation {max(lag.values()):.2f}; an FRF gives near 1): "
@@ -217,6 +218,11 @@ def _explain_failure(fit, rel, identify) -> list:
                                   {"channel": c, "rel_error_without": float(alt.rel_error)}))
                 return out
     return out
+
+
+def _lag1(*parts) -> float:
+    """Pooled lag-1 autocorrelation along frequency of real series, each about its mean."""
+    return lag1_autocorrelation(np.stack([p - p.mean() for p in parts]))
 
 
 def _design_rel(fit, data, channels=None) -> float:
