@@ -41,7 +41,16 @@ def fit_and_score(method: str, seed: int, threads: int, noise: float, blind) -> 
     t2 = evaluate(model)
     b = evaluate(model, blind, noise, 0)
     info = model.fit_info_
-    return {"method": method, "seed": seed, "threads": threads, "noise": noise, "wall_s": wall, "cpu_s": cpu,
+    extra = {}
+    if info.get("held_out"):  # the same nets, every member in every mean (no held-out rule)
+        import copy
+
+        plain = copy.copy(model)
+        plain.fit_info_ = {k: v for k, v in info.items() if k != "held_out"}
+        pt, pb = evaluate(plain), evaluate(plain, blind, noise, 0)
+        extra = {"all_members": {"table2_mae_R": pt["mae_R"], "table2_mae_L": pt["mae_L"], "blind_mae_R": pb["mae_R"],
+                                 "blind_mae_L": pb["mae_L"], "coverage": pb["coverage"]}}
+    return {**extra, "method": method, "seed": seed, "threads": threads, "noise": noise, "wall_s": wall, "cpu_s": cpu,
             "load_1min_before": load, "load_1min_after": os.getloadavg()[0],
             "table2_mae_R": t2["mae_R"], "table2_mae_L": t2["mae_L"], "blind_mae_R": b["mae_R"],
             "blind_mae_L": b["mae_L"], "coverage": b["coverage"], "coverage_R": b["coverage_R"],
@@ -112,6 +121,10 @@ def summarise(records: list) -> dict:
     for k in ("table2_mae_R", "table2_mae_L", "blind_mae_R", "blind_mae_L"):
         for m in ("old", "new"):
             out[f"{m}_mean_{k}"] = float(np.mean([by[(m, s, 1, 0.0)][k] for s in seeds])) if seeds else None
+    alt = [by[("new", s, 1, 0.0)].get("all_members") for s in seeds]
+    if seeds and all(alt):  # the same nets with every member in every mean: the held-out rule measured
+        for k in ("table2_mae_R", "table2_mae_L", "blind_mae_R", "blind_mae_L"):
+            out[f"new_all_members_mean_{k}"] = float(np.mean([a[k] for a in alt]))
     for (m, s, t, z), r in sorted(by.items()):
         if m == "new" and z == 0 and ("old", s, t, z) in by:
             o = by[("old", s, t, z)]
@@ -139,9 +152,12 @@ def summarise(records: list) -> dict:
 def headline(summary: dict) -> str:
     """The line of figures."""
     parts = []
-    for t in summary["timing"]:
-        parts.append(f"{t['threads']} thread(s): old {t['old_wall_s']:.1f} s, new {t['new_wall_s']:.1f} s wall "
-                     f"(x{t['ratio_wall']:.2f}; CPU {t['old_cpu_s']:.1f} -> {t['new_cpu_s']:.1f} s)")
+    for n in sorted({t["threads"] for t in summary["timing"]}):
+        ts = [t for t in summary["timing"] if t["threads"] == n]
+        mean = {k: float(np.mean([t[k] for t in ts])) for k in ("old_wall_s", "new_wall_s", "old_cpu_s", "new_cpu_s")}
+        parts.append(f"{n} thread(s) ({len(ts)} pair(s)): old {mean['old_wall_s']:.1f} s, new {mean['new_wall_s']:.1f} s "
+                     f"wall (x{mean['new_wall_s'] / mean['old_wall_s']:.2f}; CPU {mean['old_cpu_s']:.1f} -> "
+                     f"{mean['new_cpu_s']:.1f} s)")
     if summary["seeds"]:
         parts.append(f"Table 2 MAE over seeds {','.join(map(str, summary['seeds']))}: R old "
                      f"{summary['old_mean_table2_mae_R']:.4f} new {summary['new_mean_table2_mae_R']:.4f} Ω, L old "
@@ -151,7 +167,7 @@ def headline(summary: dict) -> str:
     return "inverse once: " + "; ".join(parts)
 
 
-def run_once(seeds, thread_counts, coverage_noise) -> dict:
+def run_once(seeds, thread_counts, coverage_noise, methods=("old", "new")) -> dict:
     """The jobs of ``--once``, each old then new back to back; records merged into inverse_once.json."""
     from _machine import describe, load_after, machine
 
@@ -166,7 +182,7 @@ def run_once(seeds, thread_counts, coverage_noise) -> dict:
     res["machine"] = machine("cpu", 1)
     records = {_key(r): r for r in res["records"]}
     for seed, threads, noise in jobs:
-        for method in ("old", "new"):
+        for method in methods:
             r = fit_and_score(method, seed, threads, noise, blind)
             if OUT.is_file():  # another run may have added records meanwhile: keep them
                 records = {**{_key(q): q for q in json.loads(OUT.read_text(encoding="utf-8"))["records"]}, **records}
@@ -206,6 +222,12 @@ def readme_markdown(res: dict) -> str:
     for c in s["coverage"]:
         lines.append(f"- 2σ coverage at {100 * c['noise']:g} % noise on the {c['n']} blind FRFs: old {c['old']:.3f}, "
                      f"new {c['new']:.3f}.")
+    if "new_all_members_mean_table2_mae_R" in s:
+        lines.append(f"- The same new nets with every member in every mean (no held-out rule): mean Table 2 MAE R "
+                     f"{s['new_all_members_mean_table2_mae_R']:.4f} Ω, L {s['new_all_members_mean_table2_mae_L']:.3g} H; "
+                     f"246 blind FRFs R {s['new_all_members_mean_blind_mae_R']:.4f} Ω, L "
+                     f"{s['new_all_members_mean_blind_mae_L']:.3g} H (with the rule: "
+                     f"{s['new_mean_blind_mae_R']:.4f} Ω, {s['new_mean_blind_mae_L']:.3g} H).")
     b = res.get("member_batching_ms")
     if b:
         lines.append(f"- One training step of the 5 members (CPU ms): stacked weights with `baddbmm` "

@@ -46,6 +46,16 @@ down to ``lr_final``.
 
 Noise (eq. 23) is drawn afresh for every batch and member, and added to the
 network inputs only; the physics target stays noise-free.
+
+Members on their own samples
+----------------------------
+With ``members`` (cross-fitting, `satmd.inverse.strategies`) each member draws
+its mini-batch from its own training set: the step still runs all members at
+once, with inputs (E, B, 240) and targets (E, B, 2, F) instead of one batch
+broadcast to every member. An epoch is the largest member's set. Measured
+per training step (5 members x 64 samples, one thread; `benchmarks/inverse.py
+--once`), the stacked weights with ``baddbmm`` beat ``torch.func.vmap`` over
+``functional_call`` and a loop over members.
 """
 from __future__ import annotations
 
