@@ -8,7 +8,7 @@ import pytest
 from satmd import Rig, effect, simulate
 from satmd.cli import main
 from satmd.discovery import discover
-from satmd.discovery.adequacy import Adequacy, Reason, effects_at_edge
+from satmd.discovery.adequacy import Adequacy, Reason, after_search, effects_at_edge
 from satmd.errors import DataError
 from satmd.identification import identify
 from satmd.io import FRFData, load_frf, save_frf
@@ -111,6 +111,18 @@ def test_an_effect_at_the_edge_of_its_search_range_is_evidence():
                                 effect("sensor_gain", gain_a1=1.05, gain_a2=0.97)], rig)
 
 
+def test_a_large_smooth_misfit_after_the_best_vocabulary_model_is_another_structure():
+    from types import SimpleNamespace
+
+    fit = SimpleNamespace(rel_error=0.3, values={"m2": 0.5}, pinned=())
+    smooth, rough = SimpleNamespace(structured_fraction=0.8), SimpleNamespace(structured_fraction=0.1)
+    assert [r.kind for r in after_search(fit, [], Rig(), smooth)] == ["structure_left"]
+    assert after_search(fit, [], Rig(), rough) == []  # a rough rest is the noise model's business
+    assert after_search(SimpleNamespace(rel_error=0.02, values={"m2": 0.5}, pinned=()), [], Rig(), smooth) == []
+    far = SimpleNamespace(rel_error=0.02, values={"m2": 50.0}, pinned=("m2",))
+    assert [r.kind for r in after_search(far, [], Rig())] == ["implausible"]
+
+
 def test_no_parameter_for_a_channel_that_is_not_there():
     d = simulate(GRID, Rig(m2=0.55, kp=1.05e5, R=30.0, L=0.1), effects=[effect("sensor_gain", gain_a1=1.06,
                  gain_a2=1.0)], noise=(0.005, 0.001), seed=8).select(["a1"])
@@ -136,6 +148,7 @@ def test_real_beam_accelerance_is_not_a_satmd_rig():
     d = rep.to_dict()
     assert d["model_adequate"] is False and d["effects"] == []
     assert all("outside the bounds" not in r["message"] for r in d["adequacy_reasons"])
+    assert d["adequacy_reasons"][0]["kind"] in ("poor_fit", "implausible")  # another structure; not noise
 
 
 def test_tune_refuses_an_inadequate_model_unless_forced(tmp_path, capsys):
