@@ -71,11 +71,15 @@ def snls_report(directory, alpha: float = 1e-3):
     half = arrow.n_samples // 2
     parts = [Recording(arrow.fs_hz, {"force": arrow["force"][a:b], "acc1": arrow["y"][a:b]})
              for a, b in ((0, half), (half, 2 * half))]
-    band = (20.0, 200.0)
+    from ..io.lpm import excited_band
+
+    edges = [excited_band(p["force"], p.fs_hz)[:2] for p in parts]
+    band = (max(20.0, *(e[0] for e in edges)), min(200.0, *(e[1] for e in edges)))  # one grid for both halves
     ests = [lpm(p, band=band, width_hz=0.5) for p in parts]
-    freq = ests[0].freq_hz
-    frfs = [{"y": e.frf["a1"]} for e in ests]
-    stds = [{"y": e.std["a1"]} for e in ests]
+    freq = np.intersect1d(np.round(ests[0].freq_hz, 9), np.round(ests[1].freq_hz, 9))
+    idx = [np.searchsorted(np.round(e.freq_hz, 9), freq) for e in ests]
+    frfs = [{"y": e.frf["a1"][i]} for e, i in zip(ests, idx)]
+    stds = [{"y": e.std["a1"][i]} for e, i in zip(ests, idx)]
     levels = [float(np.std(p["force"])) for p in parts]
     test = _multisine_distortion(ms, band, alpha / 2)
     return analyse_generic(frfs, stds, freq, levels, [test], alpha / 2)

@@ -65,7 +65,16 @@ class NonlinearTest:
         """One line in words."""
         where = ", ".join(f"{a:.1f}–{b:.1f} Hz" for a, b in self.bands_hz) or "no band alone"
         verdict = "rejects linearity" if self.significant else "consistent with a linear system"
-        return f"{self.name}: p = {self.p_value:.2g} ({verdict} at α = {self.alpha:g}); bands: {where}"
+        channel = self.channel
+        carried = f"; carried most by {channel}" if channel and self.significant else ""
+        return f"{self.name}: p = {self.p_value:.2g} ({verdict} at α = {self.alpha:g}); bands: {where}{carried}"
+
+    @property
+    def channel(self):
+        """The channel with the largest share of the test's score (None when the test has one channel)."""
+        per = self.details.get("per_channel") or {c: w["chi2"] for c, w in (self.details.get("worst") or {}).items()}
+        per = {c: float(np.sum(v)) for c, v in per.items()}
+        return max(per, key=per.get) if len(per) > 1 else None
 
 
 def band_scan(freq, score, dof, alpha, widths=WIDTHS):
@@ -278,7 +287,7 @@ def level_dependence(freq, frfs: list, stds: list, alpha: float = 1e-3, name: st
     chans = [c for c in frfs[0] if all(c in f for f in frfs)]
     scores = np.zeros(len(freq))
     dof = 0
-    worst = {}
+    worst, per_channel = {}, {}
     for c in chans:
         H = np.stack([f[c] for f in frfs])
         sd = np.stack([s[c] for s in stds])
@@ -291,6 +300,7 @@ def level_dependence(freq, frfs: list, stds: list, alpha: float = 1e-3, name: st
         if dof_noise:
             chi = _chi2_score(stats.f.sf(chi / (2 * (k - 1)), 2 * (k - 1), dof_noise), 2 * (k - 1))
         scores += chi
+        per_channel[c] = chi
         dof += 2 * (k - 1)
         z = np.abs(H - mean) * np.sqrt(w)
         i = int(np.argmax(chi))
@@ -301,4 +311,4 @@ def level_dependence(freq, frfs: list, stds: list, alpha: float = 1e-3, name: st
     p_value, bands, p_global, p_band = band_scan(freq, scores, dof, alpha, widths=WIDTHS[1:])
     return NonlinearTest(name, p_value, bands, alpha, {"p_global": p_global, "p_band": p_band, "scores": scores,
                                                        "freq_hz": np.asarray(freq), "dof": dof, "worst": worst,
-                                                       "inflation": inflation})
+                                                       "inflation": inflation, "per_channel": per_channel})
