@@ -2,7 +2,7 @@
 
 >>> from satmd.explain import xi_dataset, distill
 >>> data = xi_dataset()                                   # doctest: +SKIP
->>> res = distill(data.X, data.targets["xi"], max_complexity=21)   # doctest: +SKIP
+>>> res = distill(data.X, data.targets["xi"])   # the search `satmd explain` runs  # doctest: +SKIP
 >>> print(res.report())                                   # doctest: +SKIP
 
 Inputs are z-scored with the mean and std (ddof 0) of the whole dataset, as
@@ -12,7 +12,8 @@ refitted on the training part (``polish``), constants the others can absorb
 are dropped (``prune``), the rest rounded to 4 significant digits, and *all* reported metrics are computed from that rounded sympy
 expression. Complexity is `satmd.explain.symbolic.node_count`.
 
-Back ends: ``operon`` (pyoperon, default), ``pysr`` (needs a Julia runtime;
+Back ends: the default pools the skeleton pass with ``operon`` (``hybrid``,
+`DEFAULT_SEARCH`); ``operon`` (pyoperon), ``skeleton``, ``pysr`` (needs a Julia runtime;
 refused in one line without it), ``sindy`` (PySINDy's STLSQ over a
 polynomial, optionally rational, library: the transparent baseline).
 """
@@ -160,20 +161,34 @@ def pareto_front(entries: list, key: str = "r2_train") -> list:
     return front
 
 
-def distill(X, y, backend: str = "operon", names=None, *, max_complexity: int | None = None,
+#: What `distill` runs when no back end is named: the search `satmd explain` runs for ξ (the
+#: skeleton pass pooled with operon, finalists by cross-validation on a validation share), the
+#: best of those measured (`benchmarks/distill.py`), at about 75 s.
+DEFAULT_SEARCH = {"backend": "hybrid", "max_complexity": 20, "validation": 0.2, "finalists": 10, "time_limit": 75,
+                  "operon_share": 0.25, "restarts": 2,
+                  "allowed_symbols": "add,sub,mul,div,square,exp,constant,variable", "max_length": 18,
+                  "max_depth": 8, "generations": 20, "population_size": 1000, "optimizer_iterations": 10}
+#: The settings a named back end starts from (each overridden by the keyword of that name).
+NAMED_DEFAULTS = {"max_complexity": None, "validation": 0.0, "finalists": 5, "time_limit": None}
+
+
+def distill(X, y, backend: str | None = None, names=None, *, max_complexity: int | None = None,
             test_size: float = 0.2, seed: int = 42, search_seed: int | None = None, zscore: bool = True,
             n_threads: int = 1,
             time_limit: float | None = None, polish: bool | None = None, prune: bool | None = None, digits: int = 4,
-            validation: float = 0.0, finalists: int = 5, cv_folds: int = 5, **options) -> DistillResult:
+            validation: float | None = None, finalists: int | None = None, cv_folds: int = 5,
+            **options) -> DistillResult:
     """Fit a compact formula y ≈ f(z(X)).
 
     Parameters
     ----------
     X : (n, d) physical inputs
     y : (n,) target (non-finite rows are dropped)
-    backend : "operon" (default), "pysr", "sindy", "skeleton" (product skeletons
-        within the node budget, `satmd.explain.skeletons`) or "hybrid" (operon
-        and the skeletons pooled)
+    backend : None (default: `DEFAULT_SEARCH`, the hybrid search `satmd explain` runs, at
+        most 20 nodes, chosen on a validation share; about 75 s), "operon", "pysr", "sindy",
+        "skeleton" (product skeletons within the node budget, `satmd.explain.skeletons`) or
+        "hybrid" (operon and the skeletons pooled). A named back end starts from
+        `NAMED_DEFAULTS` and its own settings.
     names : names of the d inputs (default x0..)
     max_complexity : return the most accurate candidate (training R², or
         validation R² with ``validation``) with at most this many nodes; None:
@@ -203,6 +218,17 @@ def distill(X, y, backend: str = "operon", names=None, *, max_complexity: int | 
     -------
     DistillResult
     """
+    given = {"max_complexity": max_complexity, "validation": validation, "finalists": finalists,
+             "time_limit": time_limit}
+    if backend is None:
+        preset = dict(DEFAULT_SEARCH)
+        backend = preset.pop("backend")
+        options = {**{k: v for k, v in preset.items() if k not in given}, **options}
+    else:
+        preset = NAMED_DEFAULTS
+    given = {k: preset[k] if v is None else v for k, v in given.items()}
+    max_complexity, validation, finalists, time_limit = (given[k] for k in ("max_complexity", "validation",
+                                                                            "finalists", "time_limit"))
     if backend not in BACKENDS:
         raise SatmdError(f"unknown backend {backend!r}; choose from {', '.join(BACKENDS)}")
     if not 0.0 <= validation < 0.9:

@@ -17,7 +17,7 @@ from . import contract
 from .anova import GridAnova, grid_anova, grid_ceiling
 from .attributions import BLIND_CASES, OUTPUTS, PAPER_TABLE3, attribution, in_paper_bands
 from .descriptors import MODAL_NAMES, grid_rig, modal_physics, xi_dataset
-from .distillation import DistillResult, distill, paper_formula_result
+from .distillation import DEFAULT_SEARCH, DistillResult, distill, paper_formula_result
 from .latent import LatentMap
 from .sensitivity import agreement, chain_rule_check, physical_sensitivity
 from .symbolic import PAPER_FORMULA, PAPER_METRICS, paper_complexity
@@ -27,10 +27,7 @@ from .symbolic import PAPER_FORMULA, PAPER_METRICS, paper_complexity
 #: node budget: `satmd.explain.skeletons`), the formula shortlisted on a validation part of the
 #: training rows and picked by 5-fold CV among the ten best; about 55 s on one core. time_limit
 #: caps the search (operon gets operon_share of it; the skeleton pass needs about 25 s of its 56).
-XI_SEARCH = {"backend": "hybrid", "validation": 0.2, "finalists": 10, "time_limit": 75, "operon_share": 0.25,
-             "restarts": 2,
-             "allowed_symbols": "add,sub,mul,div,square,exp,constant,variable", "max_length": 18, "max_depth": 8,
-             "generations": 20, "population_size": 1000, "optimizer_iterations": 10}
+XI_SEARCH = {k: v for k, v in DEFAULT_SEARCH.items() if k != "max_complexity"}  # distill's own default
 XI_SEARCH_QUICK = {**XI_SEARCH, "restarts": 1, "generations": 10, "time_limit": 25}
 #: operon on its own, as before the skeleton pass (kept for comparison in the benchmark).
 XI_OPERON = {"allowed_symbols": "add,sub,mul,div,square,exp,constant,variable", "max_length": 18, "max_depth": 8,

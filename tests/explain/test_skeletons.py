@@ -341,3 +341,16 @@ def test_search_trades_c0_and_a_linear_term_for_a_shifted_power():
     assert r2 > 1 - 1e-9, found[:3]
     expr = S.compact(S.parse(text, 3))
     assert S.node_count(expr) <= 17 and "x0 +" in str(expr).replace("(", ""), expr
+
+
+def test_the_default_is_the_search_satmd_explain_runs():
+    """Issue 25: a user of the API gets the best method measured (the hybrid search) by default."""
+    from satmd.explain.distillation import DEFAULT_SEARCH
+    from satmd.explain.run import XI_SEARCH
+
+    assert {**XI_SEARCH, "max_complexity": DEFAULT_SEARCH["max_complexity"]} == DEFAULT_SEARCH
+    Z, y = planted(300)
+    res = distill(Z, y, zscore=False, time_limit=4, generations=2, population_size=50,
+                  skeleton_options={"subsample": 150, "keep": 3})
+    assert res.backend == "hybrid" and res.info["chosen_on"] == "r2_cv" and res.complexity <= 20
+    assert res.info["validation"] == DEFAULT_SEARCH["validation"]
