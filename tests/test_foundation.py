@@ -36,7 +36,7 @@ def _reference_pick(values, coords, n, min_dist, finite_only):
     return picked
 
 
-@settings(max_examples=60, deadline=None)
+@settings(max_examples=40, deadline=None)
 @given(arrays(float, st.tuples(st.integers(1, 40), st.integers(1, 3)), elements=st.floats(0, 1)),
        st.integers(1, 6), st.sampled_from([0.02, 0.1, 0.3]), st.booleans(), st.integers(0, 2**31))
 def test_distinct_best_is_the_loop_it_replaced(coords, n, min_dist, finite_only, seed):
@@ -50,7 +50,7 @@ def test_distinct_best_is_the_loop_it_replaced(coords, n, min_dist, finite_only,
         assert all(a == b or np.max(np.abs(coords[a] - coords[b])) > min_dist for b in got)
 
 
-@settings(max_examples=60, deadline=None)
+@settings(max_examples=40, deadline=None)
 @given(arrays(complex, st.integers(0, 200), elements=st.complex_numbers(max_magnitude=1e6, allow_nan=False)))
 def test_lag1_matches_the_concatenated_form_bit_for_bit(v):
     """discovery.locate's former formula: centred Re and Im concatenated (now one shared function)."""

@@ -15,7 +15,6 @@ the response to a band-limited random force of that RMS (the best linear approxi
 """
 from __future__ import annotations
 
-import math
 import time
 from dataclasses import dataclass, field
 
