@@ -269,8 +269,14 @@ def run_proc_case(c, base, work, limit, timeout):
     argv = [sys.executable, "-m", "satmd", *_sub(c["argv"], base, work)]
     old = {n: _snapshot(work / n) for n in c.get("keep", [])}
     env = {**os.environ, "PYTHONPATH": str(ROOT), "MPLBACKEND": "Agg"}
-    p = subprocess.Popen(argv, cwd=work, stdout=subprocess.PIPE, stderr=subprocess.PIPE, env=env,
-                         preexec_fn=_limit(limit))
+    fsize = c.get("fsize")
+
+    def limits():
+        _limit(limit)()
+        if fsize:  # a full disk: writes beyond this many bytes fail (EFBIG; Python ignores SIGXFSZ)
+            resource.setrlimit(resource.RLIMIT_FSIZE, (fsize, fsize))
+
+    p = subprocess.Popen(argv, cwd=work, stdout=subprocess.PIPE, stderr=subprocess.PIPE, env=env, preexec_fn=limits)
     if c.get("signal"):
         time.sleep(c["delay"])
         if p.poll() is None:
@@ -285,7 +291,11 @@ def run_proc_case(c, base, work, limit, timeout):
     if "Traceback" in err:
         return "traceback", err.strip()[-300:]
     if not c.get("signal"):
-        return _judge_cli(c, p.returncode, out, err)
+        cls, detail = _judge_cli(c, p.returncode, out, err)
+        for name, before in old.items():  # a refused write leaves the old output as it was
+            if cls == "refused" and _snapshot(work / name) != before:
+                return "damaged", f"{name} changed by a refused command"
+        return cls, detail
     for name, before in old.items():
         now = _snapshot(work / name)
         if now != before and not _complete(work / name):
@@ -437,7 +447,7 @@ def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--workers", type=int, default=2)
     ap.add_argument("--limit", type=int, default=None, help="run only the first N cases")
-    ap.add_argument("--only", default=None, help="run only one family")
+    ap.add_argument("--only", default=None, help="run only these families (comma-separated)")
     ap.add_argument("--memory-gib", type=float, default=6.0, help="address-space limit per worker (GiB)")
     ap.add_argument("--timeout", type=float, default=90.0, help="seconds per case")
     ap.add_argument("--out", default=str(HERE / "results" / "fuzz.json"))
@@ -451,7 +461,7 @@ def main():
         fc.make_base(base)
         cases = fc.generate(base)
         if args.only:
-            cases = [c for c in cases if c["family"] == args.only]
+            cases = [c for c in cases if c["family"] in args.only.split(",")]
         if args.limit:
             cases = cases[:args.limit]
         limit = int(args.memory_gib * 2 ** 30)

@@ -194,6 +194,8 @@ def parse_freq(text: str) -> np.ndarray:
         raise SatmdError(f"--freq {text!r}: N must be an integer") from None
     if not (0 < lo < hi) or n < 2:
         raise SatmdError(f"--freq {text!r}: need 0 < LO < HI and N >= 2")
+    if lo < 1e-9 or hi > 1e9:
+        raise SatmdError(f"--freq {text!r}: LO and HI must lie in 1e-9..1e9 Hz")
     if n > MAX_FREQ_POINTS:
         raise SatmdError(f"--freq {text!r}: {n} points is more than the {MAX_FREQ_POINTS} satmd computes at once")
     return np.linspace(lo, hi, n)
@@ -288,7 +290,11 @@ def add_rig_options(parser: argparse.ArgumentParser, names=DEFAULT_FREE):
 
 def rig_from_args(args, names=DEFAULT_FREE) -> Rig:
     changes = {n: getattr(args, n) for n in names if getattr(args, n, None) is not None}
-    return Rig().replace(**changes).validate()
+    try:
+        return Rig().replace(**changes).validate()
+    except ValueError as exc:  # name the option: "--m2 -1: rig parameter m2 must be > 0"
+        bad = next((n for n in changes if f" {n} " in f" {exc} "), None)
+        raise SatmdError(f"--{bad} {changes[bad]:g}: {exc}" if bad else str(exc)) from None
 
 
 def add_data_options(parser: argparse.ArgumentParser):

@@ -35,8 +35,15 @@ def run(args):
     from ..report import reproduce
     from ._common import check_outputs
 
+    from ..errors import SatmdError
+    from ..report import section_keys
+
     check_outputs([("--out", args.out, None)])
-    only = [s.strip() for s in args.only.split(",")] if args.only else None
+    only = [s.strip() for s in args.only.split(",")] if args.only is not None else None
+    unknown = [k for k in only or () if k not in section_keys()]
+    if only is not None and (unknown or not any(only)):
+        raise SatmdError(f"--only {args.only!r}: unknown section {', '.join(map(repr, unknown)) or '(none given)'}; "
+                         f"choose from {', '.join(section_keys())}")
     from ..report import IncompleteReport
 
     try:

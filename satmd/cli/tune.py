@@ -8,7 +8,7 @@ from pathlib import Path
 
 from ..conventions import DEFAULT_FREE
 from ..errors import DataError
-from ._common import (check_outputs, dumps_json, load_data, one_line_warnings, parse_effect, parse_kv, parse_list,
+from ._common import (check_outputs, name_list, dumps_json, load_data, one_line_warnings, parse_effect, parse_kv, parse_list,
                       parse_number, plot_suffixes)
 
 _DATA_TYPES = (".csv", ".uff", ".unv", ".mat", ".npz", ".txt", ".wav")
@@ -42,8 +42,8 @@ def register(sub):
     p.add_argument("--draws", type=int, default=128, help="parameter draws for --robust (default 128)")
     p.add_argument("--uncertainty", default=None, metavar="kp=5e3,...",
                    help="standard deviations for --robust (instead of the fit's covariance; needed with --rig)")
-    p.add_argument("--free", default="m2,kp,R,L", help="parameters identified from DATA (default m2,kp,R,L)")
-    p.add_argument("--channels", default=None, help="channels to fit (default a1,a2 when present)")
+    p.add_argument("--free", type=name_list, default="m2,kp,R,L", help="parameters identified from DATA (default m2,kp,R,L)")
+    p.add_argument("--channels", type=name_list, default=None, help="channels to fit (default a1,a2 when present)")
     p.add_argument("--force", action="store_true",
                    help="tune even when the SATMD model cannot describe DATA (model_adequate false); "
                         "without it such data are refused (exit 2)")
@@ -103,8 +103,11 @@ def _tune_options(args) -> dict:
     if not sep:
         raise DataError(f"--band {args.band!r}: expected LO:HI in Hz")
     band = (parse_number(lo, "--band LO"), parse_number(hi, "--band HI"))
-    Objective(args.objective, args.output, band)  # validates the band now, before any work
     _check_work(args, band)
+    try:
+        Objective(args.objective, args.output, band)  # validates the band now, before any work
+    except DataError as exc:
+        raise DataError(f"--band {args.band}: {exc}") from None
     design = parse_list(args.design)
     if not design:
         raise DataError("--design: give at least one rig parameter, e.g. R,L")
@@ -117,7 +120,10 @@ def _tune_options(args) -> dict:
         bounds[name.strip()] = (parse_number(a, f"--bounds {name} LO"), parse_number(b, f"--bounds {name} HI"))
         for x in bounds[name.strip()]:
             _check_scale(f"--bounds {item}", name.strip(), x)
-    DesignSpace.build(design, {n: 1.0 for n in design}, bounds)  # names and bounds checked before any work
+    try:  # names and bounds checked before any work
+        DesignSpace.build(design, {n: 1.0 for n in design}, bounds)
+    except DataError as exc:
+        raise DataError(f"{'--bounds' if bounds and 'bounds' in str(exc) else '--design'}: {exc}") from None
     q = args.robust
     if q is not None and not 0.5 <= q < 1:
         raise DataError(f"--robust {q}: the quantile must lie in [0.5, 1)")
@@ -156,7 +162,9 @@ def _check_work(args, band):
 
     if not 16 <= args.draws <= MAX_DRAWS:
         raise DataError(f"--draws {args.draws}: need 16..{MAX_DRAWS} (about 55 s per 1000 draws)")
-    points = math.log(band[1] / band[0]) / 0.004  # satmd.tuning.objective.band_grid's spacing
+    if not 0 < band[0] < band[1]:
+        raise DataError(f"--band {args.band}: need 0 < LO < HI")
+    points = (math.log(band[1]) - math.log(band[0])) / 0.004  # satmd.tuning.objective.band_grid's spacing
     check_memory(f"--band {args.band} ({points:.3g} grid points)", points * GRID_BYTES, "narrow the band")
 
 

@@ -177,7 +177,10 @@ def parse_channel_map(spec, allowed, aliases=None) -> dict:
             raise ValueError(f"channel_map: {key}= needs NODE:DIR or #RECORD")
         if key in out:
             raise ValueError(f"channel_map: {key} given twice")
-        out[key] = parse_dof(str(value))
+        try:
+            out[key] = parse_dof(str(value))
+        except ValueError as exc:
+            raise ValueError(f"channel_map {key}={str(value).strip()}: {str(exc).split(': ', 1)[-1]}") from None
         same = [k for k, v in out.items() if k != key and _same_source(v, out[key])]
         if same:
             raise ValueError(f"channel_map: {same[0]} and {key} both name {str(value).strip()} "

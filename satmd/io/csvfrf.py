@@ -70,6 +70,8 @@ def _estimator(path, text, meta, freq_max) -> dict:
     except (ValueError, RecursionError):
         raise FormatError(path, f"the '# {ESTIMATOR_KEY}:' comment is not JSON (or nests too deeply)",
                           line=line) from None
+    if not isinstance(estimator, dict):
+        raise FormatError(path, f"the '# {ESTIMATOR_KEY}:' comment is not a JSON object", line=line)
     try:
         return validate_estimator(estimator, freq_max)
     except DataError as exc:

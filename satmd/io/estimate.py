@@ -95,21 +95,26 @@ def _check_force(recording: Recording):
     if not responses:
         raise DataError(f"{source}: no acc1 or acc2 channel (has {', '.join(recording.channels)})")
     check_rate(source, recording.fs_hz)
+    return source, responses
+
+
+def _check_constant(recording: Recording, source, responses):
+    """A constant force or response: nothing was excited or measured (said before any spectrum is taken)."""
     for name in ("force", *responses):
         if np.ptp(recording[name]) == 0:
             raise DataError(f"{source}: channel {name} is constant ({recording[name][0]:g} throughout): "
                             f"{'nothing excited the rig' if name == 'force' else 'the sensor recorded nothing'}")
-    return source, responses
 
 
 def _estimate_lpm(recording: Recording, band, width_hz) -> FRFData:
     from .chain import clipping_findings, lpm_findings
     from .lpm import lpm
 
-    source, _ = _check_force(recording)
+    source, responses = _check_force(recording)
     if recording.n_samples < 256:
         raise DataError(f"{source}: {recording.n_samples} samples is too short for a local-polynomial FRF "
                         f"estimate (need at least 256)")
+    _check_constant(recording, source, responses)
     est = lpm(recording, band=band, width_hz=width_hz)
     s = est.settings
     findings = clipping_findings(recording) + lpm_findings(est.freq_hz, est.frf, est.std, s,
@@ -139,7 +144,8 @@ def _estimate_welch(recording: Recording, nperseg, window, overlap, estimator, b
 
     est = check_estimator(estimator)
     source, responses = _check_force(recording)
-    s = spectra(recording, "force", responses, nperseg, window, overlap)
+    s = spectra(recording, "force", responses, nperseg, window, overlap)  # too short: said here first
+    _check_constant(recording, source, responses)
     # bins the force never excited are noise over noise: keep to the excited band, as the LPM does
     lo, hi, _ = excited_band(recording["force"], recording.fs_hz)
     requested = band

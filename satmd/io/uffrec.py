@@ -93,9 +93,9 @@ def _kind(r):
 
 def _uff_roles(path, times, channel_map) -> dict:
     """{dataset number: channel name}."""
-    if all(r.tag in ROLES for r in times) and len({r.tag for r in times}) == len(times):
-        return {r.index: r.tag for r in times}
     names = {r.index: f"ch{r.index}" for r in times}
+    if not channel_map and all(r.tag in ROLES for r in times) and len({r.tag for r in times}) == len(times):
+        return {r.index: r.tag for r in times}  # written by satmd, and no map says otherwise
     if channel_map:
         wanted = channel_map_of(path, channel_map, ROLES, MAP_ALIASES)
         for role, (kind, a, b) in wanted.items():

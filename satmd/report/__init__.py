@@ -101,7 +101,7 @@ def reproduce(out, only=None, quick=False, log=print, acceptance=None) -> Path:
         only = [str(k).strip() for k in only]
         unknown = [k for k in only if k not in keys]
         if unknown or not only:
-            raise DataError(f"--only: unknown section {', '.join(map(repr, unknown)) or '(none given)'}; "
+            raise DataError(f"only: unknown section {', '.join(map(repr, unknown)) or '(none given)'}; "
                             f"choose from {', '.join(keys)}")
     ctx = Context(Path(out), quick=quick, acceptance=None if acceptance is None else Path(acceptance))
     created = [p for p in [ctx.out, *ctx.out.parents] if not p.exists()]
