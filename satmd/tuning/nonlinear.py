@@ -129,7 +129,7 @@ def simulated_peaks(rig, elements, R, L, levels, band_hz, output="u1", duration_
     batch = rig.replace(R=R, L=L)
     for j, lev in enumerate(levels):
         els = list(elements)
-        r = integrate(batch, lev * unit, fs_hz, els, outputs=(output,))
+        r = integrate(batch, lev * unit, fs_hz, els, outputs=(output,), oversample=2 if els else 1)
         y = np.atleast_2d(r.signals[output])
         _, pfy = csd(unit[skip:] * lev, y[:, skip:], fs_hz, nperseg=nper, axis=-1)
         out[:, j] = np.max(np.abs(pfy[:, keep] / (lev * lev * pff[keep])), axis=1)

@@ -109,9 +109,36 @@ def band_limited(force, fs_hz: float, pad: int = 2048) -> np.ndarray:
     return irfft(rfft(padded) / gain, size)[..., pad:pad + n]
 
 
+def upsample(force, k: int, pad: int = 2048) -> np.ndarray:
+    """Band-limited interpolation of samples to ``k`` times the rate (zero-padded FFT; 0 outside the record).
+
+    Parameters
+    ----------
+    force : (N,) or (batch, N) samples.
+    k : factor.
+    pad : zeros added at each end before the FFT.
+
+    Returns
+    -------
+    ndarray (..., k N); every k-th sample is the input.
+    """
+    from scipy.fft import irfft, next_fast_len, rfft
+
+    x = np.asarray(force, float)
+    n = x.shape[-1]
+    size = next_fast_len(n + 2 * pad, real=True)
+    padded = np.zeros(x.shape[:-1] + (size,))
+    padded[..., pad:pad + n] = x
+    spec = rfft(padded)
+    if size % 2 == 0:
+        spec[..., -1] *= 0.5  # split the Nyquist line between its two images
+    up = irfft(spec, size * k) * k
+    return up[..., pad * k:(pad + n) * k]
+
+
 def integrate(rig, force, fs_hz: float, elements=(), outputs=ACCEL_CHANNELS, segments="auto",
               warmup_s="auto", memory_tol: float = 1e-7, corrections: int = 3,
-              hold: str = "bandlimited", backend: str = "auto") -> NonlinearResponse:
+              hold: str = "bandlimited", backend: str = "auto", oversample: int = 1) -> NonlinearResponse:
     """Simulate the rig with nonlinear elements for a sampled force on the primary mass, from rest.
 
     Parameters
@@ -127,6 +154,9 @@ def integrate(rig, force, fs_hz: float, elements=(), outputs=ACCEL_CHANNELS, seg
     corrections : fixed-point steps on the implicit element forces per sample.
     hold : ``"bandlimited"`` (default): the force is a band-limited signal sampled at fs (see
         `band_limited`); ``"linear"``: it is a straight line between samples.
+    oversample : integrate at this multiple of fs (the force interpolated band-limited) and return
+        every ``oversample``-th sample: the element forces' straight-line hold errs by ~(ωΔ)²/12
+        (0.8 % at 100 Hz and 2048 Hz); 4 brings it to 0.05 %.
     backend : ``"auto"`` (compiled when numba is installed, else NumPy), ``"numba"`` or ``"numpy"``.
         The compiled pass is sequential over the whole record (``segments``, ``warmup_s``
         and ``memory_tol`` then do not apply: it is exact).
@@ -136,6 +166,12 @@ def integrate(rig, force, fs_hz: float, elements=(), outputs=ACCEL_CHANNELS, seg
     NonlinearResponse
         Arrays of shape (N,) for a single parameter set, (batch, N) for a batch.
     """
+    if int(oversample) > 1:
+        k = int(oversample)
+        res = integrate(rig, upsample(force, k), fs_hz * k, elements, outputs, segments, warmup_s, memory_tol,
+                        corrections, hold, backend)
+        return NonlinearResponse(res.fs_hz / k, {n: v[..., ::k] for n, v in res.signals.items()},
+                                 {**res.meta, "oversample": k})
     bad = [o for o in outputs if o not in OUTPUTS]
     if bad:
         raise DataError(f"integrate: unknown output(s) {bad}; known: {', '.join(OUTPUTS)}")

@@ -1,0 +1,84 @@
+"""Uncertainty of a time-domain nonlinear fit: the errors-in-variables correction and the sandwich covariance."""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+
+def simex_shift(coords, x, data, weights, skip, draws: int, seed: int = 0, simulate=None, residuals=None):
+    """Errors-in-variables correction: the model is driven by the *measured* force, noise included.
+
+    That noise biases the fit (it enters the model's nonlinear force and its Jacobian). One step
+    of SIMEX (Cook & Stefanski 1994): add ``draws`` independent copies of in-band white noise of
+    the force-sensor noise's variance (estimated from the force's spectrum outside the excited
+    band), take a Gauss-Newton step from ``x`` for each, and extrapolate linearly in the noise
+    variance back to none: ``x0 = x - mean(step)``. Returns the shift and its covariance
+    (spread of the steps / draws). No out-of-band spectrum: no correction.
+
+    Parameters
+    ----------
+    coords : the fit's coordinates; x : the fitted coordinates.
+    data, weights, skip : as in the fit.
+    draws : noise draws.
+    seed : seed of the draws.
+    simulate, residuals : the fit's batched simulation and weighted residuals.
+
+    Returns
+    -------
+    (ndarray, ndarray)
+    """
+    if not any(d["force_noise_var"] > 0 for d in data):
+        return np.zeros(x.size), np.zeros((x.size, x.size))
+    rng = np.random.default_rng(seed)
+    steps = []
+    for _ in range(draws):
+        noisy = []
+        for d in data:
+            n = d["force"].size
+            spec = np.fft.rfft(rng.standard_normal(n)) * math.sqrt(d["force_noise_var"])
+            f = np.fft.rfftfreq(n, 1.0 / d["fs"])
+            spec[(f < d["band"][0]) | (f > d["band"][1])] = 0.0
+            noisy.append({**d, "force": d["force"] + np.fft.irfft(spec, n)})
+        h = 1e-6 * np.maximum(1.0, np.abs(x))
+        X = np.vstack([x] + [x + h[i] * np.eye(x.size)[i] for i in range(x.size)])
+        R = residuals(simulate(coords, X, noisy), noisy, weights, skip)
+        J = ((R[1:] - R[0]) / h[:, None]).T
+        steps.append(-np.linalg.lstsq(J, R[0], rcond=None)[0])
+    steps = np.array(steps)
+    cov = np.cov(steps.T).reshape(x.size, x.size) / draws if draws > 1 else np.zeros((x.size, x.size))
+    return steps.mean(axis=0), cov
+
+
+def sandwich(J, r, block_sizes, channel_length, lags: int = 1024) -> np.ndarray:
+    """Covariance B M B: B = (JᵀJ)⁻¹, M the long-run variance of the score (Newey-West).
+
+    The score of each recording is ``s_t = Σ_c J_c,t r_c,t`` over its channels; ``M`` sums its
+    autocovariances up to ``lags`` with Bartlett weights. Residuals may then be coloured,
+    coherent across a1 and a2 (force-sensor noise drives both through the rig) and
+    non-stationary (a hardening rig's small-signal response follows the trajectory).
+
+    Parameters
+    ----------
+    J : (n, p) Jacobian of the weighted residuals; r : (n,) residuals.
+    block_sizes : samples per recording (both channels); channel_length : samples per channel.
+    lags : largest lag [samples] (about the rig's memory).
+
+    Returns
+    -------
+    ndarray (p, p)
+    """
+    B = np.linalg.pinv(J.T @ J)
+    M = np.zeros_like(B)
+    start = 0
+    for size, n in zip(block_sizes, channel_length):
+        score = sum(J[start + c * n:start + (c + 1) * n] * r[start + c * n:start + (c + 1) * n, None] for c in range(2))
+        L = int(min(lags, n - 1))
+        size_fft = int(2 ** np.ceil(np.log2(n + L + 1)))
+        S = np.fft.rfft(score, size_fft, axis=0)  # (f, p)
+        cross = np.fft.irfft(np.conj(S)[:, :, None] * S[:, None, :], size_fft, axis=0)[:L + 1]  # Γ_l, l = 0..L
+        w = 1.0 - np.arange(L + 1) / (L + 1.0)
+        G = np.tensordot(w[1:], cross[1:], axes=(0, 0))
+        M += cross[0] + G + G.T
+        start += size
+    return B @ M @ B
