@@ -19,10 +19,11 @@ from satmd.validation import Grid, Interval, Options, Whole, check, invalid_valu
 
 def _validated():
     """(name, function) of every validated public function."""
+    from satmd.discovery import discover
     from satmd.identification import identify
     from satmd.io.lpm import lpm
 
-    return [("identify", identify), ("lpm", lpm)]
+    return [("identify", identify), ("lpm", lpm), ("discover", discover)]
 
 
 CASES = [(name, fn, p, bad) for name, fn in _validated() for p, allowed in fn.parameter_constraints.items()

@@ -23,8 +23,10 @@ from __future__ import annotations
 
 import time
 from functools import partial
+from numbers import Real
 from typing import Sequence
 
+from ..validation import Interval, Whole, validate_params
 from ..conventions import ACCEL_CHANNELS, DEFAULT_FREE
 from .._fleet import fleet_map
 from ..identification import identify
@@ -44,6 +46,7 @@ __all__ = ["discover", "discover_many", "DiscoveryReport", "EffectFinding", "Une
            "SCHEMA"]
 
 
+@validate_params({"alpha": [Interval(Real, 0, 1, "both")], "max_effects": [Interval(Whole, 0)]})
 def discover(
     data,
     rig: Rig | None = None,
