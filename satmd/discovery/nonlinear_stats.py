@@ -212,7 +212,8 @@ def linearity_test(force, responses: dict, fs_hz: float, regressors: dict, band=
         explained[name] = float(np.sum(rss0 - rss1) / max(np.sum(rss0), 1e-300))
     freq = centres * df
     dof_all = dof * len(responses)
-    p_value, bands, p_global, p_band = band_scan(freq, scores, dof_all, alpha)
+    # bands of ≥ 3 windows: a lone window's F tail is where non-Gaussian regressors would lie
+    p_value, bands, p_global, p_band = band_scan(freq, scores, dof_all, alpha, widths=WIDTHS[1:])
     details = {"window_hz": width * df, "windows": int(centres.size), "regressors": list(regressors),
                "p_global": p_global, "p_band": p_band, "explained": explained, "freq_hz": freq,
                "scores": scores, "per_channel": per_channel, "dof": dof_all}
