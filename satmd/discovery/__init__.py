@@ -60,12 +60,15 @@ def discover(
 
     Parameters
     ----------
-    data : FRFData or Recording
+    data : FRFData, Recording, or a list of them
         Measured FRFs, or a force/acceleration recording: its FRFs are then
         estimated by `satmd.io.estimate_frf` (local polynomial method, std from
         the recording's own noise). For FRFs estimated from a recording the
         report adds ``estimator`` and the ``measurement`` findings of the chain,
-        kept apart from physics.
+        kept apart from physics. A recording is also tested for nonlinear
+        distortion; a list of recordings (or FRFData) of one rig at several
+        levels, or repeats, is judged together (`nonlinear_discover`): the
+        report then has a ``nonlinear`` block (SPEC §9).
     rig : values of the fixed parameters (default: the paper's rig).
     free : parameters fitted in every model (default m2, kp, R, L).
     candidates : effect names to consider (default: every registered effect).
@@ -81,15 +84,28 @@ def discover(
 
     from ..io.recording import Recording
 
+    if isinstance(data, (list, tuple)):  # several recordings of one rig: judged together (issue 26)
+        from .nonlinear_discover import discover_recordings
+
+        for j, part in enumerate(data):
+            require_data(part, f"data[{j}]", FRFData, Recording)
+        return discover_recordings(data, discover, rig=rig, free=free, alpha=alpha, candidates=candidates,
+                                   channels=channels, max_effects=max_effects)
     require_data(data, "data", FRFData, Recording)
-    if isinstance(data, Recording):
+    recording = data if isinstance(data, Recording) else None
+    if recording is not None:
         from ..io.estimate import estimate_frf
 
         data = estimate_frf(data)
     report = _discover_frf(data, rig, free, candidates, channels, alpha, max_effects)
     if not data.estimator:
         return report
-    return replace(report, estimator=dict(data.estimator), measurement=list(data.estimator.get("measurement", [])))
+    report = replace(report, estimator=dict(data.estimator), measurement=list(data.estimator.get("measurement", [])))
+    if recording is not None:  # one recording: is it linear at all? (issue 26)
+        from .nonlinear_discover import check_one
+
+        report = check_one(report, recording, alpha, rig, free)
+    return report
 
 
 def _discover_one(data, kwargs):
@@ -199,6 +215,7 @@ def _discover_frf(data: FRFData, rig, free, candidates, channels, alpha, max_eff
                            parameters={k: final.fit.values[k] for k in free}, fit_before=before, fit_after=after,
                            nominal_fit=nominal_fit, final_fit=final.fit, discrepancy=disc, p_values=p_values,
                            whiteness=test0.whiteness, wall_time=time.perf_counter() - t0)
+    return withdraw_if_inadequate(report, after_search(final.fit, final.effects, rig, disc))
 
 
 def _fit_summary(fit) -> dict:
@@ -220,7 +237,6 @@ def _rel_error(fit, disc):
     import numpy as np
 
     model = fit.prediction()
-    return withdraw_if_inadequate(report, after_search(final.fit, final.effects, rig, disc))
     pred = np.stack([model[c] + disc.correction[c] for c in fit.channels])
     target = np.stack([fit.data[c] for c in fit.channels])
     return float(np.linalg.norm(pred - target) / np.linalg.norm(target))
