@@ -102,6 +102,8 @@ def identify(
         start values outside the bounds, invalid search settings.
     """
     require_data(data, "data")
+    if channels is not None and len(set(channels)) != len(tuple(channels)):
+        raise DataError(f"channels {list(channels)} name a channel twice: its data would count twice")
     t0 = time.perf_counter()
     n_search, n_refine = int(n_search), int(n_refine)
     max_nfev = None if max_nfev is None else int(max_nfev)
