@@ -154,12 +154,12 @@ def integrate(rig, force, fs_hz: float, elements=(), outputs=ACCEL_CHANNELS, seg
     corrections : fixed-point steps on the implicit element forces per sample.
     hold : ``"bandlimited"`` (default): the force is a band-limited signal sampled at fs (see
         `band_limited`); ``"linear"``: it is a straight line between samples.
-    oversample : integrate at this multiple of fs (the force interpolated band-limited) and return
-        every ``oversample``-th sample: the element forces' straight-line hold errs by ~(ωΔ)²/12
-        (0.8 % at 100 Hz and 2048 Hz); 4 brings it to 0.05 %.
     backend : ``"auto"`` (compiled when numba is installed, else NumPy), ``"numba"`` or ``"numpy"``.
         The compiled pass is sequential over the whole record (``segments``, ``warmup_s``
         and ``memory_tol`` then do not apply: it is exact).
+    oversample : integrate at this multiple of fs (the force interpolated band-limited) and return
+        every ``oversample``-th sample: the element forces' straight-line hold errs by ~(ωΔ)²/12
+        (0.8 % at 100 Hz and 2048 Hz); 4 brings it to 0.05 %.
 
     Returns
     -------
