@@ -7,7 +7,10 @@
 """
 from .fit import identify
 from .many import identify_many
+from .nonlinear import fit_nonlinear, predict
+from .nonlinear_result import NonlinearFit
 from .problem import RIG_BOUNDS, SEARCH_RANGES, Problem
 from .result import FitResult
 
-__all__ = ["identify", "identify_many", "FitResult", "Problem", "RIG_BOUNDS", "SEARCH_RANGES"]
+__all__ = ["identify", "identify_many", "fit_nonlinear", "predict", "NonlinearFit", "FitResult", "Problem",
+           "RIG_BOUNDS", "SEARCH_RANGES"]
