@@ -95,7 +95,7 @@ def equivalent_peaks(rig, elements, R, L, levels, band_hz, output="u1") -> np.nd
     f = _grid(band_hz)
     out = []
     for lev in levels:
-        eq = equivalent_rig(r, elements, band_hz, lev, iterations=30, rtol=1e-6)[0] if elements else r
+        eq = equivalent_rig(r, elements, band_hz, lev, iterations=30, rtol=1e-5, n_grid=2500)[0] if elements else r
         out.append(np.max(np.abs(frf(f, eq, outputs=(output,)).channel(output))))
     return np.array(out)
 

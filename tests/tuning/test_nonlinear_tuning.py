@@ -8,7 +8,7 @@ from satmd.errors import DataError
 from satmd.physics import Rig, nonlinear_element
 from satmd.tuning.nonlinear import equivalent_peaks, simulated_peaks, tune_nonlinear
 
-SIM = dict(duration_s=24.0, fs_hz=1024.0, seed=3)
+SIM = dict(duration_s=20.0, fs_hz=1024.0, seed=3)
 
 
 def test_linear_rig_simulated_peak_matches_the_frf_peak():

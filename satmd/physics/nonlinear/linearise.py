@@ -66,7 +66,7 @@ def response_rms(rig: Rig, band_hz=(20.0, 200.0), force_rms: float = 1.0, force=
 
 
 def equivalent_rig(rig: Rig, elements, band_hz=(20.0, 200.0), force_rms: float = 1.0, force=None, fs_hz=None,
-                   iterations: int = 60, rtol: float = 1e-8):
+                   iterations: int = 60, rtol: float = 1e-8, n_grid: int = 6000):
     """The equivalent linear rig at a drive level (statistical linearisation iterated to its fixed point).
 
     Parameters
@@ -76,6 +76,7 @@ def equivalent_rig(rig: Rig, elements, band_hz=(20.0, 200.0), force_rms: float =
     band_hz, force_rms, force, fs_hz : the force, as in `response_rms`.
     iterations : at most this many fixed-point steps (damped by half when they oscillate).
     rtol : stop when the equivalent values change by less than this (relative).
+    n_grid : points of the frequency grid the RMS are integrated on.
 
     Returns
     -------
@@ -83,7 +84,7 @@ def equivalent_rig(rig: Rig, elements, band_hz=(20.0, 200.0), force_rms: float =
         The equivalent rig, the signals' RMS at the fixed point, and one `EquivalentLinear` per element.
     """
     current = rig
-    rms = response_rms(current, band_hz, force_rms, force, fs_hz)
+    rms = response_rms(current, band_hz, force_rms, force, fs_hz, n_grid)
     prev = None
     for it in range(iterations):
         changes, eqs = {}, []
@@ -102,5 +103,5 @@ def equivalent_rig(rig: Rig, elements, band_hz=(20.0, 200.0), force_rms: float =
                 values = {p: 0.5 * (values[p] + prev[p]) for p in values}
         prev = values
         current = rig.replace(**{p: v if np.ndim(v) else float(v) for p, v in values.items()})
-        rms = response_rms(current, band_hz, force_rms, force, fs_hz)
+        rms = response_rms(current, band_hz, force_rms, force, fs_hz, n_grid)
     return current, rms, eqs
