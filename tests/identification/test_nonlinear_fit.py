@@ -11,6 +11,11 @@ from satmd.identification.nonlinear_compare import compare_models
 from satmd.io.recording import Recording
 from satmd.physics import Rig, nonlinear_element
 
+from satmd.physics.nonlinear import kernel
+
+# time-domain fits and direct-simulation tuning run hundreds of simulations: compiled integrator only
+pytestmark = pytest.mark.skipif(not kernel.available, reason="numba not installed (pip install numba)")
+
 TRUE = Rig(m2=0.55, kp=1.2e5, R=30.0, L=0.07)
 KW = dict(duration_s=16.0, fs_hz=1024.0, noise=0.01)
 

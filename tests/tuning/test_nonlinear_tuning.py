@@ -8,6 +8,11 @@ from satmd.errors import DataError
 from satmd.physics import Rig, nonlinear_element
 from satmd.tuning.nonlinear import equivalent_peaks, simulated_peaks, tune_nonlinear
 
+from satmd.physics.nonlinear import kernel
+
+# time-domain fits and direct-simulation tuning run hundreds of simulations: compiled integrator only
+pytestmark = pytest.mark.skipif(not kernel.available, reason="numba not installed (pip install numba)")
+
 SIM = dict(duration_s=20.0, fs_hz=1024.0, seed=3)
 
 
