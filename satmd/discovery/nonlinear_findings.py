@@ -46,6 +46,12 @@ def _distortion_tests(recordings, alpha):
     return tests
 
 
+def _inner(freq, share: float = 0.05):
+    """Points of ``freq`` away from its two ends by ``share`` of the span."""
+    lo, hi = freq[0], freq[-1]
+    return (freq >= lo + share * (hi - lo)) & (freq <= hi - share * (hi - lo))
+
+
 def _hint(test: NonlinearTest) -> str:
     """Where the distortion is and what carries it, in words."""
     where = ", ".join(f"{a:.1f}–{b:.1f} Hz" for a, b in test.bands_hz) or "the band"
@@ -87,8 +93,12 @@ def analyse_recordings(recordings, rig=None, free=DEFAULT_FREE, alpha: float = 1
         grid = on_common_grid(datas)
         if grid is not None:
             freq, datas = grid
-            lt = level_dependence(freq, [d.channels for d in datas], [d.std for d in datas], alpha / 2,
-                                  model_errors=[d.meta.get("model_error") for d in datas])
+            inner = _inner(freq)  # the band edges, where the force falls off, carry the estimator's own errors
+            lt = level_dependence(freq[inner], [{c: v[inner] for c, v in d.channels.items()} for d in datas],
+                                  [{c: v[inner] for c, v in d.std.items()} for d in datas], alpha / 2,
+                                  model_errors=[{c: np.asarray(v)[inner] for c, v in (d.meta.get("model_error")
+                                                                                      or {}).items()}
+                                                for d in datas])
             level_test = NonlinearTest(lt.name, lt.p_value, concentrated_bands(lt), lt.alpha, lt.details)
             tests.append(level_test)
     detected = any(t.significant for t in tests)

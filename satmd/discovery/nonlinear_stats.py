@@ -264,7 +264,8 @@ def level_dependence(freq, frfs: list, stds: list, alpha: float = 1e-3, name: st
     alpha : level
     name : test name in the report
     dof_noise : degrees of freedom behind the stds (None: known)
-    rel_floor : relative error added to each std (estimator model error: ``rel_floor |H|``)
+    rel_floor : relative error added to each std (estimator model error: ``rel_floor |H|``, with
+        |H| at least 5 % of its peak)
     model_errors : optional list over records of {channel: (M,) estimated model error of the estimate}
         (e.g. local polynomial degree 2 vs 3), added to the std in quadrature
 
@@ -295,7 +296,9 @@ def level_dependence(freq, frfs: list, stds: list, alpha: float = 1e-3, name: st
         if model_errors is not None:
             sd = np.hypot(sd, np.stack([np.asarray((m or {}).get(c, 0.0), float) * np.ones(len(freq))
                                         for m in model_errors]))
-        w = 1.0 / np.maximum(sd ** 2 + (rel_floor * np.abs(H)) ** 2, 1e-300)
+        # estimator error scales with the FRF's dynamic range: near an antiresonance it is not relative to |H|
+        level = np.maximum(np.abs(H), 0.05 * np.abs(H).max(axis=1, keepdims=True))
+        w = 1.0 / np.maximum(sd ** 2 + (rel_floor * level) ** 2, 1e-300)
         mean = np.sum(w * H, axis=0) / np.sum(w, axis=0)  # weighted mean, the "one linear system" estimate
         chi = np.sum(w * np.abs(H - mean) ** 2, axis=0)  # χ² with 2(k-1) dof per point
         if dof_noise:
