@@ -18,7 +18,6 @@ Other variables are ignored with a warning. ``.npz`` files are opened with
 """
 from __future__ import annotations
 
-import io as _io
 import math
 import struct
 import zipfile
@@ -30,7 +29,7 @@ import numpy as np
 from ..errors import DataError, FormatError
 from ._common import read_bytes, short_error, warn
 from .atomic import atomic_write
-from .limits import MAX_BINARY_BYTES, check_samples, size_text
+from .limits import MAX_BINARY_BYTES, MAX_SAMPLES, check_file, check_samples, size_text
 from .frfdata import CHANNELS, FRFData
 
 RECORDING_NAMES = ("force", "acc1", "acc2")
@@ -39,25 +38,36 @@ RECORDING_NAMES = ("force", "acc1", "acc2")
 def load_variables(path) -> dict:
     """name -> ndarray for a .mat or .npz file; anything unreadable is a FormatError."""
     path = Path(path)
-    raw = read_bytes(path)  # missing / empty / unreadable files get the common messages
     if path.suffix.lower() == ".npz":
+        if check_file(path, MAX_BINARY_BYTES) == 0:  # missing, a FIFO, a device, too large: refused unopened
+            raise FormatError(path, "empty file")
         try:
-            z = np.load(_io.BytesIO(raw), allow_pickle=False)  # from memory: no file handle left open
-            if not hasattr(z, "files"):
-                raise FormatError(path, "a single .npy array, not an .npz archive of named arrays")
-            with z:
-                total = sum(info.file_size for info in z.zip.infolist())
-                if total > MAX_BINARY_BYTES:
-                    raise FormatError(path, f"the archive unpacks to {size_text(total)}: more than the "
-                                            f"{size_text(MAX_BINARY_BYTES)} satmd reads from one file")
-                return {k: np.asarray(z[k]) for k in z.files}
+            with open(path, "rb") as fh:
+                z = np.load(fh, allow_pickle=False)  # lazily: the directory is checked before any member is read
+                if not hasattr(z, "files"):
+                    raise FormatError(path, "a single .npy array, not an .npz archive of named arrays")
+                with z:
+                    _check_members(path, z.zip.infolist())
+                    return {k: np.asarray(z[k]) for k in z.files}
         except FormatError:
             raise
         except (zipfile.BadZipFile, EOFError):
             raise FormatError(path, "not a NumPy .npz archive (corrupt or truncated zip)") from None
         except Exception as exc:  # noqa: BLE001 - numpy and zipfile raise many kinds
             raise FormatError(path, f"cannot read .npz archive ({short_error(exc)})") from None
-    return read_mat5(path, raw)
+    return read_mat5(path, read_bytes(path))
+
+
+def _check_members(path, infos):
+    """Refuse an archive whose members unpack beyond what satmd reads (sizes from the zip directory)."""
+    total = sum(info.file_size for info in infos)
+    if total > MAX_BINARY_BYTES:
+        raise FormatError(path, f"the archive unpacks to {size_text(total)}: more than the "
+                                f"{size_text(MAX_BINARY_BYTES)} satmd reads from one file")
+    for info in infos:
+        if info.file_size > 16 * MAX_SAMPLES + 4096:  # complex doubles, plus the .npy header
+            raise FormatError(path, f"array {info.filename[:-4]!r} unpacks to {size_text(info.file_size)}: more "
+                                    f"than the {MAX_SAMPLES} values satmd reads at once")
 
 
 # --- MATLAB v5 (-v6, -v7) reader ------------------------------------------------
@@ -154,7 +164,10 @@ def _matrix(path, data, order, out):
         raise FormatError(path, f"corrupt MATLAB variable {name!r} (dimensions {dims})")
     if cls not in _NUMERIC_CLASSES and cls != _CHAR_CLASS:
         return  # cell, struct, object, sparse: nothing satmd reads
-    count = math.prod(dims)  # Python integers: dimensions whose product overflows int64 are refused below
+    count = math.prod(dims)  # Python integers: dimensions whose product overflows int64 are refused here
+    if count > MAX_SAMPLES:
+        raise FormatError(path, f"MATLAB variable {name!r} has {count:.4g} values (dimensions {dims}): more than the "
+                                f"{MAX_SAMPLES} satmd reads at once")
 
     def values(k):
         if len(parts) <= k:

@@ -16,7 +16,7 @@ import numpy as np
 from ..errors import DataError, FormatError
 from ._common import channel_map_of, read_bytes, warn
 from .atomic import atomic_write
-from .limits import check_samples
+from .limits import MAX_BINARY_BYTES, check_file, check_samples
 from .recdata import MAP_ALIASES, ROLES, SI_UNITS, Recording, warn_clipping
 
 _WAV_ROLES = {3: ("force", "acc1", "acc2"), 2: ("acc1", "acc2")}
@@ -30,8 +30,12 @@ def read_recording_wav(path, channel_map=None, scale=None) -> Recording:
     from scipy.io import wavfile
 
     path = Path(path)
+    size = check_file(path, MAX_BINARY_BYTES)
+    if size == 0:
+        raise FormatError(path, "empty file")
+    with open(path, "rb") as fh:  # the header first: sizes and the sample cap are checked before the data are read
+        _check_layout(path, fh.read(1 << 16), size)
     raw = read_bytes(path)
-    _check_layout(path, raw)
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")  # unknown chunks; we report what matters ourselves
@@ -135,14 +139,17 @@ def _wav_comment(raw: bytes) -> str:
     return ""
 
 
-def _check_layout(path, raw: bytes):
-    """Sizes the RIFF header declares, checked against the bytes there are, and the sample cap (before decoding)."""
+def _check_layout(path, raw: bytes, total: int):
+    """Sizes the RIFF header declares, checked against the file's ``total`` bytes, and the sample cap.
+
+    ``raw`` is the start of the file (the chunk headers before the data).
+    """
     if len(raw) < 12 or raw[:4] not in (b"RIFF", b"RIFX", b"RF64") or raw[8:12] != b"WAVE":
         raise FormatError(path, "not a WAV file (no RIFF/WAVE header)")
     order = ">" if raw[:4] == b"RIFX" else "<"
     declared = struct.unpack(order + "I", raw[4:8])[0] + 8
-    if raw[:4] != b"RF64" and declared > len(raw):
-        warn(path, f"the RIFF header declares {declared} bytes, the file holds {len(raw)}: truncated?")
+    if raw[:4] != b"RF64" and declared > total:
+        warn(path, f"the RIFF header declares {declared} bytes, the file holds {total}: truncated?")
     pos, channels, block = 12, None, None
     while pos + 8 <= len(raw):
         cid, size = raw[pos:pos + 4], struct.unpack(order + "I", raw[pos + 4:pos + 8])[0]
@@ -150,9 +157,9 @@ def _check_layout(path, raw: bytes):
             channels = struct.unpack(order + "H", raw[pos + 10:pos + 12])[0]
             block = struct.unpack(order + "H", raw[pos + 20:pos + 22])[0]
         elif cid == b"data":
-            if raw[:4] != b"RF64" and pos + 8 + size > len(raw):
+            if raw[:4] != b"RF64" and pos + 8 + size > total:
                 raise FormatError(path, f"truncated WAV file: the data chunk declares {size} bytes, the file holds "
-                                        f"{len(raw) - pos - 8} after its header")
+                                        f"{total - pos - 8} after its header")
             if channels and block:
                 check_samples(path, size // block, channels, path=path)
             return
