@@ -305,7 +305,8 @@ class InverseModel:
             message = check_message(out, out["R"], out["L"], self.rig_or_default)
             if message:
                 warnings.warn(message, DataWarning, stacklevel=2)
-        message = trust_check(out, self.bounds, self.std_scale_)  # std finite, >= 0 and saying something
+        # std finite, >= 0 and saying something (the optimization kind has no calibration: factors 1)
+        message = trust_check(out, self.bounds, getattr(self, "std_scale_", np.ones(2)))
         if message:
             warnings.warn(message, DataWarning, stacklevel=2)
         return out
