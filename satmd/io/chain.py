@@ -118,6 +118,8 @@ def lpm_findings(freq_hz, channels: dict, std: dict, settings: dict, force_noise
                 f"outside the excited band and removed",
                 "a cleaner force signal (higher excitation level or a quieter load cell)", corrected=True))
     found += _unseen_floor(channels, std, settings, bias_bound)
+    found += _lines(settings.get("lines_removed_hz") or {}, settings.get("line_windows_hz") or [],
+                    settings["window_hz"])
     lo, hi = settings["band_hz"]
     req_lo, req_hi = requested_band or (None, None)
     cut = [f"{a:g}–{b:g} Hz" for a, b in ((req_lo, lo), (hi, req_hi))
@@ -129,6 +131,30 @@ def lpm_findings(freq_hz, channels: dict, std: dict, settings: dict, force_noise
             f"force and were left out",
             "widen the excitation band of the shaker signal"))
     return found
+
+
+def _lines(removed: dict, dropped: list, window_hz: float) -> list[MeasurementFinding]:
+    """Lines in the responses that the force does not explain: removed from the record, or windows dropped."""
+    freqs = sorted({round(f, 2) for fs in removed.values() for f in fs} | {round(f, 2) for f in dropped})
+    if not freqs:
+        return []
+    tol = max(window_hz, 0.5)
+    mains = [m for m in (50.0, 60.0) if all(min(abs(f - k * m) for k in range(1, int(f / m) + 2)) <= tol
+                                               for f in freqs)]
+    where = ", ".join(f"{f:.2f}" for f in freqs[:12]) + (" ..." if len(freqs) > 12 else "")
+    did = []
+    if removed:
+        did.append(f"{sum(len(v) for v in removed.values())} sinusoid(s) fitted and subtracted from "
+                   f"{', '.join(sorted(removed))}")
+    if dropped:
+        did.append(f"{len(dropped)} estimate window(s) still carrying a line left out")
+    what = f"lines at multiples of {mains[0]:g} Hz (mains hum)" if mains else "narrow lines"
+    return [MeasurementFinding(
+        "mains_hum" if mains else "narrowband_interference",
+        f"the responses carry {what} that the force does not explain, at {where} Hz: {'; '.join(did)}. They are "
+        f"the sensor chain's, not the structure's",
+        "check grounding and shielding of the accelerometer cables (ground loop), or use differential inputs"
+        if mains else "look for electrical pick-up or a rotating machine nearby", corrected=True)]
 
 
 def _unseen_floor(channels, std, settings, bias_bound) -> list[MeasurementFinding]:

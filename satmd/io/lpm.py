@@ -41,6 +41,7 @@ import numpy as np
 from ..validation import Interval, Whole, validate_params
 from ..conventions import RECORDING_CHANNELS
 from ..errors import DataError
+from .forcefloor import force_noise_floor, true_runs as _runs
 
 _RESPONSES = RECORDING_CHANNELS
 
@@ -116,88 +117,6 @@ def _excited(force, fs_hz, smooth_hz=1.0, drop_db=20.0) -> dict:
     return {"lo": float(f[i0]), "hi": float(f[i1]), "i0": i0, "i1": i1, "level": float(level), "floor": verdict}
 
 
-def force_noise_floor(power: np.ndarray, f: np.ndarray, start: int, level: float) -> dict:
-    """The force sensor's noise floor above the excited band, only where the spectrum shows one.
-
-    A shaker's force does not stop at the band edge: it rolls off (gently or
-    steeply, with the shaker's own resonance, pink or coloured), and a roll-off
-    is not noise. The noise floor is where the spectrum stops falling: above
-    ``start`` the periodogram is cut into blocks whose level is the block median
-    / ln 2 (the mean of exponential bins, robust to hum lines); the floor is the
-    longest run of blocks that is flat within their scatter, ends in the lowest
-    levels, spans at least half an octave and lies 30 dB under the excitation.
-    Otherwise the floor cannot be told from the signal: no floor, and
-    ``bound`` = the lowest block level, an upper bound on it (signal + noise ≥
-    noise), from which the bias that was *not* corrected can be bounded.
-
-    Parameters
-    ----------
-    power : |X_k|² of the force (rfft bins).
-    f : frequencies of the bins [Hz].
-    start : first bin clear of the excited band.
-    level : the excitation's typical per-bin power.
-
-    Returns
-    -------
-    dict
-        ``floor`` (per-bin E|N_k|², or None), ``bound`` (per-bin upper bound or None), ``status``
-        (``estimated``, ``no_plateau``, ``not_below_excitation`` or ``no_region``), ``slope_db_per_octave``
-        (of the spectrum's last stretch, when there is no floor) and ``span_hz``.
-    """
-    region = power[start:]
-    m = max(32, region.size // 48)
-    n_blocks = region.size // m
-    if n_blocks < 6:
-        return {"floor": None, "bound": None, "status": "no_region", "slope_db_per_octave": None, "span_hz": None}
-    blocks = region[: n_blocks * m].reshape(n_blocks, m)
-    fb = f[start: start + n_blocks * m].reshape(n_blocks, m).mean(axis=1)
-    lev = np.median(blocks, axis=1) / np.log(2)
-    db = 10 * np.log10(np.maximum(lev, 1e-300))
-    sd = 10 / np.log(10) * 1.25 / np.sqrt(m)  # scatter of a block median's level [dB]
-    tol = max(1.0, 3.0 * sd)
-    bound = float(lev.min() * (1 + 3 * 1.25 / np.sqrt(m)))
-    ref = np.percentile(db, 10)
-    near = db <= ref + tol
-    best = max(_runs(near, bridge=1), key=lambda r: r[1] - r[0])
-    r0, r1 = best
-    run = slice(r0, r1 + 1)
-    octaves = np.log2(fb[r1] / max(fb[r0], 1e-300))
-    slope = None
-    flat = False
-    if r1 - r0 + 1 >= 6 and octaves >= 0.5:
-        x = np.log2(fb[run])
-        slope = float(np.polyfit(x, db[run], 1)[0])
-        flat = abs(slope) * octaves <= tol
-    out = {"bound": bound, "span_hz": [float(fb[r0]), float(fb[r1])], "slope_db_per_octave": slope}
-    if not flat:
-        tail = slice(max(0, n_blocks - max(6, n_blocks // 4)), n_blocks)
-        x = np.log2(fb[tail])
-        out["slope_db_per_octave"] = float(np.polyfit(x, db[tail], 1)[0]) if np.ptp(x) > 0 else None
-        return {**out, "floor": None, "status": "no_plateau"}
-    floor = float(np.median(blocks[run]) / np.log(2))
-    out["floor_rel_std"] = float(1.25 / np.sqrt(blocks[run].size))
-    if floor * 1e3 >= level:  # not 30 dB below the excitation: a flat stretch of force, not noise
-        return {**out, "floor": None, "status": "not_below_excitation"}
-    return {**out, "floor": floor, "status": "estimated"}
-
-
-def _runs(mask, bridge):
-    runs, start, gap = [], None, 0
-    for i, m in enumerate(mask):
-        if m:
-            if start is None:
-                start = i
-            end, gap = i, 0
-        elif start is not None:
-            gap += 1
-            if gap > bridge:
-                runs.append((start, end))
-                start, gap = None, 0
-    if start is not None:
-        runs.append((start, end))
-    return runs
-
-
 @validate_params({"width_hz": [None, Interval(Real, 0, open="lo")], "degree": [Interval(Whole, 0)]})
 def lpm(recording, band=None, width_hz: float | None = None, degree: int = 2, smooth: int = 10) -> LPMEstimate:
     """LPM FRF estimates a1 = acc1/force, a2 = acc2/force on non-overlapping windows.
@@ -227,7 +146,6 @@ def lpm(recording, band=None, width_hz: float | None = None, degree: int = 2, sm
     from .recdata import check_rate
 
     check_rate(recording.meta.get("source", "recording"), recording.fs_hz)  # entry check (time in ms, ...)
-
     fs, n = recording.fs_hz, recording.n_samples
     x = recording["force"]
     found = _excited(x, fs)
@@ -292,31 +210,68 @@ def _local_fits(spectra, fs, n, lo, hi, width_hz, degree, smooth, verdict) -> LP
     elif verdict["bound"] is not None:
         bound = np.minimum(verdict["bound"] / np.maximum(sxx - verdict["bound"], 1e-300 * sxx + 1e-300), 1.0)
     out_h, out_std, out_coh, dof = {}, {}, {}, None
-    raw_h, resid, var = {}, {}, {}
+    raw_h, resid, var, raw_s2 = {}, {}, {}, {}
     for name, ch in _RESPONSES.items():
         if name not in spectra:
             continue
         Y = spectra[name][idx]
         theta = _solve(Q, Rinv, Y)
-        h = theta[:, 0] / xscale
+        raw_h[ch] = theta[:, 0] / xscale
         resid[ch] = Y - np.einsum("mwp,mp->mw", K, theta)
-        s2 = np.sum(np.abs(resid[ch]) ** 2, axis=1) / max(q, 1)
-        v, dof = _smooth_noise(s2, np.abs(h) ** 2, q, smooth)
-        raw_h[ch], var[ch] = h, v
-        out_h[ch] = h * (1.0 + bias)  # errors in variables: the force noise pulled H towards zero
-        out_std[ch] = np.sqrt(v * c00 / 2.0)
+        raw_s2[ch] = np.sum(np.abs(resid[ch]) ** 2, axis=1) / max(q, 1)
+    keep = np.ones(centres.size, bool)
+    lev = np.sum(np.abs(Q) ** 2, axis=2)  # hat-matrix diagonal per window and bin
+    for _ in range(3):  # lines (mains hum, ...) leave windows with one or two bins far above the noise
+        for ch in raw_h:
+            var[ch], dof = _smooth_noise(raw_s2[ch], np.abs(raw_h[ch]) ** 2, q, smooth, keep)
+        lines = _line_windows(resid, var, lev, raw_s2, q, freq, 0.5 * width * df) & keep
+        if not np.any(lines):
+            break
+        keep &= ~lines
+    for ch, h in raw_h.items():
+        v = var[ch]
+        out_h[ch] = (h * (1.0 + bias))[keep]  # errors in variables: the force noise pulled H towards zero
+        out_std[ch] = np.sqrt(v * c00 / 2.0)[keep]
         signal = np.abs(h) ** 2 * sxx
-        out_coh[ch] = signal / (signal + v)
+        out_coh[ch] = (signal / (signal + v))[keep]
     correlation = {}
     if len(raw_h) == 2:
-        correlation["a1,a2"] = _channel_correlation(resid, raw_h, var, q, smooth)
+        correlation["a1,a2"] = _channel_correlation(resid, raw_h, var, q, smooth)[keep]
+    dropped = [float(x) for x in freq[~keep]]
+    freq, bias, bound = freq[keep], bias[keep], bound[keep]
     settings = {"method": "lpm", "record_s": n / fs, "bins_per_window": width, "window_hz": width * df,
                 "degree": degree, "noise_dof_per_window": q, "noise_dof": dof, "smooth_windows": 2 * smooth + 1,
                 "band_hz": [float(lo), float(hi)], "force_noise_floor": floor,
                 "force_noise_status": verdict["status"], "force_noise_bound": verdict["bound"],
                 "force_noise_slope_db_per_octave": verdict["slope_db_per_octave"],
-                "force_noise_span_hz": verdict["span_hz"]}
+                "force_noise_span_hz": verdict["span_hz"], "line_windows_hz": dropped}
     return LPMEstimate(freq, out_h, out_std, out_coh, bias, settings, correlation, bound)
+
+
+def _line_windows(resid, var, lev, s2, q, freq, half_hz, alpha: float = 1e-3):
+    """Windows holding a spectral line the force does not explain (mains hum, a pick-up tone).
+
+    Each residual bin, standardised by the noise model and its leverage, is
+    exponential: |r_k|² / (σ² (1 − h_k)) ~ Exp(1). A bin beyond ln(bins / α) is
+    not noise (Bonferroni at ``alpha``). A line puts one or two such bins in a
+    window (two when it falls between bins); a window with more is a polynomial
+    that cannot follow the FRF, which is not the sensor chain's and is kept,
+    unless the window holds a multiple of 50 or 60 Hz and its residual fails
+    the χ²_{2q} test: a strong hum line spreads over the whole window's fit.
+    """
+    from scipy import stats
+
+    mains = np.zeros(freq.size, bool)
+    for m in (50.0, 60.0):
+        mains |= np.abs(freq - m * np.maximum(np.round(freq / m), 1.0)) <= half_hz + 0.05
+    out = None
+    for ch, r in resid.items():
+        z = np.abs(r) ** 2 / np.maximum(var[ch][:, None] * (1.0 - lev), 1e-300)
+        count = np.sum(z > np.log(r.size / alpha), axis=1)
+        limit = stats.chi2.isf(alpha / max(freq.size, 1), 2 * max(q, 1)) / (2 * max(q, 1))
+        hit = ((count >= 1) & (count <= 2)) | (mains & (s2[ch] > limit * var[ch]))
+        out = hit if out is None else out | hit
+    return out
 
 
 def _channel_correlation(resid, h, var, q, half):
@@ -344,21 +299,23 @@ def _solve(Q, Rinv, Y):
     return np.einsum("mpk,mk->mp", Rinv, qy)
 
 
-def _smooth_noise(s2, g, q, half):
+def _smooth_noise(s2, g, q, half, keep=None):
     """Smooth E|V|² = a + b g (g = |H|²) by local weighted least squares; returns (variance, dof).
 
     Each raw s2 is a mean of q exponential-like terms, so its variance is
     ∝ (a + b g)²/q: the fit is weighted by the current model's inverse square and
-    refined once. Negative a or b fall back to the one-term fit.
+    refined once. Negative a or b fall back to the one-term fit. Windows outside
+    ``keep`` (lines) get no weight.
     """
+    mask = np.ones_like(s2) if keep is None else keep.astype(float)
     kernel = np.ones(2 * min(half, (s2.size - 1) // 2) + 1)  # 'same' keeps the length only if kernel ≤ data
 
     def local(v):
         return np.convolve(v, kernel, mode="same")
 
-    model = np.full_like(s2, np.median(s2))
+    model = np.full_like(s2, np.median(s2[mask > 0]) if mask.any() else np.median(s2))
     for _ in range(3):
-        w = 1.0 / np.maximum(model, 1e-300) ** 2
+        w = mask / np.maximum(model, 1e-300) ** 2
         s00, s01, s11 = local(w), local(w * g), local(w * g * g)
         t0, t1 = local(w * s2), local(w * g * s2)
         det = s00 * s11 - s01 * s01
@@ -366,13 +323,13 @@ def _smooth_noise(s2, g, q, half):
             a = (t0 * s11 - t1 * s01) / det
             b = (s00 * t1 - s01 * t0) / det
         bad = ~np.isfinite(a) | ~np.isfinite(b) | (a < 0) | (b < 0)
-        a_only, b_only = t0 / s00, t1 / np.maximum(s11, 1e-300)
+        a_only, b_only = t0 / np.maximum(s00, 1e-300), t1 / np.maximum(s11, 1e-300)
         res_a = local(w * (s2 - a_only * 1.0) ** 2)
         res_b = local(w * (s2 - b_only * g) ** 2)
         use_a = res_a <= res_b
         a = np.where(bad, np.where(use_a, a_only, 0.0), a)
         b = np.where(bad, np.where(use_a, 0.0, b_only), b)
         model = np.maximum(a + b * g, 1e-300)
-    counts = local(np.ones_like(s2))
+    counts = local(mask)
     dof = float(2 * max(q, 1) * np.median(counts) - 4)
     return model, dof

@@ -23,6 +23,13 @@ rig, since the impulse response comes from `satmd.physics.frf` with effects.
 Noise. Independent white Gaussian noise on *every* channel: ``noise`` × RMS on
 each accelerometer and ``force_noise`` × RMS on the force (default half of
 ``noise``: a load cell is usually cleaner than an accelerometer, never perfect).
+
+Lab conditions (`satmd.io.conditions`). ``force_spectrum=ForceSpectrum(...)``
+shapes the random force as a shaker does (roll-off, high-pass, pink colour,
+armature resonance) instead of cutting it sharply at the band edges;
+``sensor_noise=SensorNoise(...)`` adds pink noise, drift and mains hum to the
+accelerometers. The recorded force passes the same anti-aliasing roll-off as the
+responses, as in a real acquisition system.
 """
 from __future__ import annotations
 
@@ -44,7 +51,8 @@ _RESPONSES = tuple((ch, name) for name, ch in RECORDING_CHANNELS.items())
 def simulate_recording(duration_s: float = 60.0, fs_hz: float = 1000.0, rig: Rig | None = None,
                        effects: Sequence = (), band_hz=(20.0, 200.0), force_rms: float = 1.0,
                        noise: float = 0.0, seed: int | None = None, excitation: str = "random",
-                       force_noise: float | None = None, burn_in_s: float = 0.0) -> Recording:
+                       force_noise: float | None = None, burn_in_s: float = 0.0, force_spectrum=None,
+                       sensor_noise=None) -> Recording:
     """A recording of force, acc1, acc2 for a force on the primary mass (see the module docstring).
 
     Parameters
@@ -73,6 +81,10 @@ def simulate_recording(duration_s: float = 60.0, fs_hz: float = 1000.0, rig: Rig
         Force-sensor noise std relative to the force RMS (default ``noise / 2``).
     burn_in_s : float
         Time the rig is excited before the record starts (0: the record starts at rest).
+    force_spectrum : ForceSpectrum, optional
+        Shape of the random force (`satmd.io.conditions`; default: flat, cut sharply at the band edges).
+    sensor_noise : SensorNoise, optional
+        Pink noise, drift and mains hum on the accelerometers (default: white noise only).
 
     Returns
     -------
@@ -110,10 +122,10 @@ def simulate_recording(duration_s: float = 60.0, fs_hz: float = 1000.0, rig: Rig
         total = n + burn
         if excitation == "random":
             # the force goes on after the record ends: the anti-aliasing roll-off looks a few ms ahead
-            force = _random_force(total + int(fs_hz), fs_hz, lo, hi, rng)
+            force = _random_force(total + int(fs_hz), fs_hz, lo, hi, rng, force_spectrum)
         else:
             force = _sweep(total, fs_hz, lo, hi)
-        clean = {"force": force, **_convolve(force, fs_hz, rig, effects, hi)}
+        clean = {"force": force, **_convolve(force, fs_hz, rig, effects, hi)}  # force: anti-aliased as recorded
         clean = {k: v[burn:total] for k, v in clean.items()}
     gain = force_rms / np.sqrt(np.mean(clean["force"] ** 2))  # linear: one scale for all channels
     signals = {}
@@ -122,11 +134,17 @@ def simulate_recording(duration_s: float = 60.0, fs_hz: float = 1000.0, rig: Rig
         rel = force_noise if name == "force" else noise
         if rel:
             x = x + rel * np.sqrt(np.mean(x * x)) * rng.standard_normal(n)
+        if sensor_noise is not None and name != "force":
+            x = x + sensor_noise.sample(n, fs_hz, np.sqrt(np.mean(x * x)), rng)
         signals[name] = x
     meta = {"generator": "satmd simulate --time", "excitation": excitation, "band_hz": f"{lo:g}:{hi:g}",
             "force_rms": f"{force_rms:g}", "noise": f"{noise:g}", "force_noise": f"{force_noise:g}",
             "burn_in_s": f"{burn_in_s:g}", "seed": str(seed)}
     meta.update({k: f"{float(v):.12g}" for k, v in rig.as_dict().items()})
+    if force_spectrum is not None:
+        meta["force_spectrum"] = ", ".join(f"{k}={v}" for k, v in force_spectrum.to_dict().items())
+    if sensor_noise is not None:
+        meta["sensor_noise"] = ", ".join(f"{k}={v}" for k, v in sensor_noise.to_dict().items())
     for eff in effects:
         meta[f"effect {eff.name}"] = ", ".join(f"{k}={float(v):.12g}" for k, v in eff.params.items())
     return Recording(fs_hz, signals, {"force": "N", "acc1": "m/s^2", "acc2": "m/s^2"}, meta)
@@ -138,12 +156,18 @@ def recording_memory(duration_s: float, fs_hz: float, burn_in_s: float = 0.0) ->
     return 2.0e4 * fs_hz + 400.0 * ((duration_s + burn_in_s) * fs_hz + fs_hz)
 
 
-def _random_force(n, fs_hz, lo, hi, rng) -> np.ndarray:
-    """Band-limited Gaussian noise, filtered on a record 4x longer and cut: not periodic in n samples."""
+def _random_force(n, fs_hz, lo, hi, rng, shape=None) -> np.ndarray:
+    """Band-limited Gaussian noise, filtered on a record 4x longer and cut: not periodic in n samples.
+
+    ``shape`` (a `ForceSpectrum`) gives the shaker's amplitude response; default: flat, cut at lo and hi.
+    """
     m = 4 * n
     spectrum = np.fft.rfft(rng.standard_normal(m))
     f = np.fft.rfftfreq(m, 1.0 / fs_hz)
-    spectrum[(f < lo) | (f > hi)] = 0.0
+    if shape is None:
+        spectrum[(f < lo) | (f > hi)] = 0.0
+    else:
+        spectrum *= shape.amplitude(f, lo, hi)
     start = int(rng.integers(0, m - n))
     return np.fft.irfft(spectrum, m)[start:start + n]
 
@@ -169,7 +193,9 @@ def _convolve(force, fs_hz, rig, effects, pass_hz=0.0) -> dict:
     f = np.fft.rfftfreq(size, 1.0 / fs_hz)
     h = _frf_with_dc(f, rig, effects, pass_hz)
     spectrum = np.fft.rfft(force, size)
-    return {name: np.fft.irfft(h[ch] * spectrum, size)[:n] for ch, name in _RESPONSES}
+    out = {name: np.fft.irfft(h[ch] * spectrum, size)[:n] for ch, name in _RESPONSES}
+    out["force"] = np.fft.irfft(h["rolloff"] * spectrum, size)[:n]  # the same anti-aliasing as the responses
+    return out
 
 
 def _impulse_length(fs_hz, rig, effects, pass_hz, max_s: float = 120.0) -> int:
@@ -204,6 +230,7 @@ def _frf_with_dc(f, rig, effects, pass_hz) -> dict:
         h = np.zeros(f.size, dtype=complex)
         h[1:] = r.channel(ch) * rolloff[1:]
         out[ch] = h
+    out["rolloff"] = rolloff
     return out
 
 
