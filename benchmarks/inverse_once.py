@@ -24,7 +24,7 @@ METHODS = {"old": {"calibration": "holdout", "jacobian": "fd"}, "new": {}}
 TARGET_S = 30.0  # issue 29: paper preset, physics, default settings, wall seconds on the 2-core machine
 
 
-def fit_and_score(method: str, seed: int, threads: int, noise: float, blind) -> dict:
+def fit_and_score(method: str, seed: int, threads: int, noise: float, blind, run: str = "") -> dict:
     """One default paper-preset physics fit by ``method``: wall and CPU seconds, Table 2 and blind-set scores."""
     import os
 
@@ -41,22 +41,13 @@ def fit_and_score(method: str, seed: int, threads: int, noise: float, blind) -> 
     t2 = evaluate(model)
     b = evaluate(model, blind, noise, 0)
     info = model.fit_info_
-    extra = {}
-    if info.get("held_out"):  # the same nets, every member in every mean (no held-out rule)
-        import copy
-
-        plain = copy.copy(model)
-        plain.fit_info_ = {k: v for k, v in info.items() if k != "held_out"}
-        pt, pb = evaluate(plain), evaluate(plain, blind, noise, 0)
-        extra = {"all_members": {"table2_mae_R": pt["mae_R"], "table2_mae_L": pt["mae_L"], "blind_mae_R": pb["mae_R"],
-                                 "blind_mae_L": pb["mae_L"], "coverage": pb["coverage"]}}
-    return {**extra, "method": method, "seed": seed, "threads": threads, "noise": noise, "wall_s": wall, "cpu_s": cpu,
+    return {"method": method, "seed": seed, "threads": threads, "noise": noise, "wall_s": wall, "cpu_s": cpu,
             "load_1min_before": load, "load_1min_after": os.getloadavg()[0],
             "table2_mae_R": t2["mae_R"], "table2_mae_L": t2["mae_L"], "blind_mae_R": b["mae_R"],
             "blind_mae_L": b["mae_L"], "coverage": b["coverage"], "coverage_R": b["coverage_R"],
             "coverage_L": b["coverage_L"], "n_blind": b["n"], "std_scale": list(map(float, model.std_scale_)),
             "calibration": info.get("calibration"), "val_coverage_2sd": info.get("val_coverage_2sd"),
-            "settings": METHODS[method], "date": time.strftime("%Y-%m-%d %H:%M:%S")}
+            "settings": METHODS[method], "date": time.strftime("%Y-%m-%d %H:%M:%S"), "run": run}
 
 
 def member_batching(steps: int = 60) -> dict:
@@ -115,18 +106,15 @@ def summarise(records: list) -> dict:
     out = {"seeds": seeds, "per_seed": [], "timing": [], "coverage": []}
     for s in seeds:
         o, n = by[("old", s, 1, 0.0)], by[("new", s, 1, 0.0)]
-        out["per_seed"].append({"seed": s, **{f"{m}_{k}": r[k] for m, r in (("old", o), ("new", n))
-                                              for k in ("table2_mae_R", "table2_mae_L", "blind_mae_R",
-                                                        "blind_mae_L", "wall_s", "cpu_s")}})
+        out["per_seed"].append({"seed": s, "same_run": o.get("run") == n.get("run"),
+                                **{f"{m}_{k}": r[k] for m, r in (("old", o), ("new", n))
+                                   for k in ("table2_mae_R", "table2_mae_L", "blind_mae_R", "blind_mae_L", "wall_s",
+                                             "cpu_s")}})
     for k in ("table2_mae_R", "table2_mae_L", "blind_mae_R", "blind_mae_L"):
         for m in ("old", "new"):
             out[f"{m}_mean_{k}"] = float(np.mean([by[(m, s, 1, 0.0)][k] for s in seeds])) if seeds else None
-    alt = [by[("new", s, 1, 0.0)].get("all_members") for s in seeds]
-    if seeds and all(alt):  # the same nets with every member in every mean: the held-out rule measured
-        for k in ("table2_mae_R", "table2_mae_L", "blind_mae_R", "blind_mae_L"):
-            out[f"new_all_members_mean_{k}"] = float(np.mean([a[k] for a in alt]))
     for (m, s, t, z), r in sorted(by.items()):
-        if m == "new" and z == 0 and ("old", s, t, z) in by:
+        if m == "new" and z == 0 and ("old", s, t, z) in by and by[("old", s, t, z)].get("run") == r.get("run"):
             o = by[("old", s, t, z)]
             out["timing"].append({"seed": s, "threads": t, "old_wall_s": o["wall_s"], "new_wall_s": r["wall_s"],
                                   "old_cpu_s": o["cpu_s"], "new_cpu_s": r["cpu_s"],
@@ -174,6 +162,7 @@ def run_once(seeds, thread_counts, coverage_noise, methods=("old", "new")) -> di
     from satmd.inverse import BLIND_PAIRS, pairs_dataset
 
     blind = pairs_dataset(BLIND_PAIRS, per_pair=40, seed=1000)
+    run = time.strftime("%Y-%m-%dT%H:%M:%S")  # timings are compared only within one run
     jobs = [(s, 1, 0.0) for s in seeds]
     jobs += [(seeds[0], t, 0.0) for t in thread_counts if t != 1]
     if coverage_noise:
@@ -183,7 +172,7 @@ def run_once(seeds, thread_counts, coverage_noise, methods=("old", "new")) -> di
     records = {_key(r): r for r in res["records"]}
     for seed, threads, noise in jobs:
         for method in methods:
-            r = fit_and_score(method, seed, threads, noise, blind)
+            r = fit_and_score(method, seed, threads, noise, blind, run)
             if OUT.is_file():  # another run may have added records meanwhile: keep them
                 records = {**{_key(q): q for q in json.loads(OUT.read_text(encoding="utf-8"))["records"]}, **records}
             records[_key(r)] = r
@@ -204,12 +193,12 @@ def run_once(seeds, thread_counts, coverage_noise, methods=("old", "new")) -> di
 def readme_markdown(res: dict) -> str:
     """The README region: old vs new, per seed and mean, timings and coverage."""
     s = res["summary"]
-    lines = ["| seed | old Table 2 MAE R [Ω] | new | old MAE L [H] | new | old train [s] | new |",
+    lines = ["| seed | old Table 2 MAE R [Ω] | new | old MAE L [H] | new | old train CPU [s] | new |",
              "|---|---|---|---|---|---|---|"]
     for p in s["per_seed"]:
         lines.append(f"| {p['seed']} | {p['old_table2_mae_R']:.4f} | {p['new_table2_mae_R']:.4f} | "
-                     f"{p['old_table2_mae_L']:.3g} | {p['new_table2_mae_L']:.3g} | {p['old_wall_s']:.0f} | "
-                     f"{p['new_wall_s']:.0f} |")
+                     f"{p['old_table2_mae_L']:.3g} | {p['new_table2_mae_L']:.3g} | {p['old_cpu_s']:.0f} | "
+                     f"{p['new_cpu_s']:.0f} |")
     if s["seeds"]:
         lines.append(f"| **mean** | {s['old_mean_table2_mae_R']:.4f} | {s['new_mean_table2_mae_R']:.4f} | "
                      f"{s['old_mean_table2_mae_L']:.3g} | {s['new_mean_table2_mae_L']:.3g} | | |")
@@ -222,12 +211,6 @@ def readme_markdown(res: dict) -> str:
     for c in s["coverage"]:
         lines.append(f"- 2σ coverage at {100 * c['noise']:g} % noise on the {c['n']} blind FRFs: old {c['old']:.3f}, "
                      f"new {c['new']:.3f}.")
-    if "new_all_members_mean_table2_mae_R" in s:
-        lines.append(f"- The same new nets with every member in every mean (no held-out rule): mean Table 2 MAE R "
-                     f"{s['new_all_members_mean_table2_mae_R']:.4f} Ω, L {s['new_all_members_mean_table2_mae_L']:.3g} H; "
-                     f"246 blind FRFs R {s['new_all_members_mean_blind_mae_R']:.4f} Ω, L "
-                     f"{s['new_all_members_mean_blind_mae_L']:.3g} H (with the rule: "
-                     f"{s['new_mean_blind_mae_R']:.4f} Ω, {s['new_mean_blind_mae_L']:.3g} H).")
     b = res.get("member_batching_ms")
     if b:
         lines.append(f"- One training step of the 5 members (CPU ms): stacked weights with `baddbmm` "

@@ -117,23 +117,6 @@ def test_crossfit_needs_no_more_than_the_data(tiny_data):
     assert m.fit_info_["n_val"] == 0 and np.all(m.std_scale_ == 1)
 
 
-def test_a_member_is_left_out_where_it_held_out_the_pair():
-    from types import SimpleNamespace
-
-    from satmd.inverse.strategies import member_weights
-
-    model = SimpleNamespace(bounds=InverseModel.bounds,
-                            fit_info_={"held_out": [[1, 9.0, 13.0, 0.032, 0.052], [2, 9.0, 13.0, 0.03, 0.06]]})
-    # normalised outputs of 3 members for 2 samples: one near (11 Ω, 0.042 H), one far from every held-out box
-    near, far = [11.0 / 103, 0.042 / 0.5], [50.0 / 103, 0.25 / 0.5]
-    out = torch.tensor([[near, far]] * 3, dtype=torch.float64)
-    w = member_weights(model, out).numpy()
-    np.testing.assert_array_equal(w, [[1, 1], [0, 1], [0, 1]])
-    assert member_weights(model, out, drop_held_out=False) is None
-    model.fit_info_["held_out"].append([0, 9.0, 13.0, 0.03, 0.06])  # every member held it out: all count
-    np.testing.assert_array_equal(member_weights(model, out).numpy(), np.ones((3, 2)))
-
-
 def test_cross_fitted_model_records_its_held_out_pairs(tiny_physics, tiny_data):
     held = tiny_physics.fit_info_["held_out"]
     assert len(held) == 6 and {h[0] for h in held} == {0, 1, 2}
