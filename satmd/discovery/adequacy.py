@@ -32,7 +32,13 @@ EDGE = 0.005  # share of a search range (log width for ranges over a decade) tha
 
 
 def assess_fit(fit) -> Adequacy:
-    """The verdict of the nominal fit: `FitResult.adequacy`, with the readings that name a mistake."""
+    """The verdict of the nominal fit before the search: inadequate only when it reproduces little of the
+    data (then `FitResult.adequacy`, with the readings that name a mistake). Implausible values alone are
+    left to the search: a missing effect can push the nominal model's free parameters anywhere; the best
+    augmented fit is judged again (`after_search`)."""
+    quick = assess_one(fit, readings=False)
+    if quick.adequate or not any(r.kind == "poor_fit" for r in quick.reasons):
+        return Adequacy(True)
     if fit.adequacy is not None:
         return fit.adequacy
     from ..identification import identify
@@ -49,7 +55,9 @@ def effects_at_edge(effects, rig) -> list:
             v = float(eff.params[p])
             if p in neutral and v == float(neutral[p]):
                 continue
-            for b in (lo, hi):
+            # a bound at the neutral value is where the effect vanishes (a light mode, a small loss), not
+            # where it is stretched: only the other edges count
+            for b in (x for x in (lo, hi) if not (p in neutral and x == float(neutral[p]))):
                 if _near(v, b, lo, hi):
                     side = "lower" if b == lo else "upper"
                     out.append(Reason("effect_at_bound", f"{eff.name} needs {p} = {v:.4g}, at the {side} edge of its "
