@@ -13,8 +13,9 @@ def simex_shift(coords, x, data, weights, skip, draws: int, seed: int = 0, simul
     of SIMEX (Cook & Stefanski 1994): add ``draws`` independent copies of in-band white noise of
     the force-sensor noise's variance (estimated from the force's spectrum outside the excited
     band), take a Gauss-Newton step from ``x`` for each, and extrapolate linearly in the noise
-    variance back to none: ``x0 = x - mean(step)``. Returns the shift and its covariance
-    (spread of the steps / draws). No out-of-band spectrum: no correction.
+    variance back to none: ``x0 = x - mean(step)``. Returns the shift and a covariance to add to
+    the sandwich: the steps' spread (x (1 + 1/draws)), the errors-in-variables part the
+    sandwich's first order misses (conservative). No out-of-band spectrum: no correction.
 
     Parameters
     ----------
@@ -46,7 +47,10 @@ def simex_shift(coords, x, data, weights, skip, draws: int, seed: int = 0, simul
         J = ((R[1:] - R[0]) / h[:, None]).T
         steps.append(-np.linalg.lstsq(J, R[0], rcond=None)[0])
     steps = np.array(steps)
-    cov = np.cov(steps.T).reshape(x.size, x.size) / draws if draws > 1 else np.zeros((x.size, x.size))
+    # the steps' spread is what one more unit of force noise does to the estimate, through the model's
+    # input *and* its Jacobian, which the sandwich's first order misses: added in full (conservative),
+    # plus the uncertainty of their mean
+    cov = np.cov(steps.T).reshape(x.size, x.size) * (1 + 1 / draws) if draws > 1 else np.zeros((x.size, x.size))
     return steps.mean(axis=0), cov
 
 
