@@ -95,16 +95,21 @@ def analyse_recordings(recordings, rig=None, free=DEFAULT_FREE, alpha: float = 1
             freq, datas = grid
             inner = _inner(freq)  # the band edges, where the force falls off, carry the estimator's own errors
             lt = level_dependence(freq[inner], [{c: v[inner] for c, v in d.channels.items()} for d in datas],
-                                  [{c: v[inner] for c, v in d.std.items()} for d in datas], alpha / 2,
+                                  [{c: v[inner] for c, v in d.std.items()} for d in datas], alpha / 4,
                                   model_errors=[{c: np.asarray(v)[inner] for c, v in (d.meta.get("model_error")
                                                                                       or {}).items()}
                                                 for d in datas])
             level_test = NonlinearTest(lt.name, lt.p_value, concentrated_bands(lt), lt.alpha, lt.details)
-            tests.append(level_test)
+            cmp = _hypotheses(datas, rig, free, levels)
+            from .nonlinear_name import parameter_test
+
+            pt = parameter_test(cmp, alpha / 4)
+            tests += [level_test, NonlinearTest(pt.name, pt.p_value, level_test.bands_hz, pt.alpha, pt.details)]
     detected = any(t.significant for t in tests)
     spread = max(levels) / max(min(levels), 1e-300)
-    if detected and level_test is not None and level_test.significant and spread > 1.5:
-        findings.append(_name_from_levels(datas, rig, free, levels, recordings))
+    moved = level_test is not None and (level_test.significant or tests[-1].significant)
+    if detected and moved and spread > 1.5:
+        findings.append(_name_from_levels(datas, rig, free, levels, recordings, cmp))
     elif detected:
         worst = min(tests, key=lambda t: t.p_value)
         findings.append({"name": UNEXPLAINED_NL, "parameters": {}, "ci95": {}, "equivalent": [],
@@ -116,15 +121,22 @@ def analyse_recordings(recordings, rig=None, free=DEFAULT_FREE, alpha: float = 1
     return NonlinearReport(detected, tests, findings, experiments, levels)
 
 
-def _name_from_levels(datas, rig, free, levels, recordings) -> dict:
-    """The finding for a significant level dependence: moving parameter, direction, element, strength."""
+def _hypotheses(datas, rig, free, levels) -> dict:
+    """`compare_hypotheses` started from the identified lowest level."""
     from ..identification import identify
-    from .nonlinear_name import compare_hypotheses, element_for, fit_strength
+    from .nonlinear_name import compare_hypotheses
 
     lo = int(np.argmin(levels))
     fit0 = identify(datas[lo], rig, free, tuple(c for c in ACCEL_CHANNELS if c in datas[lo].channels), warn=False)
     channels = tuple(c for c in ACCEL_CHANNELS if all(c in d.channels for d in datas))
-    cmp = compare_hypotheses(datas, rig, tuple(free), channels, dict(fit0.values), levels)
+    return compare_hypotheses(datas, rig, tuple(free), channels, dict(fit0.values), levels)
+
+
+def _name_from_levels(datas, rig, free, levels, recordings, cmp=None) -> dict:
+    """The finding for a significant level dependence: moving parameter, direction, element, strength."""
+    from .nonlinear_name import element_for, fit_strength
+
+    cmp = cmp or _hypotheses(datas, rig, free, levels)
     p, direction = cmp["best"], cmp["direction"]
     fit = cmp["fits"][p]
     eq_lin = {p: [float(v) for v in fit.per_record]}

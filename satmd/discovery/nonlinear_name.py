@@ -154,6 +154,44 @@ def compare_hypotheses(datas, rig, free, channels, start: dict, levels) -> dict:
             "z": float(z), "order": order}
 
 
+def parameter_test(cmp: dict, alpha: float = 1e-3):
+    """Do the recordings' equivalent linear parameters differ beyond their uncertainty? (Wald test)
+
+    For each hypothesis of `compare_hypotheses`, the per-recording values of its
+    parameter against their weighted mean give χ²(k − 1) under "one linear
+    system" (stds scaled up by √χ²_red when the fit is worse than its noise);
+    the smallest p-value over the hypotheses is Bonferroni-corrected.
+
+    Parameters
+    ----------
+    cmp : the result of `compare_hypotheses`
+    alpha : level
+
+    Returns
+    -------
+    NonlinearTest
+        ``level_dependence_parameters``; ``details`` holds the χ² per parameter.
+    """
+    from scipy import stats
+
+    from .nonlinear_stats import NonlinearTest
+
+    chi, pvals = {}, {}
+    for p in MOVING:
+        fit = cmp["fits"][p]
+        v = np.asarray(fit.per_record, float)
+        n_par = len(fit.shared) + v.size
+        scale = max(fit.chi2 / max(fit.n_data - n_par, 1), 1.0)
+        var = np.maximum(np.asarray(fit.per_record_std, float) ** 2 * scale, 1e-300)
+        mean = np.sum(v / var) / np.sum(1.0 / var)
+        chi[p] = float(np.sum((v - mean) ** 2 / var))
+        pvals[p] = float(stats.chi2.sf(chi[p], v.size - 1))
+    worst = min(pvals, key=pvals.get)
+    p_value = min(1.0, pvals[worst] * len(MOVING))
+    return NonlinearTest("level_dependence_parameters", p_value, [], alpha,
+                         {"chi2": chi, "p": pvals, "parameter": worst})
+
+
 def element_for(parameter: str, direction: str):
     """The element class whose equivalent linearisation moves ``parameter`` that way (None if none does).
 
