@@ -188,11 +188,17 @@ def analyse_frfs(datas, rig=None, free=DEFAULT_FREE, alpha: float = 1e-3, levels
             levels = [float(d.meta["force_rms"]) for d in datas]
         except (KeyError, TypeError, ValueError):
             levels = [float(i + 1) for i in range(len(datas))]
+    from .nonlinear_name import parameter_test
+
     freq = datas[0].freq_hz
-    lt = level_dependence(freq, [d.channels for d in datas], [d.std for d in datas], alpha)
+    lt = level_dependence(freq, [d.channels for d in datas], [d.std for d in datas], alpha / 2)
     test = NonlinearTest(lt.name, lt.p_value, concentrated_bands(lt), lt.alpha, lt.details)
-    findings = [_name_from_levels(datas, rig, free, levels, None)] if test.significant else []
-    return NonlinearReport(test.significant, [test], findings, [EXPERIMENT_MULTISINE] if findings else [], levels)
+    cmp = _hypotheses(datas, rig, free, levels)
+    pt = parameter_test(cmp, alpha / 2)
+    tests = [test, NonlinearTest(pt.name, pt.p_value, test.bands_hz, pt.alpha, pt.details)]
+    detected = any(t.significant for t in tests)
+    findings = [_name_from_levels(datas, rig, free, levels, None, cmp)] if detected else []
+    return NonlinearReport(detected, tests, findings, [EXPERIMENT_MULTISINE] if findings else [], levels)
 
 
 # --- generic input→output records --------------------------------------------------------------------------
