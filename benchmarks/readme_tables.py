@@ -344,45 +344,48 @@ def recordings() -> str:
     if not path.exists():
         return "_No results yet: run `python benchmarks/recordings.py`, then `python benchmarks/readme_tables.py`._"
     r = load("recordings")
-    nu, se, te, cov = r["nulls"], r["single_effects"], r["two_effects"], r["identify_coverage_95"]
+    if "nulls_by_simulator" not in r:
+        return "_Old result format: rerun `python benchmarks/recordings.py`._"
+    nu, se, cov = r["nulls"], r["single_effects"], r["identify_coverage_95"]
 
     def found(x):
-        return (f"{x['found']}/{x['frf_path_detects']} found, {x['no_spurious']}/{x['frf_path_detects']} "
-                f"without a spurious effect")
+        n = x["frf_path_detects"]
+        return f"{x['found']}/{n} found, {x['no_spurious']}/{n} without a spurious effect" if n else "none detectable"
 
-    rows = [
-        "| what | result |",
-        "|---|---|",
-        f"| null recordings: false alarms | {nu['false_alarms']}/{nu['n']} "
-        f"(median χ²_red {nu['median_chi2_reduced']:.2f}) |",
-        "| `identify` 95 % interval coverage on the null recordings | "
-        + ", ".join(f"{k} {v:.2f}" for k, v in cov.items()) + " |",
-        f"| single effects ({se['n']} recordings; counted over the {se['frf_path_detects']} the FRF path detects) | "
-        f"{found(se)} |",
-    ]
-    for name, x in r.get("per_effect", {}).items():
-        if x["frf_path_detects"]:
-            rows.append(f"| &nbsp;&nbsp;{name} | {found(x)} |")
-    rows.append(f"| two effects ({te['n']} recordings; {te['frf_path_detects']} detected by the FRF path) | "
-                f"{found(te)} |")
+    def null_row(label, x):
+        cal = x["std_calibration_rms"]
+        floor = (f"{x['floor_within_1_5']}/{x['floor_corrected']} within ×1.5, {x['n'] - x['floor_corrected']} "
+                 f"not corrected")
+        return (f"| {label} | {x['false_alarms']}/{x['n']} | {cal['near']:.3f} / {cal['elsewhere']:.3f} | {floor} | "
+                f"{', '.join(x['measurement_findings']) or '—'} |")
+
+    rows = ["| null recordings | false alarms | std calibration: RMS of error/std near resonances / elsewhere "
+            "| force-noise floor | measurement findings |", "|---|---|---|---|---|",
+            null_row("all", nu)]
+    for sim, x in r["nulls_by_simulator"].items():
+        rows.append(null_row(f"{sim} simulator", x))
+    for sim, fams in r["nulls_by_family"].items():
+        for fam, x in fams.items():
+            if x["n"]:
+                rows.append(null_row(f"&nbsp;&nbsp;{sim}: {fam}", x))
+    rows += ["", "| concealed single effects (counted over the cases the FRF path detects at the same information) "
+             "| result |", "|---|---|", f"| all ({se['n']} recordings) | {found(se)} |"]
+    for sim, effects in r["per_effect"].items():
+        for name, x in effects.items():
+            rows.append(f"| &nbsp;&nbsp;{sim}: {name} ({x['n']}) | {found(x)} |")
+    rows += ["", "| other | result |", "|---|---|",
+             "| `identify` 95 % interval coverage on the null recordings | "
+             + ", ".join(f"{k} {v:.2f}" for k, v in cov.items()) + " |"]
     for label, b in r.get("estimator_bias", {}).items():
         rows.append(f"| noise-free estimate at the first resonance ({b['freq_hz']:.1f} Hz), {label} | relative error "
                     f"{b['rel_error_at_peak']:.2g}, {b['bias_over_std_at_peak']:.2g} std of a 2 % noise estimate |")
-    timing = r.get("timing_120s_2kHz")
-    if timing:
-        load_avg = r.get("timing_machine", r["machine"]).get("load_average_1min")
-        where = f" (one process, load average {load_avg:.1f} on 2 cores)" if load_avg is not None else ""
-        rows.append(f"| `discover(estimate_frf(rec))` per 120 s recording at 2 kHz{where} | "
+    timing = r.get("timing_120s_2kHz") or {}
+    if timing.get("null", {}).get("median_s") is not None:
+        rows.append(f"| `discover(estimate_frf(rec))` per 120 s recording at 2 kHz | "
                     f"{timing['null']['median_s']:.1f} s with nothing missing; median "
-                    f"{timing['hidden_effect']['median_s']:.1f} s, longest {timing['hidden_effect']['max_s']:.1f} s "
-                    f"with a hidden effect (the vocabulary search) |")
-    else:
-        rows.append(f"| `discover(estimate_frf(rec))`, 120 s null recording at 2 kHz | "
-                    f"{r['seconds_per_120s_2kHz_recording']:.1f} s (median of 3) |")
-    z = r.get("identify_z_std")
-    if z:
-        rows.append("| spread of (estimate − truth)/std on the null recordings (1 if the std is right) | "
-                    + ", ".join(f"{k} {v:.2f}" for k, v in z.items()) + " |")
+                    f"{timing['hidden_effect']['median_s']:.1f} s with a hidden effect |")
+    rows.append(f"| benchmark wall time ({r['machine']['workers']} workers, load average "
+                f"{r['machine'].get('load_average_1min', float('nan')):.1f}) | {r['benchmark_seconds']:.0f} s |")
     return "\n".join(rows)
 
 

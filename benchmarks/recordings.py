@@ -1,29 +1,29 @@
-"""Recordings benchmark: discovery and identification from lab-like time recordings.
+"""Recordings benchmark: discovery and identification from lab-like time recordings, two simulators.
 
-Every recording is made by `satmd.io.simulate_recording` with its realistic
-defaults: random non-periodic band-limited force (20–200 Hz), rig at rest at
-t = 0, white noise on the force *and* on both accelerometers. Settings are
-drawn per recording: fs 1–5 kHz, 30–180 s, accelerometer noise 1–5 % and force
-noise 0.5–2 % of RMS, rig anywhere in the SPEC §9 ranges. Each recording goes
-through exactly what `satmd discover REC` does (LPM estimate, then discovery).
+Recordings come from two simulators that share nothing: satmd's own
+(`satmd.io.simulate_recording` with `satmd.io.conditions.lab_conditions`) and an
+independent one (`benchmarks/_indep_sim.py`: SPEC §2 as ODEs integrated with
+scipy.signal, its own shaker force and sensor noise). Conditions are drawn per
+recording: force flat or rolled off (Butterworth order 2–8), white or pink, a
+shaker resonance; sensor noise white (0.3–10 % of RMS: low and high SNR) plus
+pink noise, drift and 50/60 Hz hum with harmonics; fs 1–10 kHz; 20–120 s
+(at most 400 000 samples); rig anywhere in the SPEC §9 ranges. Each recording
+goes through exactly what `satmd discover REC` does (LPM estimate, discovery).
 
-1. False alarms over N null recordings (nothing missing from the physics).
-2. The same nulls → identification: coverage of the 95 % intervals
-   (estimate ± 1.96 std) per parameter.
-3. Concealed single effects, per effect: found from the recording, and no
-   spurious effect in the report. The reference is the FRF-domain path *at the
-   same information*: the true model on the estimate's grid with the
-   estimate's std as Gaussian noise (`discover` on FRFs). Rates are over the
-   cases that path detects.
-4. Two simultaneous effects: both found.
-5. Estimator bias at the first resonance, noise-free: LPM vs the Welch H1
-   default, relative to the noise std of a 2 %-noise recording.
-6. Seconds per 120 s recording at 2 kHz (estimate + discover, one process, after the pool has
-   finished): null recordings and recordings with a hidden effect (`--timing-only` reruns just
-   these into an existing result file, e.g. on a quiet machine).
+1. Null recordings (nothing missing from the physics): false alarms (any physics
+   effect or a significant mismatch); hum and drift may only be `measurement`.
+2. LPM std calibration: RMS of (estimate − truth)/std, near the resonances
+   (within 5 % of a peak of |a1| or |a2|) and elsewhere, per simulator.
+3. Force-noise floor: estimated / true within a factor 1.5, or no correction.
+4. The nulls → identification: coverage of the 95 % intervals per parameter.
+5. Concealed single effects, per effect and simulator: found, no spurious
+   effect. The reference is the FRF path *at the same information*: the true
+   model on the estimate's grid with the estimate's std as Gaussian noise and
+   the same noise degrees of freedom; rates are over the cases it detects.
+6. Estimator bias at the first resonance and seconds per recording (as before).
 
 Writes benchmarks/results/recordings.json and prints one line of figures.
-Usage: python benchmarks/recordings.py [--nulls 200] [--per-effect 8] [--pairs 10] [--workers 2] [--quick]
+Usage: python benchmarks/recordings.py [--nulls 160] [--per-effect 4] [--workers 2] [--quick]
 """
 from __future__ import annotations
 
@@ -39,10 +39,14 @@ import numpy as np
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
+sys.path.insert(0, str(ROOT / "benchmarks"))  # _indep_sim
 
 EFFECTS = ["extra_mode", "time_delay", "structural_damping", "sensor_gain", "dielectric_loss",
            "shunt_capacitance", "parameter_offset:k1", "parameter_offset:c1"]
+INDEP_EFFECTS = ["extra_mode", "time_delay", "sensor_gain", "shunt_capacitance", "parameter_offset:k1",
+                 "parameter_offset:c1"]  # what the independent ODE simulator can express exactly
 PARAMS = ("m2", "kp", "R", "L")
+MAX_SAMPLES = 400_000
 
 
 def machine_info(workers):
@@ -54,15 +58,102 @@ def machine_info(workers):
 
 
 def draw_settings(rng):
-    return dict(duration_s=float(rng.uniform(30, 180)), fs_hz=float(rng.choice([1000, 2000, 3000, 4000, 5000])),
-                noise=float(rng.uniform(0.01, 0.05)), force_noise=float(rng.uniform(0.005, 0.02)))
+    """fs, duration, SNR and lab conditions of one recording (both simulators draw the same way)."""
+    from satmd.io.conditions import lab_conditions
+
+    fs = float(rng.choice([1000, 2000, 4000, 10000]))
+    seconds = min(float(rng.uniform(20, 120)), MAX_SAMPLES / fs)
+    cond = lab_conditions(int(rng.integers(1 << 30)))
+    cond["noise"] = float(np.exp(rng.uniform(np.log(0.003), np.log(0.1))))  # low and high SNR
+    return fs, seconds, cond
+
+
+def describe(fs, seconds, cond):
+    f, n = cond["force_spectrum"], cond["sensor_noise"]
+    return {"fs_hz": fs, "duration_s": seconds, "noise": cond["noise"], "force_noise": cond["force_noise"],
+            "rolloff_order": f.rolloff_order, "pink_force": f.colour > 0, "shaker_resonance": f.resonance_hz is not None,
+            "pink": n.pink > 0, "drift": n.drift > 0, "hum": n.hum > 0}
+
+
+def make_recording(sim, rng, rig, effects, seed):
+    """(Recording, true FRF function, true per-bin force-noise power, conditions) from one simulator."""
+    from satmd.io import Recording, simulate_recording
+    from satmd.physics import frf
+
+    fs, seconds, cond = draw_settings(rng)
+    band = (10.0, min(300.0, 0.4 * fs))
+    if sim == "satmd":
+        rec = simulate_recording(seconds, fs, rig, effects, band_hz=band, seed=seed, **cond)
+        floor = rec.n_samples * cond["force_noise"] ** 2  # force RMS 1 N
+
+        def truth(freq):
+            r = frf(freq, rig, effects, outputs=("a1", "a2"))
+            return {"a1": r.a1, "a2": r.a2}
+    else:
+        import _indep_sim as ind
+
+        p = {k: float(getattr(rig, k)) for k in ind.NOMINAL}
+        eff = None if not effects else (effects[0].name, dict(effects[0].params))
+        f, n = cond["force_spectrum"], cond["sensor_noise"]
+        force = dict(lo=band[0], hi=band[1], rolloff=f.rolloff_order or 24, highpass=f.highpass_order or 8,
+                     pink=f.colour > 0, resonance=(f.resonance_hz, 5.0, f.resonance_gain) if f.resonance_hz else None)
+        noise = dict(white_acc=cond["noise"], white_force=cond["force_noise"], pink=n.pink, drift=n.drift,
+                     hum=n.hum, mains=n.mains_hz)
+        chans, t = ind.record(p, seconds, fs, rng, effect=eff, force=force, noise=noise)
+        rec = Recording(fs, chans, {"force": "N", "acc1": "m/s^2", "acc2": "m/s^2"}, {"generator": "indep"})
+        clean_rms = np.std(chans["force"]) / np.sqrt(1 + cond["force_noise"] ** 2)
+        floor = rec.n_samples * (cond["force_noise"] * clean_rms) ** 2
+
+        def truth(freq):
+            return ind.true_frf(freq, t["p"], t["mode"], t["Cs"], t["gains"], t["tau"])
+    return rec, truth, floor, describe(fs, seconds, cond)
+
+
+def calibration(data, truth):
+    """Sums of |error/std|² / 2 and counts near the resonances (5 % of a peak) and elsewhere."""
+    true = truth(data.freq_hz)
+    f = data.freq_hz
+    peaks = []
+    for c in ("a1", "a2"):
+        m = np.abs(true[c])
+        peaks += [f[i] for i in range(1, m.size - 1) if m[i] >= m[i - 1] and m[i] >= m[i + 1] and m[i] > 0.2 * m.max()]
+    near = np.zeros(f.size, bool)
+    for p in peaks:
+        near |= np.abs(f - p) <= 0.05 * p
+    out = {"near": [0.0, 0], "elsewhere": [0.0, 0]}
+    for c in data.channels:
+        z2 = np.abs(data[c] - true[c]) ** 2 / (2 * data.std[c] ** 2)
+        for key, sel in (("near", near), ("elsewhere", ~near)):
+            out[key][0] += float(z2[sel].sum())
+            out[key][1] += int(2 * sel.sum())
+    return out
+
+
+def run_null(job):
+    from satmd import discover
+    from satmd.discovery.scenarios import random_rig
+    from satmd.io import estimate_frf
+    from satmd.io.lpm import excited_band
+
+    sim, seed = job
+    rng = np.random.default_rng(1000 + seed)
+    rig = random_rig(rng)
+    rec, truth, floor_true, cond = make_recording(sim, rng, rig, [], seed)
+    t0 = time.perf_counter()
+    data = estimate_frf(rec)
+    rep = discover(data)
+    seconds = time.perf_counter() - t0
+    fit = rep.nominal_fit
+    floor = excited_band(rec["force"], rec.fs_hz)[2]
+    return {"sim": sim, "seed": seed, **cond, "alarm": bool(rep.significant_mismatch or rep.effects),
+            "effects": rep.effect_names, "measurement": [m["name"] for m in rep.measurement],
+            "cover": {p: bool(abs(fit.values[p] - getattr(rig, p)) <= 1.96 * fit.std[p]) for p in PARAMS},
+            "chi2_reduced": rep.fit_before["chi2_reduced"], "calibration": calibration(data, truth),
+            "floor_ratio": None if floor is None else floor / floor_true, "seconds": seconds}
 
 
 def names_with_equivalents(report):
-    out = []
-    for e in report.effects:
-        out.append({e.name, *getattr(e, "equivalent", [])})
-    return out
+    return [{e.name, *getattr(e, "equivalent", [])} for e in report.effects]
 
 
 def score(report, truth):
@@ -73,53 +164,40 @@ def score(report, truth):
     return found, spurious
 
 
-def run_null(seed):
-    from satmd import discover
-    from satmd.discovery.scenarios import random_rig
-    from satmd.io import estimate_frf, simulate_recording
-
-    rng = np.random.default_rng(1000 + seed)
-    rig = random_rig(rng)
-    s = draw_settings(rng)
-    rec = simulate_recording(s["duration_s"], s["fs_hz"], rig, noise=s["noise"], force_noise=s["force_noise"],
-                             seed=seed)
-    t0 = time.perf_counter()
-    rep = discover(estimate_frf(rec))
-    fit = rep.nominal_fit
-    cover = {p: bool(abs(fit.values[p] - getattr(rig, p)) <= 1.96 * fit.std[p]) for p in PARAMS}
-    z = {p: float((fit.values[p] - getattr(rig, p)) / fit.std[p]) for p in PARAMS}
-    return {"seed": seed, **s, "alarm": bool(rep.significant_mismatch), "effects": rep.effect_names,
-            "measurement": [m["name"] for m in rep.measurement], "cover": cover, "z": z,
-            "chi2_reduced": rep.fit_before["chi2_reduced"], "seconds": time.perf_counter() - t0}
-
-
-def run_effect(args):
-    name_list, seed = args
+def run_effect(job):
     from satmd import discover
     from satmd.discovery.scenarios import random_effect, random_rig
-    from satmd.io import FRFData, estimate_frf, simulate_recording
-    from satmd.physics import frf
+    from satmd.io import FRFData, estimate_frf
 
+    sim, name, seed = job
     rng = np.random.default_rng(5000 + seed)
     rig = random_rig(rng)
-    effects = [random_effect(n, rng, np.array([40.0, 180.0])) for n in name_list]
-    s = draw_settings(rng)
-    rec = simulate_recording(s["duration_s"], s["fs_hz"], rig, effects, noise=s["noise"],
-                             force_noise=s["force_noise"], seed=seed)
+    effects = [random_effect(name, rng, np.array([40.0, 180.0]))]
+    rec, truth, _, cond = make_recording(sim, rng, rig, effects, seed)
     t0 = time.perf_counter()
     data = estimate_frf(rec)
     rep = discover(data)
     seconds = time.perf_counter() - t0
-    # the FRF-domain path at the same information: true model + Gaussian noise of the estimate's std
-    true = frf(data.freq_hz, rig, effects, outputs=tuple(data.channels))
-    noisy = {c: true.channel(c) + data.std[c] * (rng.standard_normal(len(data)) + 1j * rng.standard_normal(len(data)))
+    # the FRF path at the same information: true model + Gaussian noise of the estimate's std and dof
+    true = truth(data.freq_hz)
+    noisy = {c: true[c] + data.std[c] * (rng.standard_normal(len(data)) + 1j * rng.standard_normal(len(data)))
              for c in data.channels}
-    ref = discover(FRFData(data.freq_hz, noisy, dict(data.std)))
-    found, spurious = score(rep, name_list)
-    ref_found, _ = score(ref, name_list)
-    return {"seed": seed, "truth": name_list, **s, "found": found, "spurious": spurious,
+    ref = discover(FRFData(data.freq_hz, noisy, dict(data.std),
+                           estimator={"noise_dof": data.estimator["noise_dof"]}))
+    found, spurious = score(rep, [name])
+    return {"sim": sim, "seed": seed, "truth": [name], **cond, "found": found, "spurious": spurious,
             "reported": rep.effect_names, "measurement": [m["name"] for m in rep.measurement],
-            "frf_path_found": ref_found, "frf_path_reported": ref.effect_names, "seconds": seconds}
+            "frf_path_found": score(ref, [name])[0], "frf_path_reported": ref.effect_names, "seconds": seconds}
+
+
+def _progress(results, label):
+    out = []
+    for r in results:
+        out.append(r)
+        flag = r.get("alarm", r.get("spurious"))
+        print(f"{label} {len(out)}: {r['sim']} seed {r['seed']} {'FLAG ' if flag else ''}{r.get('effects', r.get('reported'))} "
+              f"{r['measurement']} {r['seconds']:.0f} s", file=sys.stderr, flush=True)
+    return out
 
 
 def estimator_bias():
@@ -165,17 +243,16 @@ def seconds_per_recording(repeats=3):
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--nulls", type=int, default=200)
-    ap.add_argument("--per-effect", type=int, default=8)
-    ap.add_argument("--pairs", type=int, default=10)
+    ap.add_argument("--nulls", type=int, default=160, help="null recordings per simulator")
+    ap.add_argument("--per-effect", type=int, default=4, help="recordings per effect and simulator")
     ap.add_argument("--workers", type=int, default=2)
-    ap.add_argument("--quick", action="store_true", help="20 nulls, 2 per effect, 3 pairs")
+    ap.add_argument("--quick", action="store_true", help="10 nulls per simulator, 1 per effect, no timing")
     ap.add_argument("--timing-only", action="store_true",
                     help="rerun only the seconds-per-recording figures into an existing --out file")
     ap.add_argument("--out", default=str(ROOT / "benchmarks" / "results" / "recordings.json"))
     a = ap.parse_args()
     if a.quick:
-        a.nulls, a.per_effect, a.pairs = 20, 2, 3
+        a.nulls, a.per_effect = 10, 1
     if a.timing_only:  # rerun only the timings (on a quiet machine) into an existing result file
         result = json.loads(Path(a.out).read_text())
         timing = seconds_per_recording()
@@ -187,16 +264,14 @@ def main():
               f"per 120 s recording at 2 kHz")
         return
     t_start = time.perf_counter()
+    sims = ("satmd", "independent")
     with ProcessPoolExecutor(a.workers) as pool:
-        nulls = list(pool.map(run_null, range(a.nulls)))
-        jobs = [([name], 100 * k + i) for k, name in enumerate(EFFECTS) for i in range(a.per_effect)]
-        rng = np.random.default_rng(7)
-        pairs = [sorted(rng.choice(EFFECTS, 2, replace=False).tolist()) for _ in range(a.pairs)]
-        jobs += [(p, 9000 + i) for i, p in enumerate(pairs)]
-        cases = list(pool.map(run_effect, jobs))
-    timing = seconds_per_recording()  # after the pool: timed alone in this process
-    singles = [c for c in cases if len(c["truth"]) == 1]
-    doubles = [c for c in cases if len(c["truth"]) == 2]
+        nulls = _progress(pool.map(run_null, [(sim, i) for i in range(a.nulls) for sim in sims]), "nulls")
+        jobs = [("satmd", name, 100 * k + i) for k, name in enumerate(EFFECTS) for i in range(a.per_effect)]
+        jobs += [("independent", name, 100 * k + i) for k, name in enumerate(INDEP_EFFECTS) for i in range(a.per_effect)]
+        cases = _progress(pool.map(run_effect, jobs), "effects")
+    timing = seconds_per_recording() if not a.quick and a.per_effect else \
+        {"null": {"median_s": None}, "hidden_effect": {"median_s": None}}
 
     def rates(rows):
         detectable = [r for r in rows if r["frf_path_found"]]
@@ -207,18 +282,38 @@ def main():
                 "no_spurious_rate": (sum(not r["spurious"] for r in detectable) / len(detectable))
                 if detectable else None}
 
-    per_effect = {name: rates([c for c in singles if c["truth"] == [name]]) for name in EFFECTS}
+    def null_stats(rows):
+        cal = {k: float(np.sqrt(sum(r["calibration"][k][0] for r in rows) / max(sum(r["calibration"][k][1] for r in rows), 1)))
+               for k in ("near", "elsewhere")}
+        ratios = [r["floor_ratio"] for r in rows if r["floor_ratio"] is not None]
+        return {"n": len(rows), "false_alarms": sum(r["alarm"] for r in rows),
+                "false_alarm_rate": float(np.mean([r["alarm"] for r in rows])) if rows else None,
+                "median_chi2_reduced": float(np.median([r["chi2_reduced"] for r in rows])) if rows else None,
+                "measurement_findings": sorted({m for r in rows for m in r["measurement"]}),
+                "std_calibration_rms": cal,
+                "floor_corrected": len(ratios),
+                "floor_within_1_5": sum(1 / 1.5 <= x <= 1.5 for x in ratios),
+                "floor_ratio_range": [float(min(ratios)), float(max(ratios))] if ratios else None}
+
+    families = {"hum": lambda r: r["hum"], "drift": lambda r: r["drift"], "pink sensor noise": lambda r: r["pink"],
+                "force rolled off": lambda r: r["rolloff_order"] > 0, "shaker resonance": lambda r: r["shaker_resonance"],
+                "fs 10 kHz": lambda r: r["fs_hz"] >= 10000, "noise < 1 %": lambda r: r["noise"] < 0.01,
+                "noise > 5 %": lambda r: r["noise"] > 0.05}
+    per_family = {sim: {fam: null_stats([r for r in nulls if r["sim"] == sim and pick(r)]) for fam, pick in families.items()}
+                  for sim in sims}
     coverage = {p: float(np.mean([n["cover"][p] for n in nulls])) for p in PARAMS}
+    per_effect = {sim: {name: rates([c for c in cases if c["sim"] == sim and c["truth"] == [name]])
+                        for name in (EFFECTS if sim == "satmd" else INDEP_EFFECTS)} for sim in sims}
     result = {
-        "what": "discovery and identification from lab-like recordings (random force, at rest, noise on all channels)",
+        "what": "discovery and identification from lab-like recordings of two independent simulators",
         "machine": machine_info(a.workers),
-        "nulls": {"n": len(nulls), "false_alarms": sum(n["alarm"] for n in nulls),
-                  "false_alarm_rate": float(np.mean([n["alarm"] for n in nulls])),
-                  "median_chi2_reduced": float(np.median([n["chi2_reduced"] for n in nulls])),
-                  "measurement_findings": sorted({m for n in nulls for m in n["measurement"]})},
+        "nulls": null_stats(nulls),
+        "nulls_by_simulator": {sim: null_stats([r for r in nulls if r["sim"] == sim]) for sim in sims},
+        "nulls_by_family": per_family,
         "identify_coverage_95": coverage,
-        "identify_z_std": {p: float(np.std([n["z"][p] for n in nulls])) for p in PARAMS},
-        "single_effects": rates(singles), "per_effect": per_effect, "two_effects": rates(doubles),
+        "single_effects": rates(cases),
+        "single_effects_by_simulator": {sim: rates([c for c in cases if c["sim"] == sim]) for sim in sims},
+        "per_effect": per_effect,
         "estimator_bias": estimator_bias(),
         "seconds_per_120s_2kHz_recording": timing["null"]["median_s"],
         "timing_120s_2kHz": timing,
@@ -226,18 +321,17 @@ def main():
         "cases": {"nulls": nulls, "effects": cases},
     }
     Path(a.out).parent.mkdir(parents=True, exist_ok=True)
-    Path(a.out).write_text(json.dumps(result, indent=1))
-    s, d, b = result["single_effects"], result["two_effects"], result["estimator_bias"]
+    Path(a.out).write_text(json.dumps(result, indent=1, default=float))
+    nu, s1, b = result["nulls"], result["single_effects"], result["estimator_bias"]
     fmt = lambda x: "n/a" if x is None else f"{100 * x:.0f} %"  # noqa: E731
-    print(f"recordings: false alarms {result['nulls']['false_alarms']}/{len(nulls)}; "
-          f"coverage " + " ".join(f"{p} {coverage[p]:.2f}" for p in PARAMS) + "; "
-          f"single effects found {fmt(s['found_rate'])}, no spurious {fmt(s['no_spurious_rate'])} "
-          f"(of {s['frf_path_detects']} the FRF path detects); two effects {fmt(d['found_rate'])}; "
-          f"peak bias/std LPM {b['lpm']['bias_over_std_at_peak']:.2f} vs Welch "
-          f"{b['welch_h1_default']['bias_over_std_at_peak']:.1f}; "
-          f"{timing['null']['median_s']:.1f} s per 120 s null recording at 2 kHz, "
-          f"{timing['hidden_effect']['median_s']:.1f} s with a hidden effect")
-
+    print(f"recordings: false alarms {nu['false_alarms']}/{nu['n']} (two simulators); std calibration RMS "
+          f"near resonances {nu['std_calibration_rms']['near']:.3f}, elsewhere {nu['std_calibration_rms']['elsewhere']:.3f}; "
+          f"force-noise floor within x1.5 {nu['floor_within_1_5']}/{nu['floor_corrected']} corrected "
+          f"({nu['n'] - nu['floor_corrected']} not corrected); coverage "
+          + " ".join(f"{p} {coverage[p]:.2f}" for p in PARAMS) + "; "
+          f"single effects found {fmt(s1['found_rate'])}, no spurious {fmt(s1['no_spurious_rate'])} "
+          f"(of {s1['frf_path_detects']} the FRF path detects); peak bias/std LPM "
+          f"{b['lpm']['bias_over_std_at_peak']:.2f}; {time.perf_counter() - t_start:.0f} s")
 
 if __name__ == "__main__":
     main()

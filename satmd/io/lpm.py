@@ -224,10 +224,11 @@ def _local_fits(spectra, fs, n, lo, hi, width_hz, degree, smooth, verdict) -> LP
     for _ in range(3):  # lines (mains hum, ...) leave windows with one or two bins far above the noise
         for ch in raw_h:
             var[ch], dof = _smooth_noise(raw_s2[ch], np.abs(raw_h[ch]) ** 2, q, smooth, keep)
-        lines = _line_windows(resid, var, lev, raw_s2, q, freq, 0.5 * width * df) & keep
+        lines = _line_windows(resid, var, lev, raw_s2, q, freq, 0.5 * width * df,
+                              {c: np.abs(h) ** 2 * sxx for c, h in raw_h.items()}) & keep
         if not np.any(lines):
             break
-        keep &= ~lines
+        keep &= ~(lines | np.roll(lines, 1) | np.roll(lines, -1))  # and its neighbours, which the line leaks into
     for ch, h in raw_h.items():
         v = var[ch]
         out_h[ch] = (h * (1.0 + bias))[keep]  # errors in variables: the force noise pulled H towards zero
@@ -236,7 +237,12 @@ def _local_fits(spectra, fs, n, lo, hi, width_hz, degree, smooth, verdict) -> LP
         out_coh[ch] = (signal / (signal + v))[keep]
     correlation = {}
     if len(raw_h) == 2:
-        correlation["a1,a2"] = _channel_correlation(resid, raw_h, var, q, smooth)[keep]
+        from scipy import stats
+
+        # windows whose residual is unusually large (a line's leakage, common to both channels) would pass for
+        # force noise in the cross products: the correlation is fitted without them
+        calm = keep & np.all([raw_s2[c] <= stats.chi2.isf(0.01, 2 * q) / (2 * q) * var[c] for c in raw_s2], axis=0)
+        correlation["a1,a2"] = _channel_correlation(resid, raw_h, var, q, smooth, calm)[keep]
     dropped = [float(x) for x in freq[~keep]]
     freq, bias, bound = freq[keep], bias[keep], bound[keep]
     settings = {"method": "lpm", "record_s": n / fs, "bins_per_window": width, "window_hz": width * df,
@@ -248,7 +254,7 @@ def _local_fits(spectra, fs, n, lo, hi, width_hz, degree, smooth, verdict) -> LP
     return LPMEstimate(freq, out_h, out_std, out_coh, bias, settings, correlation, bound)
 
 
-def _line_windows(resid, var, lev, s2, q, freq, half_hz, alpha: float = 1e-3):
+def _line_windows(resid, var, lev, s2, q, freq, half_hz, signal, alpha: float = 1e-3):
     """Windows holding a spectral line the force does not explain (mains hum, a pick-up tone).
 
     Each residual bin, standardised by the noise model and its leverage, is
@@ -258,6 +264,8 @@ def _line_windows(resid, var, lev, s2, q, freq, half_hz, alpha: float = 1e-3):
     that cannot follow the FRF, which is not the sensor chain's and is kept,
     unless the window holds a multiple of 50 or 60 Hz and its residual fails
     the χ²_{2q} test: a strong hum line spreads over the whole window's fit.
+    Residuals under 1e-6 of the signal's amplitude (``signal``: per-bin power) are
+    round-off, not lines.
     """
     from scipy import stats
 
@@ -267,14 +275,16 @@ def _line_windows(resid, var, lev, s2, q, freq, half_hz, alpha: float = 1e-3):
     out = None
     for ch, r in resid.items():
         z = np.abs(r) ** 2 / np.maximum(var[ch][:, None] * (1.0 - lev), 1e-300)
+        z[np.abs(r) ** 2 <= 1e-12 * signal[ch][:, None]] = 0.0
         count = np.sum(z > np.log(r.size / alpha), axis=1)
         limit = stats.chi2.isf(alpha / max(freq.size, 1), 2 * max(q, 1)) / (2 * max(q, 1))
-        hit = ((count >= 1) & (count <= 2)) | (mains & (s2[ch] > limit * var[ch]))
+        loud = s2[ch] > np.maximum(limit * var[ch], 1e-12 * signal[ch])
+        hit = ((count >= 1) & (count <= 2)) | (mains & loud)
         out = hit if out is None else out | hit
     return out
 
 
-def _channel_correlation(resid, h, var, q, half):
+def _channel_correlation(resid, h, var, q, half, keep=None):
     """Correlation of the a1 and a2 estimates: both see the same force noise, E[V1 V2*] = S_x H1 H2*.
 
     S_x is fitted locally from the residuals' cross products (the same neighbourhood
@@ -283,12 +293,12 @@ def _channel_correlation(resid, h, var, q, half):
     """
     s12 = np.sum(resid["a1"] * np.conj(resid["a2"]), axis=1) / max(q, 1)
     g12 = h["a1"] * np.conj(h["a2"])
-    w = 1.0 / np.maximum(var["a1"] * var["a2"], 1e-300)
+    w = (1.0 if keep is None else keep) / np.maximum(var["a1"] * var["a2"], 1e-300)  # line windows: no weight
     kernel = np.ones(2 * min(half, (s12.size - 1) // 2) + 1)
     num = np.convolve(w * np.real(s12 * np.conj(g12)), kernel, mode="same")
     den = np.convolve(w * np.abs(g12) ** 2, kernel, mode="same")
     s_x = np.maximum(num / np.maximum(den, 1e-300), 0.0)
-    rho = s_x * g12 / np.sqrt(var["a1"] * var["a2"])
+    rho = s_x * g12 / np.maximum(np.sqrt(var["a1"]) * np.sqrt(var["a2"]), 1e-300)
     scale = np.maximum(np.abs(rho) / 0.99, 1.0)  # a correlation stays inside the unit disc
     return rho / scale
 
@@ -315,7 +325,7 @@ def _smooth_noise(s2, g, q, half, keep=None):
 
     model = np.full_like(s2, np.median(s2[mask > 0]) if mask.any() else np.median(s2))
     for _ in range(3):
-        w = mask / np.maximum(model, 1e-300) ** 2
+        w = mask / np.maximum(model * model, 1e-300)
         s00, s01, s11 = local(w), local(w * g), local(w * g * g)
         t0, t1 = local(w * s2), local(w * g * s2)
         det = s00 * s11 - s01 * s01
