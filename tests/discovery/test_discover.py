@@ -99,8 +99,9 @@ def test_report_schema_and_text(tmp_path):
     sc = concealed_case(1, names=["time_delay"])
     rep = discover(sc.data)
     d = rep.to_dict()
-    assert list(d) == ["schema", "significant_mismatch", "noise", "mismatch_bands_hz", "effects", "parameters",
-                       "fit_before", "fit_after"]
+    assert list(d) == ["schema", "significant_mismatch", "noise", "model_adequate", "adequacy_reasons",
+                       "mismatch_bands_hz", "effects", "parameters", "fit_before", "fit_after"]
+    assert d["model_adequate"] is True and d["adequacy_reasons"] == []
     assert d["schema"] == SCHEMA and d["noise"] == "given"
     for e in d["effects"]:
         assert set(e) == {"name", "parameters", "equivalent", "delta_bic", "explanation"}
