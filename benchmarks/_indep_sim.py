@@ -11,8 +11,9 @@ SPEC §2 written as second-order ODEs in time,
 (optionally a host mode u3 on the primary mass, a stray capacitance across the
 shunt as a fourth electrical state), and integrates it with scipy.signal: the
 force lives on a grid `oversample` times finer than the recording, is taken
-piecewise linear there (for which the first-order-hold discretisation is
-exact), and the discrete system runs as second-order sections. The data
+piecewise linear there, and each mode of the state-space model is integrated
+exactly for that force (first-order hold, one complex recursion per mode with
+scipy.signal.lfilter). The data
 acquisition then low-passes every channel with the same anti-aliasing filter
 and keeps every `oversample`-th sample. Forces are shaped with Butterworth
 filters (scipy.signal.butter) and a peaking filter for a shaker resonance;
@@ -116,14 +117,29 @@ def shaker_force(n, fs, rng, lo=10.0, hi=300.0, rolloff=8, highpass=2, pink=Fals
 
 
 def respond(force_fine, fs_fine, A, B, Cy, D):
-    """Accelerations for a piecewise-linear force on the fine grid, system at rest at t = 0 (exact FOH)."""
-    Ad, Bd, Cd, Dd, _ = sg.cont2discrete((A, B, Cy, D), 1.0 / fs_fine, method="foh")
-    out = []
-    for row in range(Cd.shape[0]):
-        z, p, k = sg.ss2zpk(Ad, Bd, Cd[row:row + 1], Dd[row:row + 1])
-        sos = sg.zpk2sos(z, p, k)
-        out.append(sg.sosfilt(sos, force_fine))
-    return out
+    """Accelerations for a piecewise-linear force on the fine grid, system at rest at t = 0.
+
+    Exact first-order hold, mode by mode: A = V Λ V⁻¹, and each modal state obeys
+    x' = λ x + b u, so over one step h with u linear,
+    x[k] = e^{λh} x[k-1] + b (I1 u[k] + (I0 - I1) u[k-1]), I0 = (e^{λh} - 1)/λ,
+    I1 = (e^{λh} - 1 - λh)/(λ² h): a first-order complex recursion (scipy.signal.lfilter).
+    """
+    lam, V = np.linalg.eig(A)
+    b = np.linalg.solve(V, B[:, 0])
+    c = Cy @ V
+    h = 1.0 / fs_fine
+    z = lam * h
+    phi = np.exp(z)
+    small = np.abs(z) < 1e-4
+    em1 = np.where(small, z + z * z / 2 + z ** 3 / 6, phi - 1.0)
+    i0 = em1 / lam
+    i1 = np.where(small, h * (0.5 + z / 6 + z * z / 24), (em1 - z) / (lam * z))
+    out = [D[row, 0] * force_fine for row in range(Cy.shape[0])]
+    for m in range(lam.size):
+        xm = sg.lfilter([b[m] * i1[m], b[m] * (i0[m] - i1[m])], [1.0, -phi[m]], force_fine.astype(complex))
+        for row in range(Cy.shape[0]):
+            out[row] = out[row] + c[row, m] * xm
+    return [np.real(o) for o in out]
 
 
 def sensor_noise(n, fs, rms, rng, white, pink=0.0, drift=0.0, hum=0.0, mains=50.0):

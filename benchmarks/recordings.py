@@ -125,7 +125,7 @@ def calibration(data, truth):
         z2 = np.abs(data[c] - true[c]) ** 2 / (2 * data.std[c] ** 2)
         for key, sel in (("near", near), ("elsewhere", ~near)):
             out[key][0] += float(z2[sel].sum())
-            out[key][1] += int(2 * sel.sum())
+            out[key][1] += int(sel.sum())
     return out
 
 
