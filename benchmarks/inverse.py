@@ -72,13 +72,14 @@ def main(argv=None):
     ap.add_argument("--thread-counts", default="1,2", help="--once: torch threads timed on the first seed")
     ap.add_argument("--coverage-noise", type=float, default=0.01, help="--once: noise of the coverage check (0: none)")
     ap.add_argument("--methods", default="old,new", help="--once: methods to run (records of the others are kept)")
+    ap.add_argument("--only", choices=("coverage", "threads"), help="--once: only the coverage or the thread-count jobs")
     args = ap.parse_args(argv)
     if args.once:
         from inverse_once import run_once
 
         return run_once([int(x) for x in args.seeds.split(",") if x], [int(x) for x in args.thread_counts.split(",")
                                                                         if x], args.coverage_noise,
-                        tuple(args.methods.split(",")))
+                        tuple(args.methods.split(",")), args.only)
     if args.training:
         return time_training(args.threads, args.device, args.label)
     out = Path(args.out)

@@ -155,7 +155,7 @@ def headline(summary: dict) -> str:
     return "inverse once: " + "; ".join(parts)
 
 
-def run_once(seeds, thread_counts, coverage_noise, methods=("old", "new")) -> dict:
+def run_once(seeds, thread_counts, coverage_noise, methods=("old", "new"), only=None) -> dict:
     """The jobs of ``--once``, each old then new back to back; records merged into inverse_once.json."""
     from _machine import describe, load_after, machine
 
@@ -167,6 +167,10 @@ def run_once(seeds, thread_counts, coverage_noise, methods=("old", "new")) -> di
     jobs += [(seeds[0], t, 0.0) for t in thread_counts if t != 1]
     if coverage_noise:
         jobs.append((seeds[0], 1, float(coverage_noise)))
+    if only == "coverage":
+        jobs = [j for j in jobs if j[2] > 0]
+    elif only == "threads":
+        jobs = [j for j in jobs if j[1] != 1]
     res = json.loads(OUT.read_text(encoding="utf-8")) if OUT.is_file() else {"records": []}
     res["machine"] = machine("cpu", 1)
     records = {_key(r): r for r in res["records"]}
