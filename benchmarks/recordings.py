@@ -295,7 +295,7 @@ def main():
                 "measurement_findings": sorted({m for r in rows for m in r["measurement"]}),
                 "std_calibration_rms": cal,
                 "floor_corrected": len(ratios),
-                "floor_within_1_5": sum(1 / 1.5 <= x <= 1.5 for x in ratios),
+                "floor_within_1_5": int(sum(bool(1 / 1.5 <= x <= 1.5) for x in ratios)),
                 "floor_ratio_range": [float(min(ratios)), float(max(ratios))] if ratios else None}
 
     families = {"hum": lambda r: r["hum"], "drift": lambda r: r["drift"], "pink sensor noise": lambda r: r["pink"],
