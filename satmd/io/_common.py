@@ -19,7 +19,10 @@ def warn(path, message: str):
 
 
 def short_error(exc) -> str:
-    """An exception from a third-party reader as a short one-line text (for `FormatError` messages)."""
+    """An exception from a third-party reader as a short one-line text (for `FormatError` messages);
+    an OSError in words (a damaged archive's seek fails with ``[Errno 22]``), never its errno."""
+    if isinstance(exc, OSError) and exc.strerror:
+        return f"damaged or truncated ({exc.strerror.lower()})"
     return " ".join(str(exc).split())[:120] or type(exc).__name__
 
 
