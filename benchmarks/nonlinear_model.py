@@ -221,6 +221,10 @@ def main(argv=None):
             "simulation_s": sim_s, "cases": cases}
         if "tuning" in cases[0]:
             per[name]["tuning"] = cases[0]["tuning"]
+            print(name, "tuning", {k: v for k, v in cases[0]["tuning"].items() if "design" not in k}, flush=True)
+        result["elements"] = per  # written after every element: a partial run keeps what it measured
+        (ROOT / "benchmarks" / "results" / "nonlinear_model.json").write_text(
+            json.dumps(result, indent=1, default=lambda o: o.tolist() if hasattr(o, "tolist") else str(o)))
     result["elements"] = per
     result["seconds"] = time.perf_counter() - t_all
     result["machine"].update(load_after())

@@ -217,7 +217,11 @@ def fit_nonlinear(recordings, element=None, rig: Rig | None = None, free=LINEAR_
     if not recordings:
         raise DataError("fit_nonlinear needs at least one recording")
     rig = Rig() if rig is None else rig
-    el = make_element(element) if isinstance(element, str) else element
+    if isinstance(element, str):  # the class is what is fitted: start it at rest (strength from the scan)
+        if element not in NONLINEAR:
+            make_element(element)  # the one-line error naming the known elements
+        element = NONLINEAR[element].at_rest(rig)
+    el = element
     if el is not None and not isinstance(el, NonlinearElement):
         raise DataError(f"element must be a name from {', '.join(NONLINEAR)} or a NonlinearElement")
     data = [prepare(r, seconds) for r in recordings]
