@@ -79,3 +79,11 @@ def test_bad_input():
         fit_nonlinear([], "quadratic_damping")
     with pytest.raises(DataError):
         fit_nonlinear([rec], "bogus", start=TRUE)
+
+
+def test_inductor_saturation_by_name():
+    el = nonlinear_element("inductor_saturation", isat=0.2)  # L -~10 % at 10 N on this rig
+    fit = fit_nonlinear(_recs(el, [1.0, 10.0], seed=40), "inductor_saturation", seconds=None, start=TRUE)
+    lo, hi = fit.ci95["isat"]
+    assert abs(fit.values["isat"] / 0.2 - 1) < 0.05 and lo < hi
+    assert fit.equivalent_linear["L"][1] < fit.equivalent_linear["L"][0] < TRUE.L  # L down with level
