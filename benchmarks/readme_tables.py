@@ -350,6 +350,8 @@ def recordings() -> str:
 
     def found(x):
         n = x["frf_path_detects"]
+        if not x["n"]:
+            return "not run (`--per-effect 0`)"
         return f"{x['found']}/{n} found, {x['no_spurious']}/{n} without a spurious effect" if n else "none detectable"
 
     def null_row(label, x):
