@@ -174,12 +174,14 @@ def run_once(seeds, thread_counts, coverage_noise, methods=("old", "new"), only=
     res = json.loads(OUT.read_text(encoding="utf-8")) if OUT.is_file() else {"records": []}
     res["machine"] = machine("cpu", 1)
     records = {_key(r): r for r in res["records"]}
+    mine = {}  # the records this run made: they replace the file's, the file's others are kept
     for seed, threads, noise in jobs:
         for method in methods:
             r = fit_and_score(method, seed, threads, noise, blind, run)
+            mine[_key(r)] = r
             if OUT.is_file():  # another run may have added records meanwhile: keep them
-                records = {**{_key(q): q for q in json.loads(OUT.read_text(encoding="utf-8"))["records"]}, **records}
-            records[_key(r)] = r
+                records = {_key(q): q for q in json.loads(OUT.read_text(encoding="utf-8"))["records"]}
+            records.update(mine)
             print(f"[once] {method} seed {seed} threads {threads} noise {noise:g}: {r['wall_s']:.1f} s wall, "
                   f"{r['cpu_s']:.1f} s CPU, Table 2 MAE R {r['table2_mae_R']:.4f} L {r['table2_mae_L']:.3g}, "
                   f"coverage {r['coverage']:.3f}", file=sys.stderr, flush=True)
