@@ -100,7 +100,8 @@ def discover(
     report = _discover_frf(data, rig, free, candidates, channels, alpha, max_effects)
     if not data.estimator:
         return report
-    report = replace(report, estimator=dict(data.estimator), measurement=list(data.estimator.get("measurement", [])))
+    report = replace(report, estimator=dict(data.estimator),
+                     measurement=list(data.estimator.get("measurement", [])) + list(report.measurement))
     if recording is not None:  # one recording: is it linear at all? (issue 26)
         from .nonlinear_discover import check_one
 
@@ -198,13 +199,17 @@ def _discover_frf(data: FRFData, rig, free, candidates, channels, alpha, max_eff
                                          explanation=describe_effect(eff, rig, shifts), shifts=shifts))
     after = _fit_summary(final.fit)
     test1 = test_mismatch(final.fit, alpha, noise_dof)
-    disc = None
+    disc, noise_notes = None, []
     if test1.significant:
         disc = _unexplained(final.fit)
         structured = disc.structured_fraction
         dof = max(final.fit.dof - disc.n_parameters, 1)
         after = {"chi2_reduced": disc.chi2_after / dof, "rel_error": _rel_error(final.fit, disc)}
         n_terms = sum(disc.terms.values())
+    if test1.significant and disc.structured_fraction < NOISE_LIKE:
+        # no smooth structure left to take: a statement about the noise model, not about physics
+        noise_notes.append(_noise_like(final.fit))
+    elif test1.significant:
         effects.append(UnexplainedFinding(
             name=UNEXPLAINED, parameters={}, equivalent=[],
             delta_bic=round(float(final.fit.chi2 - disc.chi2_after - disc.n_parameters * _log_n(final.fit)), 2),
@@ -214,8 +219,24 @@ def _discover_frf(data: FRFData, rig, free, candidates, channels, alpha, max_eff
     report = DiscoveryReport(significant_mismatch=True, noise=noise, mismatch_bands_hz=test0.bands_hz, effects=effects,
                            parameters={k: final.fit.values[k] for k in free}, fit_before=before, fit_after=after,
                            nominal_fit=nominal_fit, final_fit=final.fit, discrepancy=disc, p_values=p_values,
-                           whiteness=test0.whiteness, wall_time=time.perf_counter() - t0)
+                           whiteness=test0.whiteness, wall_time=time.perf_counter() - t0,
+                           measurement=noise_notes)
     return withdraw_if_inadequate(report, after_search(final.fit, final.effects, rig, disc))
+
+
+#: A residual whose smooth correction removes less than this share of the excess χ² is noise-like.
+NOISE_LIKE = 0.05
+
+
+def _noise_like(fit) -> dict:
+    """The measurement note for a significant but noise-like residual: the std is too small."""
+    ratio = float(fit.chi2_reduced) ** 0.5
+    return {"name": "noise_underestimated",
+            "explanation": f"the residual is significant (χ²_red {fit.chi2_reduced:.2f}) but noise-like: no smooth "
+                           f"correction takes any of it, so the noise std looks about {100 * (ratio - 1):.0f} % "
+                           "too small rather than physics missing",
+            "remedy": "more averages or a longer record for the noise estimate; check the std columns",
+            "corrected": False}
 
 
 def _fit_summary(fit) -> dict:

@@ -80,6 +80,7 @@ class DiscoveryReport:
                       for m in self.measurement]
         else:
             lines = ["[[Missing-physics discovery]]"]
+            lines += [f"    note: {m['name']}: {m['explanation']} (remedy: {m['remedy']})" for m in self.measurement]
         lines += [f"    noise model: {noise}",
                  f"    nominal fit: χ²_red = {self.fit_before['chi2_reduced']:.3g}, "
                  f"relative error {self.fit_before['rel_error']:.3g} "

@@ -141,3 +141,17 @@ def test_single_channel_data():
     rig = Rig(m2=0.6, kp=1.3e5, R=30.0, L=0.1)
     data = simulate(GRID, rig, [effect("parameter_offset:k1", value=2.05e5)], noise=NOISE, seed=1).select(["a1"])
     assert discover(data).effect_names == ["parameter_offset:k1"]
+
+
+def test_a_noise_like_residual_is_a_noise_note_not_physics():
+    """Issue 24 item 3: std 15 % too small makes the mismatch test significant over 2000 points, but
+    no smooth correction takes any of it: no `unexplained`, a `noise_underestimated` note instead."""
+    import numpy as np
+
+    from satmd import discover, simulate
+
+    data = simulate(freq_hz=np.linspace(40, 130, 2000), noise=(0.01, 0.0), seed=4)
+    rep = discover(data.with_std({c: 0.85 * s for c, s in data.std.items()}))
+    assert rep.significant_mismatch and rep.effect_names == []
+    assert [m["name"] for m in rep.measurement] == ["noise_underestimated"]
+    assert "noise_underestimated" in rep.report()
