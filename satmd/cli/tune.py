@@ -81,7 +81,10 @@ def run(args):
             with one_line_warnings("tune"):
                 result = retune(series, free=free, labels=[f.stem for f in files], **options)
             return _finish(args, result)
-        result = tune(_identified(args, series[0]), force=args.force, **options)
+        try:
+            result = tune(_identified(args, series[0]), force=args.force, **options)
+        except DataError as exc:  # the library names its keyword; the command line names its option
+            raise DataError(str(exc).replace("force=True", "--force")) from None
     return _finish(args, result)
 
 

@@ -84,7 +84,7 @@ def tune(
     verdict = model_verdict(model)
     if verdict is not None and not verdict.adequate and not force:
         raise DataError(f"the SATMD model cannot describe these data: {verdict.summary}; not tuned "
-                        "(force=True, or --force on the CLI, tunes anyway)")
+                        "(force=True tunes anyway)")
     rig, effects, source, parameters, uncertain, notes, span = resolve_model(model, effects)
     if verdict is not None and not verdict.adequate:
         notes.append(f"tuned although the SATMD model cannot describe these data (forced): {verdict.summary}")
