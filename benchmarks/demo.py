@@ -62,5 +62,17 @@ def main(argv=None) -> int:
     return 0 if result["within_limit"] else 1
 
 
+def readme_markdown(result: dict) -> str:
+    """The README's sentence on `make demo` (region ``demo``), from demo.json."""
+    m = result["machine"]
+    load = m.get("load_average_1_5_15_before") or [float("nan")]
+    slow = sorted(result["sections_s"].items(), key=lambda kv: -kv[1])[:2]
+    return (f"`make demo`'s main job (`satmd reproduce`, measured by `benchmarks/demo.py`): "
+            f"{result['wall_s'] / 60:.1f} min wall ({result['cpu_s'] / 60:.1f} min CPU) on a "
+            f"{m['cpu_count']}-core machine at load average {load[0]:.1f}, peak memory "
+            f"{result['peak_rss_gb']:.2f} GB (limit {result['limit_gb']:.0f} GB), exit status {result['exit_code']}; "
+            "the longest sections: " + ", ".join(f"{t} {s:.0f} s" for t, s in slow) + ".\n")
+
+
 if __name__ == "__main__":
     sys.exit(main())
