@@ -358,10 +358,11 @@ def recordings() -> str:
         cal = x["std_calibration_rms"]
         floor = (f"{x['floor_within_1_5']}/{x['floor_corrected']} within ×1.5, {x['n'] - x['floor_corrected']} "
                  f"not corrected")
-        return (f"| {label} | {x['false_alarms']}/{x['n']} | {cal['near']:.3f} / {cal['elsewhere']:.3f} | {floor} | "
+        sig = f" ({x['significant']} significant, noise-like)" if x.get("significant") else ""
+        return (f"| {label} | {x['false_alarms']}/{x['n']}{sig} | {cal['near']:.3f} / {cal['elsewhere']:.3f} | {floor} | "
                 f"{', '.join(x['measurement_findings']) or '—'} |")
 
-    rows = ["| null recordings | false alarms | std calibration: RMS of error/std near resonances / elsewhere "
+    rows = ["| null recordings | false alarms (physics named) | std calibration: RMS of error/std near resonances / elsewhere "
             "| force-noise floor | measurement findings |", "|---|---|---|---|---|",
             null_row("all", nu)]
     for sim, x in r["nulls_by_simulator"].items():
