@@ -20,6 +20,7 @@ import numpy as np
 from .conventions import ACCEL_CHANNELS
 from .errors import DataError
 from .io.recording import Recording
+from .io.timesim import log_sweep
 from .physics import Rig, integrate
 from .physics.nonlinear.excitation import odd_multisine, random_force
 
@@ -27,14 +28,8 @@ EXCITATIONS = ("random", "sweep", "multisine")
 
 
 def _sweep(n, fs_hz, lo, hi) -> np.ndarray:
-    t = np.arange(n) / fs_hz
-    duration = n / fs_hz
-    rate = np.log(hi / lo)
-    x = np.sin(2 * np.pi * lo * duration / rate * (np.exp(t / duration * rate) - 1.0))
-    taper = max(1, int(0.05 * n))
-    ramp = 0.5 - 0.5 * np.cos(np.pi * np.arange(taper) / taper)
-    x[:taper] *= ramp
-    x[n - taper:] *= ramp[::-1]
+    """`log_sweep` at unit RMS (the drive level is the force's RMS)."""
+    x = log_sweep(n, fs_hz, lo, hi)
     return x / np.sqrt(np.mean(x * x))
 
 

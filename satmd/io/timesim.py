@@ -124,7 +124,7 @@ def simulate_recording(duration_s: float = 60.0, fs_hz: float = 1000.0, rig: Rig
             # the force goes on after the record ends: the anti-aliasing roll-off looks a few ms ahead
             force = _random_force(total + int(fs_hz), fs_hz, lo, hi, rng, force_spectrum)
         else:
-            force = _sweep(total, fs_hz, lo, hi)
+            force = log_sweep(total, fs_hz, lo, hi)
         clean = {"force": force, **_convolve(force, fs_hz, rig, effects, hi)}  # force: anti-aliased as recorded
         clean = {k: v[burn:total] for k, v in clean.items()}
     gain = force_rms / np.sqrt(np.mean(clean["force"] ** 2))  # linear: one scale for all channels
@@ -172,8 +172,8 @@ def _random_force(n, fs_hz, lo, hi, rng, shape=None) -> np.ndarray:
     return np.fft.irfft(spectrum, m)[start:start + n]
 
 
-def _sweep(n, fs_hz, lo, hi) -> np.ndarray:
-    """One logarithmic sine sweep lo -> hi over the record, tapered in and out."""
+def log_sweep(n, fs_hz, lo, hi) -> np.ndarray:
+    """One logarithmic sine sweep lo -> hi over ``n`` samples at ``fs_hz``, tapered in and out (peak 1)."""
     t = np.arange(n) / fs_hz
     duration = n / fs_hz
     rate = np.log(hi / lo)
