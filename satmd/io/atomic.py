@@ -136,17 +136,22 @@ def atomic_write(path, mode: str = "wb"):
     try:
         with open(tmp, mode, **({"encoding": "utf-8", "newline": "\n"} if "b" not in mode else {})) as fh:
             yield fh
-        pending = _PENDING.get()
-        if pending is None:
-            with _signals_blocked():
-                _commit(tmp, path)
-        else:
-            pending.append((tmp, path))
+        _commit_or_defer(tmp, path)
     except BaseException as exc:
         _remove(tmp)
         if isinstance(exc, OSError) and exc.errno is not None:  # name the output, not its temporary file
             raise OSError(exc.errno, exc.strerror, str(path)) from None
         raise
+
+
+def _commit_or_defer(tmp: Path, path: Path) -> None:
+    """Move ``tmp`` onto ``path`` now (signals blocked), or inside `all_or_none` at its end."""
+    pending = _PENDING.get()
+    if pending is None:
+        with _signals_blocked():
+            _commit(tmp, path)
+    else:
+        pending.append((tmp, path))
 
 
 @contextlib.contextmanager
@@ -164,12 +169,7 @@ def atomic_dir(path):
     try:
         tmp.mkdir()
         yield tmp
-        pending = _PENDING.get()
-        if pending is None:
-            with _signals_blocked():
-                _commit(tmp, path)
-        else:
-            pending.append((tmp, path))
+        _commit_or_defer(tmp, path)
     except BaseException:
         _remove(tmp)
         raise
