@@ -76,7 +76,8 @@ def _csv_with_comment(base_text: str, comment: str) -> bytes:
     return ("\n".join(lines[:1] + [comment] + lines[1:])).encode()
 
 
-def _mutations(seed: bytes, rng: random.Random, n: int) -> list[bytes]:
+def mutations(seed: bytes, rng: random.Random, n: int) -> list[bytes]:
+    """Random damage: truncation, byte flips, insertions, dropped/duplicated lines, garbage."""
     out = []
     for _ in range(n):
         how = rng.choice(["truncate", "flip", "insert", "lines", "garbage"])
@@ -391,7 +392,7 @@ def generate(base) -> list[dict]:
         seed_bytes = (base / name).read_bytes()[:20000]
         op = "load_frf" if name.startswith("frf") else "load_recording"
         kwargs = {"freq_axis": "40:3"} if name.endswith(".txt") else {}
-        for k, blob in enumerate(_mutations(seed_bytes, rng, 70)):
+        for k, blob in enumerate(mutations(seed_bytes, rng, 70)):
             add(case("random damage", "api", "either", [name], op=op, files={name: blob}, args=["{work}/" + name],
                      kwargs=kwargs))
 
@@ -442,7 +443,7 @@ def generate(base) -> list[dict]:
 
     for _ in range(len(cases), 1500 + 40):  # top up with further random damage of the CSV formats
         name = rng.choice(["frf.csv", "rec.csv"])
-        blob = _mutations((base / name).read_bytes()[:8000], rng, 1)[0]
+        blob = mutations((base / name).read_bytes()[:8000], rng, 1)[0]
         add(case("random damage", "api", "either", [name], op="load_frf" if name == "frf.csv" else "load_recording",
                  files={name: blob}, args=["{work}/" + name]))
     for i, c in enumerate(cases):

@@ -18,6 +18,7 @@ import json
 import random
 import re
 import shutil
+import sys
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -25,6 +26,9 @@ import numpy as np
 import pytest
 
 from satmd.cli import main
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "benchmarks"))
+from _fuzz_cases import mutations  # noqa: E402  (one generator for this test and benchmarks/fuzz.py)
 
 pytest.importorskip("torch")
 
@@ -221,34 +225,6 @@ def bad_csv_files(seed_text: str, rng: random.Random) -> list[tuple[str, bytes]]
     return out
 
 
-def random_mutations(seed: bytes, rng: random.Random, n: int) -> list[bytes]:
-    """Random damage: truncation, byte flips, insertions, dropped/duplicated lines, garbage."""
-    out = []
-    for _ in range(n):
-        how = rng.choice(["truncate", "flip", "insert", "lines", "garbage"])
-        data = bytearray(seed)
-        if how == "truncate":
-            data = data[:rng.randrange(len(data))]
-        elif how == "flip":
-            for _ in range(rng.randint(1, 6)):
-                data[rng.randrange(len(data))] = rng.randrange(256)
-        elif how == "insert":
-            i = rng.randrange(len(data))
-            data = data[:i] + bytes(rng.randrange(256) for _ in range(rng.randint(1, 16))) + data[i:]
-        elif how == "lines":
-            parts = bytes(data).split(b"\n")
-            i = rng.randrange(len(parts))
-            if rng.random() < 0.5:
-                del parts[i]
-            else:
-                parts.insert(i, parts[i])
-            data = bytearray(b"\n".join(parts))
-        else:
-            data = bytearray(rng.randrange(256) for _ in range(rng.randint(1, 200)))
-        out.append(bytes(data))
-    return out
-
-
 def cases_malformed_csv(base: Path) -> list[Case]:
     rng = random.Random(ROOT_SEED)
     files = bad_csv_files((base / "frf.csv").read_text(), rng)
@@ -280,7 +256,7 @@ def cases_damaged_formats(base: Path) -> list[Case]:
     commands = _with_tune(DATA_COMMANDS)
     for suffix, seed in seeds.items():
         name = "bad" + (".csv" if suffix == ".rec.csv" else suffix)
-        for k, content in enumerate(random_mutations(seed, rng, 24)):
+        for k, content in enumerate(mutations(seed, rng, 24)):
             # `info` reads every variant; the data commands take turns (they share one loader)
             for command in (["info", "{file}"], commands[k % len(commands)]):
                 argv = [a.replace("{file}", "{work}/" + name) for a in command]
@@ -294,7 +270,7 @@ def cases_damaged_formats(base: Path) -> list[Case]:
     short = type(short)(short.fs_hz, {k: v[:400] for k, v in short.channels.items()})
     for suffix in (".csv", ".uff", ".wav", ".npz"):
         save_recording(short, tmp / f"r{suffix}")
-        for k, content in enumerate(random_mutations((tmp / f"r{suffix}").read_bytes(), rng, 16)):
+        for k, content in enumerate(mutations((tmp / f"r{suffix}").read_bytes(), rng, 16)):
             command = [["estimate-frf", "{f}", "-o", "{work}/o.csv"], ["estimate-frf", "{f}", "-o", "{work}/o.uff",
                                                                        "--estimator", "H1"], ["info", "{f}"]][k % 3]
             argv = [a.replace("{f}", "{work}/r" + suffix) for a in command]

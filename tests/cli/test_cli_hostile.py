@@ -9,21 +9,7 @@ import pytest
 
 from satmd.cli import main
 
-
-def run(capsys, *argv):
-    rc = main([str(a) for a in argv])
-    out, err = capsys.readouterr()
-    return rc, out, err
-
-
-def refused(capsys, *argv, says=()):
-    rc, out, err = run(capsys, *argv)
-    lines = [ln for ln in err.splitlines() if ": error: " in ln]
-    assert rc == 2 and len(lines) == 1, (rc, err)
-    for word in says:
-        assert word in lines[0], lines[0]
-    assert "array(" not in lines[0] and "\x1b" not in err
-    return lines[0]
+from ._cli import refused, run
 
 
 @pytest.fixture(scope="module")

@@ -16,21 +16,7 @@ from satmd.cli._common import dumps_json
 from satmd.errors import FormatError
 from satmd.io.atomic import all_or_none, atomic_write
 
-
-def run(capsys, *argv):
-    rc = main([str(a) for a in argv])
-    out, err = capsys.readouterr()
-    return rc, out, err
-
-
-def refused(capsys, *argv, says=()):
-    rc, out, err = run(capsys, *argv)
-    assert rc == 2, (argv, out, err)
-    lines = err.strip().splitlines()
-    assert len(lines) == 1 and lines[0].startswith("satmd "), err
-    for word in says:
-        assert word in lines[0], (word, lines[0])
-    return lines[0]
+from ._cli import refused, run
 
 
 @pytest.fixture(scope="module")
