@@ -16,7 +16,7 @@ import inspect
 from pathlib import Path
 
 from ..errors import DataError, FormatError
-from ._common import DataWarning
+from ._common import DataWarning, writer_for
 from .csvfrf import read_csv, write_csv
 from .estimate import (
     Transmissibility,
@@ -113,12 +113,7 @@ def save_frf(data: FRFData, path, **options) -> Path:
         A suffix satmd cannot write (``.txt`` included) or a missing folder.
     """
     path = Path(path)
-    writer = WRITERS.get(path.suffix.lower())
-    if writer is None:
-        raise FormatError(path, f"cannot write {path.suffix!r} files (known: {', '.join(sorted(WRITERS))})")
-    if path.parent and not path.parent.exists():
-        raise FormatError(path, f"folder {path.parent} does not exist")
-    return writer(data, path, **options)
+    return writer_for(path, WRITERS, "files")(data, path, **options)
 
 
 __all__ = [

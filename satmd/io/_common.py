@@ -51,6 +51,16 @@ def read_bytes(path, limit: int | None = None) -> bytes:
     return raw
 
 
+def writer_for(path, writers: dict, what: str):
+    """The writer `writers` holds for `path`'s suffix; a `FormatError` for an unknown suffix or a missing folder."""
+    writer = writers.get(path.suffix.lower())
+    if writer is None:
+        raise FormatError(path, f"cannot write {path.suffix!r} {what} (known: {', '.join(sorted(writers))})")
+    if not path.parent.exists():
+        raise FormatError(path, f"folder {path.parent} does not exist")
+    return writer
+
+
 def read_text(path) -> str:
     """A text file (UTF-8), bounded by `limits.MAX_TEXT_BYTES`; see `read_bytes` and `decode_text`."""
     from .limits import MAX_TEXT_BYTES

@@ -28,7 +28,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from ..errors import DataError, FormatError
-from ._common import read_text, text_lines
+from ._common import read_text, text_lines, writer_for
 from .limits import MAX_BINARY_BYTES, check_file
 from .csvrec import CSV_MAGIC, read_recording_csv, write_recording_csv
 from .recdata import MAX_ABS_SAMPLE, ROLES, SI_UNITS, Recording, check_rate, clipped_channels, warn_clipping
@@ -141,13 +141,7 @@ def save_recording(rec: Recording, path) -> Path:
         A suffix satmd cannot write or a missing folder.
     """
     path = Path(path)
-    writer = RECORDING_WRITERS.get(path.suffix.lower())
-    if writer is None:
-        known = ", ".join(sorted(RECORDING_WRITERS))
-        raise FormatError(path, f"cannot write {path.suffix!r} recordings (known: {known})")
-    if not path.parent.exists():
-        raise FormatError(path, f"folder {path.parent} does not exist")
-    return writer(rec, path)
+    return writer_for(path, RECORDING_WRITERS, "recordings")(rec, path)
 
 
 def is_recording(path) -> bool:
