@@ -22,40 +22,33 @@ from ..io.limits import MAX_FREQ_POINTS, MAX_SAMPLES  # noqa: E402,F401 - the co
 
 
 # --- option types: argparse names the option in its message ---------------------
-def real(lo=None, hi=None, *, lo_open=False, hi_open=False):
-    """An argparse ``type``: a finite float within [lo, hi] (open ends with lo_open / hi_open)."""
-    allowed = Interval(Real, lo, hi, {(0, 0): "", (1, 0): "lo", (0, 1): "hi", (1, 1): "both"}[bool(lo_open), bool(hi_open)])
+def _bounded(convert, allowed, noun: str, finite: bool):
+    """An argparse ``type`` converting with `convert` and checking `allowed`; `noun` names the kind in messages."""
 
     def parse(text):
         try:
-            x = float(text)
+            x = convert(text)
         except ValueError:
-            raise argparse.ArgumentTypeError(f"{text!r} is not a number") from None
-        if not math.isfinite(x):
+            raise argparse.ArgumentTypeError(f"{text!r} is not {noun}") from None
+        if finite and not math.isfinite(x):
             raise argparse.ArgumentTypeError(f"{text!r} is not a finite number")
         if not allowed.accepts(x):
             raise argparse.ArgumentTypeError(f"{text} must be {allowed.bounds_text()}")
         return x
 
-    parse.__name__ = "number"
+    parse.__name__ = noun.split()[-1]
     return parse
+
+
+def real(lo=None, hi=None, *, lo_open=False, hi_open=False):
+    """An argparse ``type``: a finite float within [lo, hi] (open ends with lo_open / hi_open)."""
+    allowed = Interval(Real, lo, hi, {(0, 0): "", (1, 0): "lo", (0, 1): "hi", (1, 1): "both"}[bool(lo_open), bool(hi_open)])
+    return _bounded(float, allowed, "a number", finite=True)
 
 
 def integer(lo=None, hi=None):
     """An argparse ``type``: an integer within [lo, hi]."""
-    allowed = Interval(Integral, lo, hi)
-
-    def parse(text):
-        try:
-            x = int(text)
-        except ValueError:
-            raise argparse.ArgumentTypeError(f"{text!r} is not an integer") from None
-        if not allowed.accepts(x):
-            raise argparse.ArgumentTypeError(f"{text} must be {allowed.bounds_text()}")
-        return x
-
-    parse.__name__ = "integer"
-    return parse
+    return _bounded(int, Interval(Integral, lo, hi), "an integer", finite=False)
 
 
 SEED = integer(0, 2 ** 32 - 1)  # numpy and torch take non-negative seeds
