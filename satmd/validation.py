@@ -1,8 +1,9 @@
 """One vocabulary for what an argument may be, checked in one place (as scikit-learn's ``_param_validation``).
 
 A *constraint* is a list of the forms a value may take: ``None``, a type (``bool``, ``str``, a
-class), an `Options` (one of fixed strings), an `Interval` (a finite number in a range) or a
-`Grid` (an increasing array of frequencies). `validate` accepts a value that matches any form of
+class), an `Options` (one of fixed strings), an `Interval` (a finite number in a range), a
+`Grid` (an increasing array of frequencies), a `Band` (a frequency range ``(lo, hi)``) or a
+`SequenceOf` (a list or tuple of one kind, e.g. parameter names). `validate` accepts a value that matches any form of
 its list and otherwise raises one line naming the argument; `validate_params` does it for every
 call of a function from a table beside its signature, so adding a validated option means adding
 one keyword and one entry:
@@ -20,6 +21,7 @@ import inspect
 import math
 from dataclasses import dataclass
 from numbers import Real
+from typing import Any
 
 import numpy as np
 
@@ -86,10 +88,11 @@ class Interval:
         kind = Real if self.kind is Whole else self.kind
         if isinstance(v, (bool, np.bool_)) or not isinstance(v, kind):
             return False
-        if not math.isfinite(v) or (self.kind is Whole and not float(v).is_integer()):
+        x: Any = v  # a number of the kind
+        if not math.isfinite(x) or (self.kind is Whole and not float(x).is_integer()):
             return False
-        lo_ok = self.lo is None or (v > self.lo if self.open in ("lo", "both") else v >= self.lo)
-        hi_ok = self.hi is None or (v < self.hi if self.open in ("hi", "both") else v <= self.hi)
+        lo_ok = self.lo is None or (x > self.lo if self.open in ("lo", "both") else x >= self.lo)
+        hi_ok = self.hi is None or (x < self.hi if self.open in ("hi", "both") else x <= self.hi)
         return lo_ok and hi_ok
 
     def bounds_text(self) -> str:
@@ -150,12 +153,79 @@ class Grid:
         return "an increasing array of at least two positive frequencies"
 
 
+class Band:
+    """A frequency range ``(lo, hi)`` in Hz: two finite numbers with 0 < lo < hi."""
+
+    def accepts(self, v) -> bool:
+        """Whether ``v`` is such a pair.
+
+        Parameters
+        ----------
+        v : any value
+
+        Returns
+        -------
+        bool
+        """
+        if isinstance(v, (str, bytes)):
+            return False
+        try:
+            lo, hi = (float(b) for b in v)
+        except (TypeError, ValueError):
+            return False
+        return math.isfinite(lo) and math.isfinite(hi) and 0 < lo < hi
+
+    def describe(self) -> str:
+        """The constraint in words.
+
+        Returns
+        -------
+        str
+        """
+        return "a band (lo, hi) in Hz with 0 < lo < hi"
+
+
+@dataclass(frozen=True)
+class SequenceOf:
+    """A list, tuple or 1-D array (never a bare string) whose items are all instances of ``kind``."""
+
+    kind: type
+
+    def accepts(self, v) -> bool:
+        """Whether ``v`` is a list, tuple or 1-D array of ``kind``.
+
+        Parameters
+        ----------
+        v : any value
+
+        Returns
+        -------
+        bool
+        """
+        if isinstance(v, np.ndarray) and v.ndim != 1:
+            return False
+        return isinstance(v, (list, tuple, np.ndarray)) and all(isinstance(x, self.kind) for x in v)
+
+    def describe(self) -> str:
+        """The constraint in words.
+
+        Returns
+        -------
+        str
+        """
+        return f"a list of {self.kind.__name__}"
+
+
+#: A list or tuple of names (parameters, channels, effects).
+NAMES = SequenceOf(str)
+
+
 def describe(c) -> str:
     """One form of a constraint in words.
 
     Parameters
     ----------
-    c : None, a type, Options, Interval or Grid
+    c : None, a type, Options, Interval, Grid, Band or SequenceOf
 
     Returns
     -------
@@ -173,7 +243,7 @@ def accepts(c, v) -> bool:
 
     Parameters
     ----------
-    c : None, a type, Options, Interval or Grid
+    c : None, a type, Options, Interval, Grid, Band or SequenceOf
     v : any value
 
     Returns
@@ -182,6 +252,8 @@ def accepts(c, v) -> bool:
     """
     if c is None:
         return v is None
+    if c is bool:  # NumPy's booleans are flags too
+        return isinstance(v, (bool, np.bool_))
     if isinstance(c, type):
         return isinstance(v, c)
     return c.accepts(v)
@@ -198,7 +270,7 @@ def check(name: str, value, allowed, owner: str = "", error: type = DataError):
     ----------
     name : the argument's name, as the user wrote it
     value : its value
-    allowed : list of forms (None, a type, `Options`, `Interval`, `Grid`)
+    allowed : list of forms (None, a type, `Options`, `Interval`, `Grid`, `Band`, `SequenceOf`)
     owner : the function or class named in the message (empty: none)
     error : the exception class raised (a `SatmdError`)
 
@@ -273,7 +345,7 @@ def invalid_values(allowed) -> list:
 
     Parameters
     ----------
-    allowed : list of forms (None, a type, `Options`, `Interval`, `Grid`)
+    allowed : list of forms (None, a type, `Options`, `Interval`, `Grid`, `Band`, `SequenceOf`)
 
     Returns
     -------
@@ -291,4 +363,8 @@ def invalid_values(allowed) -> list:
             out.append(True)
         elif isinstance(c, Grid):
             out += [np.array([1.0]), np.array([2.0, 1.0]), np.array([0.0, 1.0])]
+        elif isinstance(c, Band):
+            out += [(2.0, 1.0), (0.0, 1.0), (1.0, float("inf")), (1.0, 2.0, 3.0)]
+        elif isinstance(c, SequenceOf):
+            out += [[object()], (None,)]
     return [v for v in out if v is not None and not any(accepts(c, v) for c in allowed)]

@@ -40,7 +40,7 @@ def run(args):
 
         pred = fit.prediction()
         fig = fit_figure(data, [("fitted model", pred.channels, {"color": "tab:blue", "lw": 1.2})],
-                         [("fit", fit.standardized_residuals(), {"color": "tab:blue", "lw": 0.8})],
+                         [("fit", fit.standardised_residuals(), {"color": "tab:blue", "lw": 0.8})],
                          title=f"identify: χ²_red = {fit.chi2_reduced:.3g}, rel. error {fit.rel_error:.2e}")
         save(fig, args.plot)
     if args.json:

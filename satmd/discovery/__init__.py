@@ -26,7 +26,7 @@ from functools import partial
 from numbers import Real
 from typing import Sequence
 
-from ..validation import Interval, Whole, validate_params
+from ..validation import NAMES, Interval, Whole, validate_params
 from ..conventions import ACCEL_CHANNELS, DEFAULT_FREE
 from .._fleet import fleet_map
 from ..identification import identify
@@ -46,7 +46,8 @@ __all__ = ["discover", "discover_many", "DiscoveryReport", "EffectFinding", "Une
            "SCHEMA"]
 
 
-@validate_params({"alpha": [Interval(Real, 0, 1, "both")], "max_effects": [Interval(Whole, 0)]})
+@validate_params({"rig": [None, Rig], "free": [NAMES], "candidates": [None, NAMES], "channels": [None, NAMES],
+                  "alpha": [Interval(Real, 0, 1, "both")], "max_effects": [Interval(Whole, 0)]})
 def discover(
     data,
     rig: Rig | None = None,

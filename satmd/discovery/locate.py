@@ -31,7 +31,7 @@ class MismatchTest:
 
 
 def standardized(fit) -> dict:
-    return fit.standardized_residuals()
+    return fit.standardised_residuals()
 
 
 def test_mismatch(fit, alpha: float = 1e-3, noise_dof: float | None = None) -> MismatchTest:

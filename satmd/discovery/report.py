@@ -120,10 +120,10 @@ class DiscoveryReport:
 
         data = self.nominal_fit.data
         curves = [("nominal model", self.nominal_fit.prediction().channels, {"color": "tab:orange", "lw": 1.0})]
-        resid = [("nominal", self.nominal_fit.standardized_residuals(), {"color": "tab:orange", "lw": 0.8})]
+        resid = [("nominal", self.nominal_fit.standardised_residuals(), {"color": "tab:orange", "lw": 0.8})]
         if self.final_fit is not None and self.final_fit is not self.nominal_fit:
             pred = dict(self.final_fit.prediction().channels)
-            z = dict(self.final_fit.standardized_residuals())
+            z = dict(self.final_fit.standardised_residuals())
             label = " + ".join(n for n in self.effect_names if n != UNEXPLAINED) or "model"
             if self.discrepancy is not None:
                 sig = self.final_fit.sigma

@@ -20,14 +20,17 @@ polynomial, optionally rational, library: the transparent baseline).
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
+from typing import Any
 
 import numpy as np
-from sklearn.metrics import mean_absolute_error, r2_score
-from sklearn.model_selection import train_test_split
 
 from ..errors import DataError, SatmdError
 from .backends import BACKENDS
+from .pareto import Finish, ParetoEntry, Parts, cv_r2, metrics, pareto_front, split
+
+__all__ = ["distill", "DistillResult", "DEFAULT_SEARCH", "NAMED_DEFAULTS", "paper_formula_result", "split",
+           "metrics", "cv_r2", "pareto_front", "ParetoEntry", "grid_ceiling"]
 from .anova import grid_ceiling  # noqa: F401 - re-exported: it bounds what distill can reach
 
 
@@ -45,7 +48,8 @@ class DistillResult:
     ``expression`` is in z-scored variables x0..x{d-1} (``names`` says which
     physical input each is; ``mean``/``std`` undo the scoring); ``pareto`` is
     the non-dominated set over (complexity, training MSE), simplest first,
-    each entry a dict with complexity, r2/mae train/test and the expression.
+    each entry a `ParetoEntry` (complexity, r2/mae train/test, the expression;
+    read like a dict).
     """
 
     backend: str
@@ -69,7 +73,7 @@ class DistillResult:
         Z = (np.asarray(X, float) - self.mean) / self.std
         return _symbolic().evaluate(self.expression, Z)
 
-    def best_within(self, max_complexity: int, on: str = "r2_test") -> dict | None:
+    def best_within(self, max_complexity: int, on: str = "r2_test") -> ParetoEntry | None:
         """The Pareto entry with the highest ``on`` among complexity <= max_complexity."""
         ok = [p for p in self.pareto if p["complexity"] <= max_complexity and np.isfinite(p[on])]
         return max(ok, key=lambda p: p[on]) if ok else None
@@ -81,7 +85,7 @@ class DistillResult:
             "r2_test": self.r2_test, "seconds": self.seconds, "names": list(self.names),
             "zscore_mean": self.mean.tolist(), "zscore_std": self.std.tolist(),
             "n_train": self.n_train, "n_test": self.n_test,
-            "pareto": [{**p, "expression": str(p["expression"])} for p in self.pareto], "info": self.info,
+            "pareto": [p.to_dict() for p in self.pareto], "info": self.info,
         }
 
     def report(self) -> str:
@@ -94,71 +98,6 @@ class DistillResult:
                  "  Pareto front (complexity: R² test):  "
                  + ", ".join(f"{p['complexity']}: {p['r2_test']:.3f}" for p in self.pareto)]
         return "\n".join(lines)
-
-
-def split(X, y, test_size=0.2, seed=42, zscore=True):
-    """z-score X with whole-data statistics (unless ``zscore`` is False), then the
-    80/20 split. Returns Z_tr, Z_te, y_tr, y_te, mean, std."""
-    X = np.asarray(X, float)
-    y = np.asarray(y, float).ravel()
-    if X.ndim != 2 or X.shape[0] != y.size:
-        raise DataError(f"X must be (n, d) and y (n,); got {X.shape} and {y.shape}")
-    keep = np.all(np.isfinite(X), axis=1) & np.isfinite(y)
-    X, y = X[keep], y[keep]
-    if y.size < 10:
-        raise DataError(f"need at least 10 finite samples, got {y.size}")
-    mean = X.mean(axis=0) if zscore else np.zeros(X.shape[1])
-    std = X.std(axis=0) if zscore else np.ones(X.shape[1])
-    std = np.where(std > 0, std, 1.0)
-    Z = (X - mean) / std
-    Ztr, Zte, ytr, yte = train_test_split(Z, y, test_size=test_size, random_state=seed)
-    return Ztr, Zte, ytr, yte, mean, std
-
-
-def metrics(expr, Ztr, Zte, ytr, yte) -> dict:
-    symbolic = _symbolic()
-    out = {}
-    for part, Z, y in (("train", Ztr, ytr), ("test", Zte, yte)):
-        p = symbolic.evaluate(expr, Z)
-        ok = np.all(np.isfinite(p))
-        out[f"r2_{part}"] = float(r2_score(y, p)) if ok else float("-inf")
-        out[f"mae_{part}"] = float(mean_absolute_error(y, p)) if ok else float("inf")
-    return out
-
-
-def cv_r2(expr, Z, y, folds: int = 5, seed: int = 0) -> float:
-    """Mean R² of ``expr`` over ``folds``-fold cross-validation, constants refitted
-    (`symbolic.polish`) on each fold's training part.
-
-    Parameters
-    ----------
-    expr : sympy expression in x0..
-    Z, y : rows to cross-validate on (never the test rows).
-    folds : number of folds.
-    seed : seed of the fold assignment.
-
-    Returns
-    -------
-    float
-    """
-    from sklearn.model_selection import KFold
-
-    symbolic = _symbolic()
-    scores = []
-    for fit_rows, held in KFold(int(folds), shuffle=True, random_state=seed).split(Z):
-        e = symbolic.polish(expr, Z[fit_rows], y[fit_rows])
-        scores.append(metrics(e, Z[fit_rows], Z[held], y[fit_rows], y[held])["r2_test"])
-    return float(np.mean(scores))
-
-
-def pareto_front(entries: list, key: str = "r2_train") -> list:
-    """Entries not dominated in (complexity low, ``key`` high), simplest first."""
-    front, best = [], -np.inf
-    for e in sorted(entries, key=lambda e: (e["complexity"], -e[key])):
-        if e[key] > best:
-            front.append(e)
-            best = e[key]
-    return front
 
 
 #: What `distill` runs when no back end is named: the search `satmd explain` runs for ξ (the
@@ -218,93 +157,117 @@ def distill(X, y, backend: str | None = None, names=None, *, max_complexity: int
     -------
     DistillResult
     """
-    given = {"max_complexity": max_complexity, "validation": validation, "finalists": finalists,
-             "time_limit": time_limit}
-    if backend is None:
-        preset = dict(DEFAULT_SEARCH)
-        backend = preset.pop("backend")
-        options = {**{k: v for k, v in preset.items() if k not in given}, **options}
-    else:
-        preset = NAMED_DEFAULTS
-    given = {k: preset[k] if v is None else v for k, v in given.items()}
-    max_complexity, validation, finalists, time_limit = (given[k] for k in ("max_complexity", "validation",
-                                                                            "finalists", "time_limit"))
-    if backend not in BACKENDS:
-        raise SatmdError(f"unknown backend {backend!r}; choose from {', '.join(BACKENDS)}")
-    if not 0.0 <= validation < 0.9:
-        raise DataError(f"validation must be a share in [0, 0.9), got {validation}")
-    symbolic = _symbolic()
-    sp = symbolic.sp
-    Ztr, Zte, ytr, yte, mean, std = split(X, y, test_size, seed, zscore)
-    d = Ztr.shape[1]
-    names = tuple(names) if names is not None else tuple(f"x{i}" for i in range(d))
-    if validation:
-        Zfit, Zval, yfit, yval = train_test_split(Ztr, ytr, test_size=validation, random_state=seed + 1)
-    else:
-        Zfit, yfit, Zval, yval = Ztr, ytr, None, None
-    if backend in ("skeleton", "hybrid"):
-        options.setdefault("budget", max_complexity if max_complexity is not None else 20)
+    settings = Settings.resolve(backend, max_complexity, validation, finalists, time_limit, options)
+    _symbolic()  # sympy first: without it, one error before any work
+    parts = Parts.make(X, y, test_size, seed, zscore, settings.validation)
+    names = tuple(names) if names is not None else tuple(f"x{i}" for i in range(parts.d))
     t0 = time.perf_counter()
     search_seed = seed if search_seed is None else search_seed
-    candidates, chosen, info = BACKENDS[backend](Zfit, yfit, seed=search_seed, n_threads=n_threads,
-                                                 time_limit=time_limit, **options)
+    candidates, chosen, info = BACKENDS[settings.backend](parts.Zfit, parts.yfit, seed=search_seed,
+                                                          n_threads=n_threads, time_limit=settings.time_limit,
+                                                          **settings.options)
     search_s = time.perf_counter() - t0
     if polish is None:
-        polish = not (backend == "sindy" and not options.get("rational", False))
-    prune = polish if prune is None else prune
+        polish = not (settings.backend == "sindy" and not settings.options.get("rational", False))
+    finish = Finish(polish, polish if prune is None else prune, digits)
+    entries = _entries(candidates, chosen, parts, finish, settings.backend)
+    pick, entries, rank = _choose(entries, parts, settings, cv_folds, seed)
+    if parts.Zval is not None:  # the chosen structure's constants from all training rows
+        refit = parts.score(finish(pick.expression, parts.Ztr, parts.ytr), pick.chosen)
+        if settings.max_complexity is None or refit.complexity <= max(settings.max_complexity, pick.complexity):
+            entries.append(refit)
+            pick = refit
+    front = tuple(pareto_front(entries))
+    seconds = time.perf_counter() - t0
+    info = {**info, "search_s": search_s, "n_candidates": len(entries), "validation": settings.validation,
+            "chosen_on": rank}
+    return DistillResult(settings.backend, pick.expression, pick.complexity, pick.mae_train, pick.mae_test,
+                         pick.r2_train, pick.r2_test, front, seconds, names, parts.mean, parts.std, len(parts.ytr),
+                         len(parts.yte), info)
 
-    def finish(expr, Z, yy):
-        if polish:
-            expr = symbolic.polish(expr, Z, yy)
-        if prune:
-            expr = symbolic.prune(expr, Z, yy)
-        return symbolic.round_floats(symbolic.compact(symbolic.round_floats(expr, digits)), digits)
 
-    def entry(expr, is_chosen=False):
-        e = {"complexity": symbolic.node_count(expr), **metrics(expr, Ztr, Zte, ytr, yte), "expression": expr,
-             "_chosen": is_chosen}
-        if Zval is not None:
-            e["r2_val"] = metrics(expr, Zval, Zval, yval, yval)["r2_train"]
-        return e
+@dataclass(frozen=True)
+class Settings:
+    """The search `distill` runs: the back end, its node budget, validation share, finalists, time
+    limit and options, from `DEFAULT_SEARCH` (no back end named) or `NAMED_DEFAULTS` and the keywords."""
 
+    backend: str
+    max_complexity: int | None
+    validation: float
+    finalists: int
+    time_limit: float | None
+    options: dict
+
+    @classmethod
+    def resolve(cls, backend, max_complexity, validation, finalists, time_limit, options: dict) -> "Settings":
+        """The settings of a `distill` call (keywords given win over the preset; None: not given).
+
+        Parameters
+        ----------
+        backend : a back end's name, or None for `DEFAULT_SEARCH`
+        max_complexity, validation, finalists, time_limit : as `distill`
+        options : the back end's own options (``**options`` of `distill`)
+
+        Returns
+        -------
+        Settings
+        """
+        given: dict[str, Any] = {"max_complexity": max_complexity, "validation": validation,
+                                 "finalists": finalists, "time_limit": time_limit}
+        if backend is None:
+            preset = dict(DEFAULT_SEARCH)
+            backend = preset.pop("backend")
+            options = {**{k: v for k, v in preset.items() if k not in given}, **options}
+        else:
+            preset = NAMED_DEFAULTS
+        given = {k: preset[k] if v is None else v for k, v in given.items()}
+        if backend not in BACKENDS:
+            raise SatmdError(f"unknown backend {backend!r}; choose from {', '.join(BACKENDS)}")
+        if not 0.0 <= given["validation"] < 0.9:
+            raise DataError(f"validation must be a share in [0, 0.9), got {given['validation']}")
+        if backend in ("skeleton", "hybrid"):
+            options = dict(options)
+            options.setdefault("budget", given["max_complexity"] if given["max_complexity"] is not None else 20)
+        return cls(backend, given["max_complexity"], given["validation"], given["finalists"], given["time_limit"],
+                   options)
+
+
+def _entries(candidates, chosen, parts: Parts, finish: Finish, backend: str) -> list:
+    """The back end's candidates finished on the search rows and scored, duplicates dropped."""
+    symbolic = _symbolic()
+    sp = symbolic.sp
     entries, seen = [], set()
     for i, text in enumerate(candidates):
-        expr = symbolic.parse(text, d) if isinstance(text, str) else sp.sympify(text)
-        expr = finish(expr, Zfit, yfit)
+        expr = symbolic.parse(text, parts.d) if isinstance(text, str) else sp.sympify(text)
+        expr = finish(expr, parts.Zfit, parts.yfit)
         key = sp.srepr(expr)
         if key in seen:
             continue
         seen.add(key)
-        entries.append(entry(expr, i == chosen))
+        entries.append(parts.score(expr, i == chosen))
     if not entries:
         raise SatmdError(f"the {backend} backend returned no expression")
-    rank = "r2_val" if Zval is not None else "r2_train"
-    if max_complexity is not None:
-        pool = [e for e in entries if e["complexity"] <= max_complexity]
-        pool = pool or [min(entries, key=lambda e: e["complexity"])]
-        pick = max(pool, key=lambda e: e[rank])
-        if Zval is not None and finalists > 1:  # one held-out part is noisy: the finalists by K-fold CV
-            short = sorted(pool, key=lambda e: -e[rank])[:int(finalists)]
-            for e in short:
-                e["r2_cv"] = cv_r2(e["expression"], Ztr, ytr, folds=cv_folds, seed=seed)
-            pick = max(short, key=lambda e: e["r2_cv"])
-            rank = "r2_cv"
-    else:
-        own = [e for e in entries if e["_chosen"]]
-        pick = own[0] if own else max(entries, key=lambda e: e[rank])
-    if Zval is not None:  # the chosen structure's constants from all training rows
-        refit = entry(finish(pick["expression"], Ztr, ytr), pick["_chosen"])
-        if max_complexity is None or refit["complexity"] <= max(max_complexity, pick["complexity"]):
-            entries.append(refit)
-            pick = refit
-    front = pareto_front(entries)
-    seconds = time.perf_counter() - t0
-    clean = tuple({k: v for k, v in e.items() if k != "_chosen"} for e in front)
-    info = {**info, "search_s": search_s, "n_candidates": len(entries), "validation": validation,
-            "chosen_on": rank}
-    return DistillResult(backend, pick["expression"], pick["complexity"], pick["mae_train"], pick["mae_test"],
-                         pick["r2_train"], pick["r2_test"], clean, seconds, names, mean, std, len(ytr), len(yte),
-                         info)
+    return entries
+
+
+def _choose(entries: list, parts: Parts, settings: Settings, cv_folds: int, seed: int) -> tuple:
+    """(pick, entries, the score it was chosen on): the best within the node budget on validation (or
+    training) R², the finalists compared by cross-validation; without a budget, the back end's choice."""
+    rank = "r2_val" if parts.Zval is not None else "r2_train"
+    if settings.max_complexity is None:
+        own = [e for e in entries if e.chosen]
+        return (own[0] if own else max(entries, key=lambda e: e[rank])), entries, rank
+    pool = [e for e in entries if e.complexity <= settings.max_complexity]
+    pool = pool or [min(entries, key=lambda e: e.complexity)]
+    pick = max(pool, key=lambda e: e[rank])
+    if parts.Zval is not None and settings.finalists > 1:  # one held-out part is noisy: the finalists by K-fold CV
+        short = sorted(pool, key=lambda e: -e[rank])[:int(settings.finalists)]
+        scored = {id(e): replace(e, r2_cv=cv_r2(e.expression, parts.Ztr, parts.ytr, folds=cv_folds, seed=seed))
+                  for e in short}
+        entries = [scored.get(id(e), e) for e in entries]
+        pick = max((scored[id(e)] for e in short), key=lambda e: e.r2_cv)
+        rank = "r2_cv"
+    return pick, entries, rank
 
 
 def paper_formula_result(X, y, test_size: float = 0.2, seed: int = 42) -> dict:

@@ -62,73 +62,125 @@ def search(Z, y, *, budget: int = 20, seed: int = 0, time_limit: float | None = 
     """
     Z = np.asarray(Z, float)
     y = np.asarray(y, float)
-    d = Z.shape[1]
     rng = np.random.default_rng(seed)
     rows = rng.choice(y.size, min(subsample, y.size), replace=False)
-    Zs, ys = Z[rows].T, y[rows]
     t0 = time.perf_counter()
+    beam_state = Beam(Z[rows].T, y[rows], budget, seed, rng)
+    beam_state.run(_factor_pool(Z, y), beam, None if time_limit is None else t0 + time_limit)
+    scored = beam_state.skeletons(expand, block_extras)
+    out = _refit(scored[:keep], Z.T, y, starts, seed)
+    n_curved = _add_curved(out, curved, Z.T, y, budget, seed)
+    info = {"products_scored": beam_state.n_fit, "skeletons": len(scored) + beam_state.n_fit + n_curved,
+            "skeletons_fitted": len(scored), "curved_variants": n_curved, "skeleton_s": time.perf_counter() - t0}
+    return sorted(((r2, sk.text(p, c)) for r2, sk, p, c in out), key=lambda t: -t[0]), info
+
+
+def _factor_pool(Z, y) -> list:
+    """The factors of `skeletons.factor_pool`, variables ordered by |correlation| with ``y``."""
     with np.errstate(all="ignore"):
         corr = np.nan_to_num([abs(np.corrcoef(z, y)[0, 1]) for z in Z.T])
-    pool = factor_pool(d, [int(v) for v in np.argsort(-corr, kind="stable")])
-    everything = tuple(range(d))
-    ranked, fitted, level, n_fit = {}, {(): np.zeros(0)}, [()], 0
-    for width in (*beam, 0):
-        grown = {}
+    return factor_pool(Z.shape[1], [int(v) for v in np.argsort(-corr, kind="stable")])
+
+
+class Beam:
+    """The beam over products on a subsample (``Zs`` (d, n), ``ys``): ``fitted`` holds each product's
+    constants, ``ranked`` its best (R², skeleton); ``n_fit`` counts the ranking fits."""
+
+    def __init__(self, Zs, ys, budget: int, seed: int, rng):
+        self.Zs, self.ys, self.budget, self.seed, self.rng = Zs, ys, budget, seed, rng
+        self.d = Zs.shape[0]
+        self.ranked: dict = {}
+        self.fitted: dict = {(): np.zeros(0)}
+        self.n_fit = 0
+
+    def run(self, pool, beam: tuple, deadline: float | None) -> None:
+        """Grow the ``beam[k]`` best products of k + 1 factors by one factor of ``pool``, level by level,
+        until the widths are spent or ``deadline`` (a `time.perf_counter` time) passes."""
+        level = [()]
+        for width in (*beam, 0):
+            grown = self._grown(level, pool)
+            for factors, (parent, new) in grown.items():
+                if deadline is not None and time.perf_counter() > deadline:
+                    break
+                self._rank(factors, parent, new)
+            level = sorted((f for f in grown if f in self.ranked), key=lambda f: -self.ranked[f][0])[:width]
+
+    def _grown(self, level, pool) -> dict:
+        """{product: (parent, new factor)} of the admissible products one factor longer than ``level``'s."""
+        grown: dict = {}
         for product in level:
             for f in pool:
                 factors = tuple(sorted(product + (f,), key=repr))
-                if (factors not in fitted and factors not in grown and 4 + sum(g.nodes for g in factors) <= budget
+                if (factors not in self.fitted and factors not in grown
+                        and 4 + sum(g.nodes for g in factors) <= self.budget
                         and (admissible(factors) or len(factors) == 1)):
                     grown[factors] = (product, f)
-        for factors, (parent, new) in grown.items():
-            if time_limit is not None and time.perf_counter() - t0 > time_limit:
-                break
-            choices = budgeted(factors, d, budget, block_extras=False)
-            if not choices:
-                continue
-            warm = _grow(parent, fitted[parent], new, factors, initial(Skeleton((new,)), 1, rng))
-            first = choices[0] if len(choices) == 1 else Skeleton(factors, everything)
-            r2, p, _ = fit(first, Zs, ys, starts=2, seed=seed + n_fit, p0=warm if parent else None, tol=RANK_TOL,
+        return grown
+
+    def _rank(self, factors: tuple, parent: tuple, new) -> None:
+        """Fit a product with every variable linear (from its parent's constants), re-project each choice
+        of linear terms the budget allows and refit the best: that score ranks the product."""
+        Zs, ys, seed = self.Zs, self.ys, self.seed
+        choices = budgeted(factors, self.d, self.budget, block_extras=False)
+        if not choices:
+            return
+        warm = _grow(parent, self.fitted[parent], new, factors, initial(Skeleton((new,)), 1, self.rng))
+        first = choices[0] if len(choices) == 1 else Skeleton(factors, tuple(range(self.d)))
+        r2, p, _ = fit(first, Zs, ys, starts=2, seed=seed + self.n_fit, p0=warm if parent else None, tol=RANK_TOL,
+                       max_starts=RANK_STARTS)
+        self.n_fit += 1
+        if not np.isfinite(r2):
+            return
+        self.fitted[factors], best = p, (r2, first)
+        if len(choices) > 1:
+            # the inner constants kept, each choice of linear terms re-projected (cheap), the best refitted
+            def projected(sk, p=p):
+                with np.errstate(all="ignore"):
+                    r = project(sk.columns(p, Zs), ys - sk.offset(p, Zs), sk.intercept)[0]
+                return float(r @ r) if np.isfinite(r).all() else np.inf
+            sk = min(choices, key=projected)
+            best = (fit(sk, Zs, ys, starts=1, seed=seed + self.n_fit, p0=p, tol=RANK_TOL)[0], sk)
+        if np.isfinite(best[0]):
+            self.ranked[factors] = best
+
+    def skeletons(self, expand: int, block_extras: bool) -> list:
+        """``[(r2, skeleton, constants), ...]``, best first: every budgeted form of the ``expand`` best
+        products fitted on the subsample, each from its product's constants."""
+        best_products = sorted(self.ranked, key=lambda f: -self.ranked[f][0])[:expand]
+        scored = []
+        forms = ((f, sk) for f in best_products for sk in budgeted(f, self.d, self.budget, block_extras))
+        for i, (f, sk) in enumerate(forms):
+            # a block term starts fresh
+            warm = np.concatenate([self.fitted[f], initial(sk, 0, self.rng)[len(self.fitted[f]):]])
+            r2, p, _ = fit(sk, self.Zs, self.ys, starts=2, seed=self.seed + i, p0=warm, tol=RANK_TOL,
                            max_starts=RANK_STARTS)
-            n_fit += 1
-            if not np.isfinite(r2):
-                continue
-            fitted[factors], best = p, (r2, first)
-            if len(choices) > 1:
-                # the inner constants kept, each choice of linear terms re-projected (cheap), the best refitted
-                def projected(sk, p=p):
-                    with np.errstate(all="ignore"):
-                        r = project(sk.columns(p, Zs), ys - sk.offset(p, Zs), sk.intercept)[0]
-                    return float(r @ r) if np.isfinite(r).all() else np.inf
-                sk = min(choices, key=projected)
-                best = (fit(sk, Zs, ys, starts=1, seed=seed + n_fit, p0=p, tol=RANK_TOL)[0], sk)
-            if np.isfinite(best[0]):
-                ranked[factors] = best
-        level = sorted((f for f in grown if f in ranked), key=lambda f: -ranked[f][0])[:width]
-    best_products = sorted(ranked, key=lambda f: -ranked[f][0])[:expand]
-    scored = []
-    for i, (f, sk) in enumerate((f, sk) for f in best_products for sk in budgeted(f, d, budget, block_extras)):
-        warm = np.concatenate([fitted[f], initial(sk, 0, rng)[len(fitted[f]):]])  # a block term starts fresh
-        r2, p, _ = fit(sk, Zs, ys, starts=2, seed=seed + i, p0=warm, tol=RANK_TOL, max_starts=RANK_STARTS)
-        if np.isfinite(r2):
-            scored.append((r2, sk, p))
-    scored.sort(key=lambda t: -t[0])
+            if np.isfinite(r2):
+                scored.append((r2, sk, p))
+        scored.sort(key=lambda t: -t[0])
+        return scored
+
+
+def _refit(scored: list, Zt, y, starts: int, seed: int) -> list:
+    """``[(r2, skeleton, inner, outer), ...]``, best first: ``scored`` refitted on all rows."""
     out = []
-    for _, sk, p0 in scored[:keep]:
-        r2, p, c = fit(sk, Z.T, y, starts=starts, seed=seed, max_nfev=100 * (sk.n_inner + 1), p0=p0)
+    for _, sk, p0 in scored:
+        r2, p, c = fit(sk, Zt, y, starts=starts, seed=seed, max_nfev=100 * (sk.n_inner + 1), p0=p0)
         if p is not None and np.isfinite(r2):
             out.append((r2, sk, p, c))
     out.sort(key=lambda t: -t[0])
+    return out
+
+
+def _add_curved(out: list, curved: int | None, Zt, y, budget: int, seed: int) -> int:
+    """Append to ``out`` the curved variants of its ``curved`` best (None: all); returns how many were fitted."""
     n_curved = 0
     for _, sk, p, c in list(out[:curved]):
-        for variant, p0 in _curved_variants(sk, p, c, Z.T, budget):
-            r2, pv, cv = fit(variant, Z.T, y, starts=2, seed=seed, max_nfev=100 * (variant.n_inner + 1), p0=p0)
+        for variant, p0 in _curved_variants(sk, p, c, Zt, budget):
+            r2, pv, cv = fit(variant, Zt, y, starts=2, seed=seed, max_nfev=100 * (variant.n_inner + 1), p0=p0)
             n_curved += 1
             if pv is not None and np.isfinite(r2):
                 out.append((r2, variant, pv, cv))
-    info = {"products_scored": n_fit, "skeletons": len(scored) + n_fit + n_curved, "skeletons_fitted": len(scored),
-            "curved_variants": n_curved, "skeleton_s": time.perf_counter() - t0}
-    return sorted(((r2, sk.text(p, c)) for r2, sk, p, c in out), key=lambda t: -t[0]), info
+    return n_curved
 
 
 def _curved_variants(sk: Skeleton, p, c, Zt, budget: int) -> list:

@@ -4,12 +4,12 @@ from __future__ import annotations
 import time
 from dataclasses import replace
 from functools import partial
-from numbers import Real
-from typing import Sequence
+from numbers import Integral, Real
+from typing import Any, Sequence
 
 import numpy as np
 
-from ..validation import Interval, Whole, validate_params
+from ..validation import NAMES, Interval, Options, SequenceOf, Whole, validate_params
 from ..numerics import distinct_best
 from ..conventions import DEFAULT_FREE
 from ..errors import DataError
@@ -28,11 +28,21 @@ SEARCH_POINTS = 512
 
 
 @validate_params({
+    "rig": [None, Rig],
+    "free": [NAMES],
+    "channels": [None, NAMES],
+    "effects": [SequenceOf(Effect)],
+    "start": [None, dict, SequenceOf(dict)],
     "reg": [Interval(Real, 0)],
+    "global_search": [bool],
     "n_search": [Interval(Whole, 1, 1 << 20)],
     "n_refine": [Interval(Whole, 1, 1 << 20)],
+    "bounds": [None, dict],
+    "scale": [Options(("channel", "global"))],
     "max_nfev": [None, Interval(Whole, 1)],
     "tol": [Interval(Real, 0, 1, "both")],
+    "seed": [Interval(Integral, 0)],
+    "warn": [bool],
 })
 def identify(
     data: FRFData,
@@ -113,7 +123,8 @@ def identify(
     coarse = problem.thinned(SEARCH_POINTS)  # memory and time O(points), not O(points × starts)
     if global_search:
         starts = starts + _search(coarse, n_search, n_refine, seed, starts)
-    best, nfev = None, 0
+    best: Any = None  # the best local fit (a least-squares result)
+    nfev = 0
     for s in starts:
         fit = _local_fit(coarse, s, nominal, reg, max_nfev, tol)
         nfev += fit.nfev
@@ -150,7 +161,7 @@ def _suspect(problem: Problem, fit, nominal) -> bool:
 def _starts(problem: Problem, start) -> list[np.ndarray]:
     base = problem.values()
     if start is None:
-        starts = [dict()]
+        starts: list[dict] = [dict()]
     elif isinstance(start, dict):
         starts = [start]
     else:

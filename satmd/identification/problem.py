@@ -18,7 +18,7 @@ from __future__ import annotations
 
 import copy
 from dataclasses import dataclass
-from typing import Sequence
+from typing import Any, Sequence
 
 import numpy as np
 
@@ -81,7 +81,7 @@ class Problem:
             raise DataError(f"free parameters must be distinct and non-empty, got {list(free)}")
         self.params = [self._parameter(n, (bounds or {}).get(n)) for n in free]
         self.names = tuple(free)
-        self.omega_hz = data.freq_hz
+        self.freq_hz = data.freq_hz
         self.target = np.stack([data[c] for c in self.channels])  # (C, F)
         n_freq = self.target.shape[1]
         if n_freq <= len(self.names):  # fewer points than unknowns: no residual dof, no noise estimate
@@ -138,9 +138,34 @@ class Problem:
         out[j] = (u[j] - rho_c[(slice(None),) + extra] * u[i]) * scale[(slice(None),) + extra]
         return out
 
-    def standardize(self, prediction: np.ndarray) -> np.ndarray:
+    def standardise(self, prediction: np.ndarray) -> np.ndarray:
         """(C, F) whitened standardised residuals of a prediction."""
         return self.whiten((prediction - self.target) / self.sigma)
+
+    def standardize(self, prediction: np.ndarray) -> np.ndarray:
+        """Deprecated spelling of `standardise`.
+
+        Parameters
+        ----------
+        prediction : (C, F) model prediction
+
+        Returns
+        -------
+        np.ndarray
+        """
+        _deprecated("Problem.standardize", "Problem.standardise")
+        return self.standardise(prediction)
+
+    @property
+    def omega_hz(self) -> np.ndarray:
+        """Deprecated name of `freq_hz` (a frequency in Hz, not an angular frequency)."""
+        _deprecated("Problem.omega_hz", "Problem.freq_hz")
+        return self.freq_hz
+
+    @omega_hz.setter
+    def omega_hz(self, value) -> None:
+        _deprecated("Problem.omega_hz", "Problem.freq_hz")
+        self.freq_hz = value
 
     def _parameter(self, name, bounds):
         target, field = resolve_parameter(name, self.effects)
@@ -196,7 +221,7 @@ class Problem:
         # θ stays inside the bounds, so the rig was checked once (in __init__) rather than per call
         r = frf(self._eval_hz(), rig, effects, wrt=self.names if wrt else None, outputs=self.channels,
                 validate=False)
-        return r if not self.kernel_rms_hz else _Smoothed(r, self.omega_hz.size)
+        return r if not self.kernel_rms_hz else _Smoothed(r, self.freq_hz.size)
 
     def _eval_hz(self):
         """Where the model is evaluated: the data grid, or f ± s for an estimator with a smoothing kernel.
@@ -209,8 +234,8 @@ class Problem:
         """
         s = self.kernel_rms_hz
         if not s:
-            return self.omega_hz
-        return np.concatenate([np.maximum(self.omega_hz - s, 1e-3 * self.omega_hz), self.omega_hz + s])
+            return self.freq_hz
+        return np.concatenate([np.maximum(self.freq_hz - s, 1e-3 * self.freq_hz), self.freq_hz + s])
 
     def prediction(self, theta) -> np.ndarray:
         r = self.model(theta)
@@ -218,12 +243,12 @@ class Problem:
 
     def residuals(self, theta) -> np.ndarray:
         """(2·C·F,) vector: [Re, Im] of (model - data)/sigma."""
-        z = self.standardize(self.prediction(theta))
+        z = self.standardise(self.prediction(theta))
         return np.concatenate([z.real.ravel(), z.imag.ravel()])
 
     def residuals_and_jacobian(self, theta):
         r = self.model(theta, wrt=True)
-        z = self.standardize(np.stack([r.channel(c) for c in self.channels]))
+        z = self.standardise(np.stack([r.channel(c) for c in self.channels]))
         J = self.whiten(np.stack([r.jac[c] for c in self.channels]) / self.sigma[..., None])  # (C, F, P)
         P = J.shape[-1]
         res = np.concatenate([z.real.ravel(), z.imag.ravel()])
@@ -240,9 +265,9 @@ class Problem:
         cost = np.zeros(thetas.shape[0])
         for a in range(0, thetas.shape[0], rows):
             rig, effects = self.apply(thetas[a:a + rows].T)
-            r = frf(self._eval_hz(), rig, effects, outputs=self.channels, validate=False)
+            r: Any = frf(self._eval_hz(), rig, effects, outputs=self.channels, validate=False)
             if self.kernel_rms_hz:
-                r = _Smoothed(r, self.omega_hz.size)
+                r = _Smoothed(r, self.freq_hz.size)
             u = [(r.channel(c) - self.target[k]) / self.sigma[k] for k, c in enumerate(self.channels)]
             if self.pair is not None:
                 i, j, rho_c, scale = self.pair
@@ -275,7 +300,7 @@ class Problem:
         arc = np.concatenate([[0.0], np.cumsum(step + step.mean())])  # half by change, half even
         idx = np.unique(np.searchsorted(arc, np.linspace(0.0, arc[-1], n_points)).clip(0, F - 1))
         sub = copy.copy(self)
-        sub.omega_hz, sub.target, sub.sigma = self.omega_hz[idx], self.target[:, idx], self.sigma[:, idx]
+        sub.freq_hz, sub.target, sub.sigma = self.freq_hz[idx], self.target[:, idx], self.sigma[:, idx]
         if self.pair is not None:
             i, j, rho_c, scale = self.pair
             sub.pair = (i, j, rho_c[idx], scale[idx])
@@ -308,3 +333,8 @@ def _default_channels(data: FRFData):
     acc = tuple(c for c in ACCEL_CHANNELS if c in data.channels)
     return acc or tuple(data.channels)
 
+
+def _deprecated(old: str, new: str) -> None:
+    import warnings
+
+    warnings.warn(f"{old} is deprecated; use {new}", DeprecationWarning, stacklevel=3)

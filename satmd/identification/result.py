@@ -3,6 +3,7 @@ from __future__ import annotations
 
 import json
 import math
+from typing import Any
 from dataclasses import dataclass, field
 from functools import cached_property
 
@@ -62,7 +63,7 @@ class FitResult:
     start: dict
     reg: float = 0.0
     pinned: tuple = ()
-    _problem: object = field(default=None, repr=False, compare=False)
+    _problem: Any = field(default=None, repr=False, compare=False)  # the fitted Problem
     _assessor: object = field(default=None, repr=False, compare=False)  # fit -> Adequacy (set by identify)
 
     # --- derived views -----------------------------------------------------
@@ -88,18 +89,31 @@ class FitResult:
         from ..physics import frf
 
         if freq_hz is None:  # as the data see it (through the estimator's smoothing, if any)
-            f, pred = self._problem.omega_hz, self._problem.prediction(self.theta)
+            f, pred = self._problem.freq_hz, self._problem.prediction(self.theta)
             return FRFData(f, {c: pred[k] for k, c in enumerate(self.channels)}, {}, {"source": "fitted model"})
         f = np.asarray(freq_hz, float)
         rig, effects = self._problem.apply(self.theta)
         r = frf(f, rig, effects, outputs=self.channels)
         return FRFData(f, {c: r.channel(c) for c in self.channels}, {}, {"source": "fitted model"})
 
-    def standardized_residuals(self) -> dict:
+    def standardised_residuals(self) -> dict:
         """(model − data)/σ per channel, complex (σ = std or the eq. 13 scale)."""
         p = self._problem
-        z = p.standardize(p.prediction(self.theta))  # whitened across channels when their noise is correlated
+        z = p.standardise(p.prediction(self.theta))  # whitened across channels when their noise is correlated
         return {c: z[k] for k, c in enumerate(p.channels)}
+
+    def standardized_residuals(self) -> dict:
+        """Deprecated spelling of `standardised_residuals`.
+
+        Returns
+        -------
+        dict
+        """
+        import warnings
+
+        warnings.warn("FitResult.standardized_residuals is deprecated; use standardised_residuals",
+                      DeprecationWarning, stacklevel=2)
+        return self.standardised_residuals()
 
     @cached_property
     def adequacy(self):
@@ -122,7 +136,7 @@ class FitResult:
     @property
     def freq_hz(self) -> np.ndarray:
         """Frequencies of the fitted points [Hz]."""
-        return self._problem.omega_hz
+        return self._problem.freq_hz
 
     @property
     def sigma(self) -> dict:

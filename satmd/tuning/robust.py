@@ -164,3 +164,36 @@ def robust_optimum(obj, space, rig: Rig, effects, draws: Draws, q: float, starts
                                       "vs_open_circuit": guaranteed_db(20 * np.log10(at_open / tuned), q)},
     }
     return x, summary, best.nfev
+
+
+def make_draws(uncertain, uncertainty, rig: Rig, effects, design, n: int, seed: int) -> Draws:
+    """The draws of robust tuning: independent Gaussians from ``uncertainty``, else the fit's covariance.
+
+    Parameters
+    ----------
+    uncertain : (names, values, covariance) of a fit, or None (a Rig)
+    uncertainty : {parameter: standard deviation} or None; overrides ``uncertain``
+    rig, effects : the nominal model (the means of ``uncertainty``'s parameters)
+    design : the design variables (never drawn)
+    n, seed : number of draws, seed
+
+    Returns
+    -------
+    Draws
+    """
+    if uncertainty:
+        values = {}
+        for name in uncertainty:
+            try:
+                i, p = resolve_parameter(name, effects)
+            except ValueError as exc:
+                raise DataError(f"uncertainty: {exc}") from None
+            if name in design:
+                raise DataError(f"uncertainty given for design variable {name}")
+            values[name] = float(getattr(rig, p)) if i < 0 else float(effects[i].params[p])
+        return draws_from_std(uncertainty, values, n, seed)
+    if uncertain is None:
+        raise DataError("robust tuning needs parameter uncertainty: tune a FitResult (its covariance) "
+                        "or pass uncertainty={name: std}")
+    names, values, cov = uncertain
+    return draws_from_covariance(names, values, cov, exclude=design, n=n, seed=seed)

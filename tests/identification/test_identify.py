@@ -151,7 +151,7 @@ def test_prediction_and_residuals(noisy_fit):
     pred = noisy_fit.prediction()
     assert tuple(pred.channels) == ("a1", "a2")
     np.testing.assert_allclose(pred.freq_hz, PAPER_GRID_HZ)
-    z = noisy_fit.standardized_residuals()
+    z = noisy_fit.standardised_residuals()
     total = sum(np.sum(np.abs(v) ** 2) for v in z.values())
     assert total == pytest.approx(noisy_fit.chi2, rel=1e-9)
     fine = noisy_fit.prediction(np.linspace(40, 130, 7))

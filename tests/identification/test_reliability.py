@@ -187,10 +187,10 @@ def test_batch_cost_in_chunks_equals_one_batch(monkeypatch):
 def test_thinned_problem_keeps_resonances():
     p = Problem(simulate(np.linspace(40, 130, 5000)))
     sub = p.thinned(512)
-    assert sub.target.shape[1] <= 512 and sub.omega_hz.size == sub.target.shape[1]
+    assert sub.target.shape[1] <= 512 and sub.freq_hz.size == sub.target.shape[1]
     assert p.thinned(10_000) is p
     # denser than even spacing where the FRF turns fast (the resonances near 50 and 100 Hz)
-    near = np.sum(np.abs(sub.omega_hz - 50) < 5) + np.sum(np.abs(sub.omega_hz - 100) < 5)
+    near = np.sum(np.abs(sub.freq_hz - 50) < 5) + np.sum(np.abs(sub.freq_hz - 100) < 5)
     assert near > 512 * 20 / 90
 
 

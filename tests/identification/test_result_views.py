@@ -9,7 +9,7 @@ def test_public_views_agree_with_the_fit():
     fit = identify(data)
     assert fit.data is not None and np.array_equal(fit.freq_hz, data.freq_hz)
     pred = fit.prediction()
-    z = fit.standardized_residuals()
+    z = fit.standardised_residuals()
     for c in fit.channels:
         assert np.array_equal(fit.sigma[c], data.std[c])
         np.testing.assert_array_equal(fit.residuals()[c], pred[c] - data[c])  # model - data
