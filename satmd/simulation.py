@@ -7,7 +7,7 @@ to the channel's peak.
 """
 from __future__ import annotations
 
-from typing import Sequence
+from typing import Any, Sequence
 
 import numpy as np
 
@@ -85,7 +85,8 @@ def simulate(
     if not noise:
         info.update(meta or {})
         return FRFData(np.asarray(freq_hz, float), clean, {}, info)
-    rel, floor = (noise, 0.0) if np.isscalar(noise) else noise
+    pair: Any = (noise, 0.0) if np.isscalar(noise) else noise
+    rel, floor = pair
     if rel < 0 or floor < 0 or (rel == 0 and floor == 0):
         raise DataError(f"noise must be REL[:FLOOR] with REL, FLOOR >= 0 and not both 0 (got {rel}:{floor})")
     rng = np.random.default_rng(seed)

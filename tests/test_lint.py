@@ -1,4 +1,4 @@
-"""ruff over satmd/ at the rule set of pyproject.toml's [tool.ruff] (issue 25); skipped where ruff is not installed."""
+"""ruff and mypy over satmd/ at the settings of pyproject.toml (issue 25); each skipped where it is not installed."""
 from __future__ import annotations
 
 import json
@@ -35,3 +35,18 @@ def test_ruff_is_clean():
 def test_ruff_is_clean_in_pending_files():
     bad = [s for s in _findings() if s.split(":")[0] in PENDING]
     assert not bad, "\n".join(bad)
+
+
+def test_mypy_is_clean():
+    """mypy over satmd/ at the level of pyproject.toml's [tool.mypy] (issue 25); skipped where mypy is not installed.
+
+    Modules other engineers are restructuring are listed there with ``ignore_errors`` until they are clean.
+    About 15 s of CPU on a cold cache, 1 s warm (the cache is .mypy_cache, ignored by git).
+    """
+    pytest.importorskip("mypy")
+    run = subprocess.run([sys.executable, "-m", "mypy", "--no-error-summary", "--hide-error-context"], cwd=ROOT,
+                         capture_output=True, text=True, timeout=300)
+    if run.returncode not in (0, 1):  # 2: mypy itself failed (bad configuration)
+        pytest.fail(f"mypy failed: {(run.stderr or run.stdout).strip()[:500]}")
+    bad = [line for line in run.stdout.splitlines() if ": error:" in line]
+    assert run.returncode == 0 and not bad, "mypy findings (`python -m mypy`):\n" + "\n".join(bad)

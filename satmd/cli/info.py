@@ -59,7 +59,7 @@ def describe(path, channel_map=None, freq_axis=None) -> list[str]:
     return lines + frf_lines(load_frf(path, **({"channel_map": channel_map} if channel_map else {})))
 
 
-def _size(n: int) -> str:
+def _size(n: float) -> str:
     for unit in ("bytes", "KiB", "MiB", "GiB"):
         if n < 1024 or unit == "GiB":
             return f"{n} {unit}" if unit == "bytes" else f"{n:.1f} {unit}"
@@ -90,7 +90,7 @@ def _uff(path, channel_map) -> list[str]:
                      f" rsp {r.response:<14s} ref {ref:<7s} {axis}; "
                      f"{r.quantity() or 'unknown quantity'} [{units or 'no units'}]"
                      + (f"; '{id1}'" if id1 and id1.upper() != "NONE" else ""))
-    dofs = {}
+    dofs: dict = {}
     for r in records:
         dofs.setdefault((r.func_type, r.rsp), []).append(f"#{r.index}")
     for (ft, dof), where in dofs.items():

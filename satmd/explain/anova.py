@@ -104,7 +104,7 @@ def grid_anova(X, y, names=None) -> GridAnova:
     total = np.mean((cube - cube.mean()) ** 2)
     if total == 0:
         raise DataError("the target is constant over the grid: nothing to decompose")
-    terms = {(i,): _term(cube, (i,)) for i in range(d)}
+    terms: dict[tuple, np.ndarray] = {(i,): _term(cube, (i,)) for i in range(d)}
     terms.update({p: _term(cube, p) for p in itertools.combinations(range(d), 2)})
     share = {k: float(np.mean(np.broadcast_to(t, cube.shape) ** 2) / total) for k, t in terms.items()}
 
@@ -112,7 +112,7 @@ def grid_anova(X, y, names=None) -> GridAnova:
         fit = cube.mean() + sum((terms[k] for k in keys), np.zeros(cube.shape))
         return float(1.0 - np.mean((cube - fit) ** 2) / total)
 
-    mains = [(i,) for i in range(d)]
+    mains: list[tuple] = [(i,) for i in range(d)]
     pairs = [k for k in terms if len(k) == 2]
     greedy, chosen = [], list(mains)
     greedy.append(("main effects", r2(chosen)))

@@ -141,7 +141,7 @@ def modal_descriptors(rig: Rig | None = None, freq=FINE_GRID_HZ) -> dict:
     rig = Rig() if rig is None else rig
     freq = np.asarray(freq, float)
     batch = rig.batch_shape
-    mag = np.abs(frf(freq, rig, outputs=("u1",)).u1).reshape(-1, freq.size)
+    mag = np.abs(frf(freq, rig, outputs=("u1",)).channel("u1")).reshape(-1, freq.size)
     logm = np.log(mag)
     n = mag.shape[0]
     inner = (logm[:, 1:-1] > logm[:, :-2]) & (logm[:, 1:-1] >= logm[:, 2:])
@@ -157,7 +157,7 @@ def modal_descriptors(rig: Rig | None = None, freq=FINE_GRID_HZ) -> dict:
     fa, _ = _parabolic(-logm, anti, freq)
     fa = np.where(between.any(axis=1), fa, np.nan)
     peak_log = np.max(logm, axis=1)
-    host = frf(freq, rig.replace(m2=_HOST_ALONE_M2), outputs=("u1",)).u1
+    host = frf(freq, rig.replace(m2=_HOST_ALONE_M2), outputs=("u1",)).channel("u1")
     host_peak = np.log(np.max(np.abs(host), axis=-1)).reshape(-1)
     host_peak = np.broadcast_to(host_peak, (n,)) if host_peak.size == 1 else host_peak
     nan = np.where(valid, 1.0, np.nan)

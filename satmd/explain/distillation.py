@@ -215,7 +215,7 @@ class Settings:
         given: dict[str, Any] = {"max_complexity": max_complexity, "validation": validation,
                                  "finalists": finalists, "time_limit": time_limit}
         if backend is None:
-            preset = dict(DEFAULT_SEARCH)
+            preset: dict[str, Any] = dict(DEFAULT_SEARCH)
             backend = preset.pop("backend")
             options = {**{k: v for k, v in preset.items() if k not in given}, **options}
         else:

@@ -108,7 +108,7 @@ def sweep(model, anchor, n: int = 11, half_width=None) -> dict:
     L = np.concatenate([np.full(n, L0), Ls])
     rig = contract.model_rig(model).replace(R=R, L=L)
     r = frf(model.freq_hz, rig, outputs=ACCEL_CHANNELS)
-    Z = contract.latent(model, complex_to_features(np.stack([r.a1, r.a2], axis=1)))
+    Z = contract.latent(model, complex_to_features(np.stack([r.channel(c) for c in ACCEL_CHANNELS], axis=1)))
     span = contract.bounds_span(model)
     dR = _direction(Z[:n], Rs / span[0])
     dL = _direction(Z[n:], Ls / span[1])

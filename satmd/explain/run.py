@@ -7,6 +7,7 @@ reproduce`` section and ``examples/uc3_explain.py``.
 from __future__ import annotations
 
 import time
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -53,7 +54,7 @@ def blind_frfs(model, cases=BLIND_CASES) -> np.ndarray:
     cases = np.asarray(cases, float)
     rig = contract.model_rig(model).replace(R=cases[:, 0], L=cases[:, 1])
     r = frf(model.freq_hz, rig, outputs=ACCEL_CHANNELS)
-    return np.stack([r.a1, r.a2], axis=1)
+    return np.stack([r.channel(c) for c in ACCEL_CHANNELS], axis=1)
 
 
 @dataclass(frozen=True)
@@ -218,8 +219,8 @@ class SymbolicAnalysis:
     cap: int  # nodes of the paper's formula
     paper: dict  # the paper's formula on our data and split
     xi: DistillResult  # at most ``cap`` nodes
-    plus1: dict | None  # best test R² at ≤ cap + 1 nodes
-    best30: dict | None  # best test R² at ≤ COMPLEXITY_CAP nodes
+    plus1: Mapping | None  # best test R² at ≤ cap + 1 nodes (a ParetoEntry)
+    best30: Mapping | None  # best test R² at ≤ COMPLEXITY_CAP nodes
     sindy: dict  # degree -> DistillResult
     ceilings: dict  # input-name triple -> R² any function of it can reach
     anova: GridAnova
@@ -228,10 +229,10 @@ class SymbolicAnalysis:
 
     @property
     def best_triple(self) -> tuple:
-        return max(self.ceilings, key=self.ceilings.get)
+        return max(self.ceilings, key=lambda k: self.ceilings[k])
 
     def to_dict(self) -> dict:
-        out = {"paper_formula": {"expression": PAPER_FORMULA,
+        out: dict = {"paper_formula": {"expression": PAPER_FORMULA,
                                  **{k: v for k, v in self.paper.items() if k != "expression"}},
                "paper_reported": PAPER_METRICS, "xi": self.xi.to_dict(),
                "best_within_30": None if self.best30 is None
@@ -304,7 +305,7 @@ def search_settings(backend: str = "hybrid", quick: bool = False, modal: bool = 
     dict
         Including ``backend``.
     """
-    full = (MODAL_SEARCH_QUICK if quick else MODAL_SEARCH) if modal else (XI_SEARCH_QUICK if quick else XI_SEARCH)
+    full: dict = (MODAL_SEARCH_QUICK if quick else MODAL_SEARCH) if modal else (XI_SEARCH_QUICK if quick else XI_SEARCH)
     if backend == "hybrid":
         return dict(full)
     if backend == "operon":

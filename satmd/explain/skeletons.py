@@ -34,6 +34,7 @@ from __future__ import annotations
 
 import itertools
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
@@ -101,7 +102,7 @@ class Skeleton:
         parts = self.parts(p)
         nf = len(self.factors)
         values = [f.value(q, Zt) for f, q in zip(self.factors, parts[:nf])]
-        out = []
+        out: list = []  # (column or None, derivative)
         for i, (f, q) in enumerate(zip(self.factors, parts[:nf])):
             others = 1.0
             for j, v in enumerate(values):
@@ -220,9 +221,9 @@ def initial(sk: Skeleton, start: int, rng) -> np.ndarray:
     factor near 1), a square's offset is spread over (and beyond) the z-score range
     where its centre may lie, exponents start small."""
     offsets = (0.0, 3.0, -3.0, 1.5)
-    p = []
+    p: list = []
     for n, block in enumerate(sk.blocks):
-        inner = block.inner if isinstance(block, Inverse) else block
+        inner: Any = block.inner if isinstance(block, Inverse) else block
         if isinstance(inner, ShiftedPower):  # the shift beyond the z-score range, a mild power
             p += [rng.uniform(2.0, 4.0), 0.5 * rng.standard_normal()]
         elif isinstance(inner, Square):

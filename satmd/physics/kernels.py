@@ -14,7 +14,7 @@ every backend. The two kernels here evaluate that closed form on NumPy chunks:
 from __future__ import annotations
 
 import math
-from typing import Sequence
+from typing import Any, Sequence
 
 import numpy as np
 
@@ -46,8 +46,8 @@ def solve_into(t, out: dict, work: "Workspace") -> None:
     np.divide(t.F0, inv, out=inv)  # inv = F0 / (K1 KmM - K M2)
     need_u1 = "u1" in out or "a1" in out
     need_u2 = "u2" in out or "a2" in out
-    u1 = np.multiply(KmM, inv, out=dest("u1")) if need_u1 else None
-    u2 = np.multiply(K, inv, out=dest("u2")) if need_u2 else None
+    u1: Any = np.multiply(KmM, inv, out=dest("u1")) if need_u1 else None  # computed where a channel needs it
+    u2: Any = np.multiply(K, inv, out=dest("u2")) if need_u2 else None
     if "q" in out:
         np.multiply(np.multiply(bz, M2, out=work.get("tmp", shape)), inv, out=out["q"])
     mw2 = -(t.omega * t.omega)
@@ -118,7 +118,7 @@ def solve_with_tangents(t, wrt: Sequence[str], outputs: Sequence[str], out_value
     rdet = 1.0 / (K1 * KmM - K * M2)
     inv = F0 * rdet
     u = {"u1": np.multiply(KmM, inv, **_into(out_values, "u1")), "u2": np.multiply(K, inv, **_into(out_values, "u2"))}
-    q = np.multiply(bz * M2, inv, **_into(out_values, "q")) if "q" in outputs else None
+    q: Any = np.multiply(bz * M2, inv, **_into(out_values, "q")) if "q" in outputs else None
     mw2 = -(v["omega"] * v["omega"])
     gain = {"a1": full("g1", mw2 if v["s1"] is None else mw2 * v["s1"]),
             "a2": full("g2", mw2 if v["s2"] is None else mw2 * v["s2"])}

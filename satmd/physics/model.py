@@ -24,7 +24,7 @@ from __future__ import annotations
 
 import os
 from dataclasses import dataclass, field
-from typing import Iterable, Sequence
+from typing import Any, Iterable, Sequence
 
 import numpy as np
 
@@ -47,15 +47,15 @@ _THREADED_POINTS = 100_000
 class Terms:
     """The entries of the eliminated system at each (batch, frequency) point."""
 
-    omega: object
-    K1: object  # host: k1 - m1 ω² + iω c1 (+ host effects)
-    Kp: object  # piezo mechanical branch: kp + iω cp
-    b: object  # e / Cp
-    Z33: object  # 1/Cp + iω Zs
-    M2: object  # m2 ω²
-    F0: object
-    s1: object = None  # sensor factor on a1 (None = 1)
-    s2: object = None
+    omega: Any  # arrays (NumPy or torch) broadcast over (batch, frequency)
+    K1: Any  # host: k1 - m1 ω² + iω c1 (+ host effects)
+    Kp: Any  # piezo mechanical branch: kp + iω cp
+    b: Any  # e / Cp
+    Z33: Any  # 1/Cp + iω Zs
+    M2: Any  # m2 ω²
+    F0: Any
+    s1: Any = None  # sensor factor on a1 (None = 1)
+    s2: Any = None
 
 
 def terms(omega, rig: Rig, effects: Sequence[Effect] = ()) -> Terms:

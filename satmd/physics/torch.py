@@ -87,7 +87,7 @@ def _closed_form(omega, rig, effects):
     return solve(terms(omega, rig, effects))
 
 
-_COMPILED = {}  # "fn": the compiled closed form, or "failed": why compiling did not work
+_COMPILED: dict = {}  # "fn": the compiled closed form, or "failed": why compiling did not work
 
 
 def _compiled_closed_form(omega, rig, effects):

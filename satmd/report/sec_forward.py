@@ -40,14 +40,14 @@ def build(ctx) -> str:
     fig, axes = plt.subplots(2, 4, figsize=(16, 6), sharex=True)
     lines += ["The missing-physics vocabulary (SPEC §8): each effect is an exact change to the model.", "",
               "| effect | physics | example | max change of A1 |", "|---|---|---|---|"]
-    base = r.a1
+    base = r.channel("a1")
     for ax, eff in zip(axes.flat, examples):
         ra = frf(f, rig, [eff])
         ax.semilogy(f, np.abs(base), "k", lw=1, label="nominal")
-        ax.semilogy(f, np.abs(ra.a1), "tab:red", lw=1, label=eff.name)
+        ax.semilogy(f, np.abs(ra.channel("a1")), "tab:red", lw=1, label=eff.name)
         ax.set_title(eff.name, fontsize=9)
         ax.legend(fontsize=7)
-        change = np.max(np.abs(ra.a1 - base) / np.abs(base))
+        change = np.max(np.abs(ra.channel("a1") - base) / np.abs(base))
         lines.append(f"| `{eff.name}` | {eff.description} | {eff!r} | {100 * change:.1f} % |")
     axes.flat[-1].axis("off")
     fig.supxlabel("frequency [Hz]")

@@ -48,9 +48,9 @@ def build(ctx) -> str:
     hybrid = InverseModel.__new__(InverseModel)
     hybrid.__dict__.update(model.__dict__)
     hybrid.kind = "hybrid"
-    t2 = {"table2": {"physics": table2(model), "hybrid": table2(hybrid)},
+    t2: dict = {"table2": {"physics": table2(model), "hybrid": table2(hybrid)},
           "paper_table2_mae": {"R": 0.0823, "L": 0.000572}}
-    info = model.fit_info_
+    info: dict = model.fit_info_
     lines = [
         "A deep ensemble of the paper's inverse net (240 → 256 → 128 → 64 → 2, ReLU, sigmoid outputs "
         "denormalised with R ∈ [0, 103] Ω, L ∈ [0, 0.5] H) is trained on the `paper` preset: the 30 "

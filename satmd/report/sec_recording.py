@@ -47,7 +47,7 @@ def build(ctx) -> str:
     concealed = simulate_recording(duration, 1000.0, effects=[hidden], noise=0.02, force_noise=0.01, seed=2)
     lpm, welch = estimate_frf(null), estimate_frf(null, estimator="H1")
     grid = np.linspace(20.0, 200.0, 4000)
-    truth = frf(grid, Rig(), outputs=("a1",)).a1
+    truth = frf(grid, Rig(), outputs=("a1",)).channel("a1")
     peak = float(grid[np.argmax(np.abs(truth))])
     rows = [_row("nothing missing, LPM (default)", discover(lpm)),
             _row("nothing missing, Welch H1 (compared through the window)", discover(welch))]

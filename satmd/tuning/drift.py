@@ -177,14 +177,15 @@ def retune(
     if len(labels) != len(series):
         raise DataError(f"{len(labels)} labels for {len(series)} FRFs")
     obj = Objective(objective, output, tuple(band))
-    prev, results, fixed = None, [], None
+    prev, results = None, []
+    fixed: dict = {}  # the first setting, kept through the series
     fixed_values, open_values = [], []
     for data in series:
         fit = identify(data, rig, free, start=prev, global_search=prev is None, warn=False)
         prev = dict(fit.values)
         res = tune(fit, objective, output, band, bounds, design, closed_form_check=False, **tune_options)
         results.append(res)
-        if fixed is None:
+        if not fixed:
             fixed = dict(res.design)
         fixed_values.append(float(obj(fit.rig.replace(**fixed), fit.effects)[0]))
         open_values.append(float(obj(fit.rig.replace(R=OPEN_CIRCUIT_R), fit.effects)[0]))

@@ -14,6 +14,7 @@
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
@@ -151,7 +152,8 @@ def minimise(batch_fun, fun, dim: int, n_search: int = 1024, n_starts: int = 3, 
         return u, f, res.nfev
 
     # coarse runs from every start, then the best one polished with restarts
-    best_u, best_f = None, np.inf
+    best_u: Any = None
+    best_f = np.inf
     for u0 in starts:
         u, f, n = run(np.asarray(u0, float), float(fun(u0)), 0.05, 1e-3, 1e-6, 80 * dim)
         nfev += n + 1

@@ -4,6 +4,7 @@ from __future__ import annotations
 import json
 import math
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 
@@ -51,8 +52,8 @@ class TuneResult:
     notes: tuple = ()
     nfev: int = 0
     wall_time: float = 0.0
-    _rig: object = field(default=None, repr=False, compare=False)  # model with the optimal design
-    _current_rig: object = field(default=None, repr=False, compare=False)
+    _rig: Any = field(default=None, repr=False, compare=False)  # model with the optimal design (a Rig)
+    _current_rig: Any = field(default=None, repr=False, compare=False)
     _effects: tuple = field(default=(), repr=False, compare=False)
 
     # --- derived figures --------------------------------------------------------

@@ -162,7 +162,7 @@ class Effect:
             _same(self.params[k], other.params[k]) for k in self.params
         )
 
-    __hash__ = None
+    __hash__ = None  # type: ignore[assignment]  # equal by value, mutable parameters: unhashable
 
     def replace(self, **params) -> "Effect":
         """A copy with some parameter values changed."""

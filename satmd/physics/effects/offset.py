@@ -26,7 +26,7 @@ class ParameterOffset(Effect):
         super().__init__(**params)
 
     @classmethod
-    def at_rest(cls, rig, parameter: str) -> "ParameterOffset":
+    def at_rest(cls, rig, parameter: str) -> "ParameterOffset":  # type: ignore[override]  # names its parameter
         """No offset: the rig's own value."""
         return cls(parameter, value=float(getattr(rig, parameter)))
 

@@ -5,12 +5,14 @@ physical states.
 """
 from __future__ import annotations
 
+from typing import Any
+
 import numpy as np
 
 from .. import dual
 from .base import Effect, Parameter, scaled
 
-_GAIN = dict(default=1.0, neutral=1.0, hard=(1e-3, 1e3), search=(0.5, 2.0), starts=(0.93, 1.0, 1.07))
+_GAIN: dict[str, Any] = dict(default=1.0, neutral=1.0, hard=(1e-3, 1e3), search=(0.5, 2.0), starts=(0.93, 1.0, 1.07))
 
 
 class SensorGain(Effect):

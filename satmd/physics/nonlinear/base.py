@@ -17,7 +17,7 @@ small-signal limit), which is what the linear model of a rig at low level is.
 from __future__ import annotations
 
 from dataclasses import asdict, dataclass
-from typing import ClassVar
+from typing import Any, ClassVar, cast
 
 import numpy as np
 
@@ -83,7 +83,7 @@ class EquivalentLinear:
     element: str
     parameter: str
     nominal: float
-    value: object
+    value: Any  # a float or an array over levels
     rms: dict
 
     @property
@@ -93,7 +93,7 @@ class EquivalentLinear:
         return "up" if delta > 0 else "down" if delta < 0 else "none"
 
     @property
-    def relative_change(self):
+    def relative_change(self) -> np.ndarray:
         """(value - nominal) / nominal."""
         return (np.asarray(self.value, float) - self.nominal) / self.nominal
 
@@ -203,7 +203,7 @@ class NonlinearElement(Effect):
 
     def linear_limit(self) -> "NonlinearElement":
         """The element at its neutral values (no force beyond the linear model), where there is one."""
-        return self.replace(**{k: v for k, v in self.neutral.items()})
+        return cast("NonlinearElement", self.replace(**{k: v for k, v in self.neutral.items()}))
 
     def to_dict(self) -> dict:
         """JSON-ready dict: name and parameter values."""

@@ -21,7 +21,7 @@ try:  # optional: `pip install numba` makes the integrator ~100x faster
 
     available = True
 except ImportError:  # pragma: no cover - exercised where numba is absent
-    numba = None
+    numba = None  # type: ignore[assignment]  # the NumPy fallback runs
     available = False
 
 HALF_PI = 0.999 * math.pi / 2

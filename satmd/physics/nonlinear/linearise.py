@@ -60,8 +60,9 @@ def response_rms(rig: Rig, band_hz=(20.0, 200.0), force_rms: float = 1.0, force=
     f, psd = _force_psd(band_hz, force_rms, force, fs_hz, n_grid)
     r = frf(f, rig, outputs=("u1", "u2", "q"))
     jw = 2j * np.pi * f
-    d = r.u2 - r.u1
-    sig = {"d": d, "v": jw * d, "u1": r.u1, "v1": jw * r.u1, "i": jw * r.q}
+    u1, u2, q = r.channel("u1"), r.channel("u2"), r.channel("q")
+    d = u2 - u1
+    sig = {"d": d, "v": jw * d, "u1": u1, "v1": jw * u1, "i": jw * q}
     return {k: np.sqrt(np.trapezoid(np.abs(x) ** 2 * psd, f, axis=-1)) for k, x in sig.items()}
 
 
@@ -87,7 +88,8 @@ def equivalent_rig(rig: Rig, elements, band_hz=(20.0, 200.0), force_rms: float =
     rms = response_rms(current, band_hz, force_rms, force, fs_hz, n_grid)
     prev = None
     for it in range(iterations):
-        changes, eqs = {}, []
+        changes: dict = {}
+        eqs = []
         for el in elements:
             eq = el.equivalent_linear(rig, rms)
             eqs.append(eq)
