@@ -7,8 +7,9 @@
 Steps (each module says how):
 
 1. detect from each recording: nonlinear distortion regressors in local
-   polynomial windows (`nonlinear_stats.linearity_test`), or the detection lines
-   of a multisine (`nonlinear_periodic`);
+   polynomial windows, one regressor at a time in windows about a resonance wide
+   (`nonlinear_stats.separate_linearity_test`, Bonferroni over the regressors),
+   or the detection lines of a multisine (`nonlinear_periodic`);
 2. detect from several: their FRFs against their noise
    (`nonlinear_stats.level_dependence`), located as bands;
 3. name (SATMD rigs): which linear parameter moves with level and which way,
@@ -26,8 +27,14 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..conventions import ACCEL_CHANNELS, DEFAULT_FREE
-from .nonlinear_stats import NonlinearTest, distortion_regressors, integrate, level_dependence, linearity_test
+from ..conventions import ACCEL_CHANNELS
+from .nonlinear_stats import (
+    NonlinearTest,
+    distortion_regressors,
+    integrate,
+    linearity_test,
+    separate_linearity_test,
+)
 
 UNEXPLAINED_NL = "nonlinear_unexplained"
 EXPERIMENT_LEVEL = "record a second level (about 20 dB apart, same band): the level dependence names the element"
@@ -125,6 +132,8 @@ def distortion_test(recording, band=None, alpha: float = 1e-3) -> NonlinearTest:
         signals = {"y": y - np.mean(y), "dy": np.gradient(y) * fs}
         shapes = {"y": ("square", "cube"), "dy": ("cube", "absv")}
     regs = distortion_regressors(signals, shapes)
+    if accs:
+        return separate_linearity_test(x, responses, fs, regs, band=band, alpha=alpha)
     return linearity_test(x, responses, fs, regs, band=band, alpha=alpha)
 
 

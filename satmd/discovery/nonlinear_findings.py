@@ -24,9 +24,11 @@ from .nonlinear import (
 )
 from .nonlinear_stats import NonlinearTest, level_dependence
 
-_REGRESSOR_HINT = {"u1": "the host's displacement (a host spring?)", "d": "the absorber's stroke (its spring?)",
-                   "v": "the absorber's relative velocity (friction or velocity-squared damping?)",
-                   "y": "the output", "dy": "the output's rate"}
+_REGRESSOR_HINT = {"u1:cube": "u1³ of the host's displacement (a host spring?)",
+                   "d:cube": "d³ of the absorber's stroke (its spring, or the shunt's inductor?)",
+                   "v:cube": "v³ of the absorber's relative velocity (a damping that grows with level?)",
+                   "v:absv": "|v|v of the absorber's relative velocity (velocity-squared damping?)",
+                   "v:sign": "sign(v) of the absorber's relative velocity (friction?)"}
 
 
 def force_levels(recordings) -> list:
@@ -61,7 +63,11 @@ def _hint(test: NonlinearTest) -> str:
         return f"distortion at {where}; at the detection lines {parts} (odd: a symmetric nonlinearity)"
     expl = test.details.get("explained", {})
     chans = ", ".join(f"{c} {100 * v:.0f} %" for c, v in expl.items())
-    return f"distortion at {where}; nonlinear functions of the responses explain {chans} of the local residual"
+    text = f"distortion at {where}; nonlinear functions of the responses explain {chans} of the local residual"
+    regs = test.details.get("regressors") or []
+    if test.details.get("per_regressor") and regs and regs[0] in _REGRESSOR_HINT:
+        text += f"; the regressor that holds it best is {_REGRESSOR_HINT[regs[0]]} (a hint, not a name)"
+    return text
 
 
 def analyse_recordings(recordings, rig=None, free=DEFAULT_FREE, alpha: float = 1e-3, datas=None) -> NonlinearReport:
