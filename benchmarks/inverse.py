@@ -68,18 +68,13 @@ def main(argv=None):
     ap.add_argument("--device", default=None, help="training device for --training (default: CUDA when present)")
     ap.add_argument("--label", default="", help="a note stored with the --training figures")
     ap.add_argument("--once", action="store_true", help="issue 29: old (hold-out + refit) vs new (cross-fit) training")
-    ap.add_argument("--seeds", default="0,1,2,3,4", help="--once: seeds of the MAE comparison")
-    ap.add_argument("--thread-counts", default="1,2", help="--once: torch threads timed on the first seed")
-    ap.add_argument("--coverage-noise", type=float, default=0.01, help="--once: noise of the coverage check (0: none)")
-    ap.add_argument("--methods", default="old,new", help="--once: methods to run (records of the others are kept)")
-    ap.add_argument("--only", choices=("coverage", "threads"), help="--once: only the coverage or the thread-count jobs")
+    sys.path.insert(0, str(Path(__file__).resolve().parent))
+    from inverse_once import add_arguments, run_args
+
+    add_arguments(ap.add_argument_group("--once (benchmarks/inverse_once.py takes the same options)"))
     args = ap.parse_args(argv)
     if args.once:
-        from inverse_once import run_once
-
-        return run_once([int(x) for x in args.seeds.split(",") if x], [int(x) for x in args.thread_counts.split(",")
-                                                                        if x], args.coverage_noise,
-                        tuple(args.methods.split(",")), args.only)
+        return run_args(args)
     if args.training:
         return time_training(args.threads, args.device, args.label)
     out = Path(args.out)

@@ -1,7 +1,9 @@
 """Issue 29, train the inverse once: the method before (hold-out + refit) against the new default (cross-fit).
 
-Run through ``python benchmarks/inverse.py --once`` (see its docstring for the
-jobs); this module holds the work and ``readme_markdown``, which
+Run as ``python benchmarks/inverse_once.py [--seeds 0,1,2,3,4] [--thread-counts 1,2]
+[--coverage-noise 0.01] [--methods old,new] [--only coverage|threads]`` (or through
+``python benchmarks/inverse.py --once``, the same options; its docstring lists the
+jobs; ``--summary`` only recomputes the summary); this module holds the work and ``readme_markdown``, which
 ``benchmarks/readme_tables.py`` renders into the README's ``inverse_once``
 region from benchmarks/results/inverse_once.json.
 """
@@ -224,13 +226,39 @@ def readme_markdown(res: dict) -> str:
     return "\n".join(lines)
 
 
-if __name__ == "__main__":
+def main(argv=None):
+    """Command line (``--help``); ``python benchmarks/inverse.py --once ...`` takes the same options."""
     import argparse
 
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    add_arguments(ap)
     ap.add_argument("--summary", action="store_true", help="only recompute the summary of inverse_once.json")
-    if ap.parse_args().summary:
+    args = ap.parse_args(argv)
+    if args.summary:
         r = json.loads(OUT.read_text(encoding="utf-8"))
         r["summary"] = summarise(r["records"])
         OUT.write_text(json.dumps(r, indent=1), encoding="utf-8")
         print(headline(r["summary"]))
+        return r
+    return run_args(args)
+
+
+def add_arguments(ap) -> None:
+    """The options of the comparison (shared with ``benchmarks/inverse.py --once``)."""
+    ap.add_argument("--seeds", default="0,1,2,3,4", help="seeds of the MAE comparison (1 torch thread, noise 0)")
+    ap.add_argument("--thread-counts", default="1,2", help="torch threads timed on the first seed (old and new "
+                    "back to back, wall and CPU seconds)")
+    ap.add_argument("--coverage-noise", type=float, default=0.01, help="noise of the coverage check (0: none)")
+    ap.add_argument("--methods", default="old,new", help="methods to run (records of the others are kept)")
+    ap.add_argument("--only", choices=("coverage", "threads"), help="only the coverage or the thread-count jobs")
+
+
+def run_args(args) -> dict:
+    """`run_once` with parsed `add_arguments` options."""
+    return run_once([int(x) for x in args.seeds.split(",") if x],
+                    [int(x) for x in args.thread_counts.split(",") if x], args.coverage_noise,
+                    tuple(args.methods.split(",")), args.only)
+
+
+if __name__ == "__main__":
+    main()

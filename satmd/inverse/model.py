@@ -72,9 +72,11 @@ class InverseModel:
     lr_final : learning rate at the end of each phase (cosine schedule)
     n_members : ensemble members
     precondition : Gauss-Newton preconditioning of the eq. 22 gradient
-    jacobian : how the preconditioner gets d residual / d(R, L): "shunt" (one difference in R;
-        dA/dL = iω dA/dR since R, L enter only through Zs = R + iωL) or "fd" (both by differences,
-        one more twin call: the method before issue 29)
+    jacobian : how training gets the residuals of eq. 22 and d residual / d(R, L): "mobius" (each
+        acceleration a Möbius map of Zs = R + iωL, fitted once from the twin: exact derivatives, no twin
+        call per step, gradients back-propagated by hand; `satmd.inverse.objective.ShuntMobius`), "shunt"
+        (the twin, one difference in R; dA/dL = iω dA/dR) or "fd" (the twin, both by differences: the
+        method before issue 29)
     twin_dtype : precision of the torch twin in training, "complex64" or "complex128"
     threads : torch CPU threads during training (None leaves torch's setting)
     samples_per_pair : paper preset: samples around each pair (None: ``PRESET_SIZES``)
@@ -99,7 +101,7 @@ class InverseModel:
         "batch_size": [Interval(Integral, 1)], "lr": [Interval(Real, 0, 1, "lo")],
         "physics_lr": [Interval(Real, 0, 1, "lo")], "lr_final": [Interval(Real, 0, 1)],
         "n_members": [Interval(Integral, 1, 256)], "precondition": [bool],
-        "jacobian": [Options(("shunt", "fd"))],
+        "jacobian": [Options(("mobius", "shunt", "fd"))],
         "twin_dtype": [Options(("complex64", "complex128"))], "threads": [None, Interval(Integral, 1)],
         "samples_per_pair": [None, Interval(Integral, 1)], "n_samples": [None, Interval(Integral, 2)],
         "val_fraction": [Interval(Real, 0, 1, "hi")], "refit": [bool],
@@ -111,7 +113,7 @@ class InverseModel:
 
     def __init__(self, kind="physics", preset="paper", noise=0.0, *, epochs=90, warm_start_epochs=50,
                  batch_size=64, lr=1e-3, physics_lr=3e-4, lr_final=1e-5, n_members=5, precondition=True,
-                 jacobian="shunt", twin_dtype="complex64", threads=1, samples_per_pair=None, n_samples=None,
+                 jacobian="mobius", twin_dtype="complex64", threads=1, samples_per_pair=None, n_samples=None,
                  val_fraction=0.2, refit=True, calibration="crossfit", mc_samples=64, refine_nfev=20, seed=0,
                  device=None, verbose=True, rig=None, freq_hz=PAPER_GRID_HZ):
         self.kind = kind

@@ -8,6 +8,10 @@ is the latent of use case III.
 deep ensemble is trained as one batched computation (``torch.baddbmm``),
 never a Python loop over members or samples. ``EnsembleNet.member(k)``
 returns member ``k`` as a plain ``InverseNet`` with a copy of its weights.
+For training, `EnsembleNet.train_forward` and `EnsembleNet.set_grad` run the
+pass and its back-propagation by hand (no autograd graph): the objectives
+give the gradient with respect to the outputs directly, and on a CPU the
+autograd engine cost about 15 % of a training step of this small net.
 """
 from __future__ import annotations
 
@@ -73,6 +77,35 @@ class EnsembleNet(nn.Module):
 
     def forward(self, x: torch.Tensor) -> torch.Tensor:
         return torch.sigmoid(self.logits(x))
+
+    def train_forward(self, x: torch.Tensor):
+        """Outputs (E, n, 2) and the layer inputs `set_grad` needs, without autograd."""
+        ws, bs = list(self.weights), list(self.biases)
+        with torch.no_grad():
+            acts = [self._broadcast(x)]
+            h = acts[0]
+            for w, b in zip(ws[:-1], bs[:-1]):
+                h = torch.baddbmm(b, h, w).relu_()
+                acts.append(h)
+            out = torch.baddbmm(bs[-1], h, ws[-1]).sigmoid_()
+        return out, acts
+
+    def set_grad(self, acts, out: torch.Tensor, grad_out: torch.Tensor) -> None:
+        """Back-propagate d objective / d outputs (E, n, 2) through `train_forward`'s pass into each ``.grad``.
+
+        The gradients are written (not accumulated) into buffers kept between calls.
+        """
+        ws, bs = list(self.weights), list(self.biases)
+        with torch.no_grad():
+            dz = torch.ops.aten.sigmoid_backward(grad_out, out)
+            for k in range(len(ws) - 1, -1, -1):
+                w, b, h = ws[k], bs[k], acts[k]
+                if w.grad is None:
+                    w.grad, b.grad = torch.empty_like(w), torch.empty_like(b)
+                torch.bmm(h.transpose(1, 2), dz, out=w.grad)
+                torch.sum(dz, dim=1, keepdim=True, out=b.grad)
+                if k:
+                    dz = torch.ops.aten.threshold_backward(torch.bmm(dz, w.transpose(1, 2)), h, 0.0)  # the ReLU
 
     def member(self, k: int) -> InverseNet:
         net = InverseNet(self.sizes)

@@ -4,6 +4,10 @@ Outputs are normalised (R, L) of any leading shape (..., n, 2); targets are
 complex FRFs (..., n, 2, F) that broadcast against them: one target set for
 every ensemble member (n, 2, F), or one per member (E, n, 2, F) when members
 train on different samples (cross-fitting, `satmd.inverse.training`).
+
+`ShuntMobius` evaluates the same residuals and the same Gauss-Newton step
+without a twin call per step (the default ``jacobian="mobius"``); the twin
+functions here are the reference it is checked against and the fallback.
 """
 from __future__ import annotations
 
@@ -15,6 +19,8 @@ except ImportError as exc:  # pragma: no cover
 from ..physics import Rig
 from ..physics.torch import frf as torch_frf
 from .dataset import BOUNDS
+
+import numpy as np
 
 MAX_STEP = 0.05  # largest Gauss-Newton step per output (normalised units)
 FD_STEP = {"complex128": 1e-6, "complex64": 1e-3}  # finite-difference step of the Jacobian, per twin precision
@@ -118,3 +124,90 @@ def physics_objective(out, target, s_n, freq_t, rig, bounds=BOUNDS, dtype=torch.
     step, loss = gn_step(out, target, s_n, freq_t, rig, bounds, dtype)
     step = step.clamp(-MAX_STEP, MAX_STEP).to(out.dtype) / out[..., 0].numel()
     return (out * step).sum(), loss.mean()
+
+
+class ShuntMobius:
+    """The twin's accelerations as Möbius maps of the shunt impedance, fitted once per rig and grid.
+
+    R and L enter the model only through ``Zs = R + iωL`` (SPEC §2), which
+    enters one entry of the system matrix linearly, so at each frequency
+    each acceleration is a Möbius map ``A(Zs) = (a Zs + b) / (c Zs + 1)``.
+    `fit` takes the three coefficients per channel and frequency from three
+    twin evaluations (complex128) and checks the map against the twin at
+    further points; a rig that the map does not reproduce to ``TOL`` gets
+    None (the caller keeps the twin). Evaluating the map and its derivative
+    ``A' = (a - c A) / (c Zs + 1)`` exactly (no finite difference) costs a
+    few complex operations per point, where the twin path costs two twin
+    evaluations per training step.
+    """
+
+    ANCHORS = ((5.0, 0.02), (50.0, 0.25), (100.0, 0.45))  # (R [Ω], L [H]) of the three fitting points
+    CHECKS = ((20.0, 0.40), (80.0, 0.05), (0.5, 0.001), (103.0, 0.5), (35.0, 0.19))
+    TOL = 1e-8  # largest |map - twin| / max |twin| at the check points (complex128)
+
+    def __init__(self, coef, omega, bounds, dtype):
+        self.a, self.b, self.c = (coef[..., k].to(dtype) for k in range(3))  # each (2, F)
+        self.omega = omega.to(real_of(dtype))
+        self.bounds = bounds
+        self.span_r = float(bounds["R"][1] - bounds["R"][0])
+        # the L column of the Jacobian is i w times the R column, w = ω span_L / span_R (per frequency)
+        self.w = self.omega * float((bounds["L"][1] - bounds["L"][0]) / self.span_r)
+        self.n_freq = omega.numel()
+
+    @classmethod
+    def fit(cls, freq_t, rig: Rig, bounds=BOUNDS, dtype=torch.complex64):
+        """The map for ``rig`` on the grid ``freq_t`` (a real tensor), or None where the twin is not of this form."""
+        freq = freq_t.detach().to(torch.float64)
+        omega = 2 * np.pi * freq.cpu().numpy()
+
+        def twin(points):
+            p = np.asarray(points, float)
+            out = torch_frf(freq.cpu(), rig.replace(R=p[:, 0], L=p[:, 1]), dtype=torch.complex128, outputs=("a1", "a2"))
+            return np.stack([out["a1"].numpy(), out["a2"].numpy()], axis=1)  # (k, 2, F)
+
+        def zs(points):
+            p = np.asarray(points, float)
+            return (p[:, 0, None] + 1j * omega * p[:, 1, None])[:, None, :]  # (k, 1, F)
+
+        z, w = np.broadcast_arrays(zs(cls.ANCHORS), twin(cls.ANCHORS))
+        # a z + b - c z w = w at the three anchors: one 3x3 system per channel and frequency
+        system = np.moveaxis(np.stack([z, np.ones_like(w), -z * w], axis=-1), 0, -2)  # (2, F, 3, 3)
+        with np.errstate(all="ignore"):
+            try:
+                coef = np.linalg.solve(system, np.moveaxis(w, 0, -1)[..., None])[..., 0]  # (2, F, 3)
+            except np.linalg.LinAlgError:
+                return None
+            zc, wc = zs(cls.CHECKS), twin(cls.CHECKS)
+            mapped = (coef[..., 0] * zc + coef[..., 1]) / (coef[..., 2] * zc + 1)
+            err = np.max(np.abs(mapped - wc)) / np.max(np.abs(wc))
+        if not np.isfinite(err) or err > cls.TOL:
+            return None
+        return cls(torch.as_tensor(coef, device=freq_t.device), torch.as_tensor(omega, device=freq_t.device),
+                   bounds, dtype)
+
+    def residuals(self, norm_out, target, s_n):
+        """Scaled complex residuals (..., n, 2, F) ``(A - target) / s_n``, the map's ``A'`` and ``1/s_n``."""
+        R, L = _denormalised(norm_out.to(self.omega.dtype), self.bounds)
+        z = torch.complex(R[..., None], L[..., None] * self.omega).unsqueeze(-2)  # (..., n, 1, F)
+        inv_d = 1.0 / (self.c * z + 1)
+        acc = (self.a * z + self.b) * inv_d
+        inv_s = (1.0 / s_n)[..., None, None]
+        return (acc - target) * inv_s, (self.a - self.c * acc) * inv_d, inv_s
+
+    def physics_loss(self, norm_out, target, s_n):
+        """Eq. 22 per sample (..., n), differentiable (as `physics_loss`)."""
+        d, _, _ = self.residuals(norm_out, target, s_n)
+        return (d.real * d.real + d.imag * d.imag).sum(dim=(-2, -1)) / self.n_freq
+
+    def gauss_newton_step(self, norm_out, target, s_n, damping: float = 1e-3):
+        """`gauss_newton_step` with the map's exact derivative: ``(step, loss)``, (..., n, 2) and (..., n)."""
+        with torch.no_grad():
+            d, dacc, inv_s = self.residuals(norm_out.detach(), target, s_n)
+            jr = dacc * (inv_s * self.span_r)  # d residual / d normalised R
+            jr2 = jr.real * jr.real + jr.imag * jr.imag
+            g = jr.conj() * d
+            a = jr2.sum(dim=(-2, -1)) * (1 + damping) + 1e-30
+            c = (jr2 * (self.w * self.w)).sum(dim=(-2, -1)) * (1 + damping) + 1e-30
+            step = torch.stack([g.real.sum(dim=(-2, -1)) / a, (g.imag * self.w).sum(dim=(-2, -1)) / c], dim=-1)
+            loss = (d.real * d.real + d.imag * d.imag).sum(dim=(-2, -1)) / self.n_freq
+        return step, loss

@@ -17,21 +17,30 @@ Objectives
     With ``precondition`` (default) every sample asks its outputs to move by
     its Gauss-Newton step of eq. 22 (`gauss_newton_step`; at most
     ``MAX_STEP``), because the FRFs are far less sensitive to R than to L and
-    plain gradient steps leave R loose. The Jacobian comes from one batched
-    twin call at (R, L) and two nudged points, so no graph is kept through the
-    twin. Without it the plain gradient of eq. 22 is back-propagated through
-    the twin. A warm start of ``warm_start_epochs`` supervised epochs puts the
-    nets near the solution first (the physics loss is flat far from it).
+    plain gradient steps leave R loose. By default (``jacobian="mobius"``)
+    the residuals and their exact Jacobian come from
+    `satmd.inverse.objective.ShuntMobius`: each acceleration is a Möbius map
+    of the shunt impedance, fitted once from the twin, so no twin call is made
+    per step. ``jacobian`` "shunt" / "fd" call the twin every step and take the
+    Jacobian by finite differences (the method before issue 29). Without
+    ``precondition`` the plain gradient of eq. 22 is back-propagated. A warm
+    start of ``warm_start_epochs`` supervised epochs puts the nets near the
+    solution first (the physics loss is flat far from it).
 ``supervised``
     Mean squared error on the normalised labels (the paper's "conventional
     supervised regressor" baseline).
 
 Speed
 -----
-What a step costs on a CPU: the twin (eq. 22 and its Jacobian: one batched
-call in complex64, no graph through it), the net's forward and backward (all
-members in one ``baddbmm`` per layer), and Adam (fused: unfused, the update
-cost as much as the net). Training is *step*-limited, not sample-limited:
+What a step costs on a CPU: the net's forward and backward (all members in
+one ``baddbmm`` / ``bmm`` per layer: most of the time), Adam (fused:
+unfused, the update cost as much as the net), and in the physics phase the
+Gauss-Newton step. The default step (`satmd.inverse.steps.step_by_hand`) gets
+d objective / d outputs from the objective and back-propagates it by hand
+(`satmd.inverse.nets.EnsembleNet.set_grad`, the same products autograd
+takes, without its graph), and evaluates the Möbius map instead of the twin
+(a third of the twin step's time, and exact where complex64 finite
+differences were not). Training is *step*-limited, not sample-limited:
 at equal epochs a batch of 256 took a quarter of the steps and gave a
 Table 2 MAE ten times worse at a third of the preset's data, and saved only
 ~20 % per sample on a CPU, so the default batch stays 64. On a GPU, raise
@@ -76,10 +85,10 @@ except ImportError as exc:  # pragma: no cover
 from ..physics import Rig
 from .dataset import BOUNDS, InverseDataset
 from .nets import EnsembleNet
-from .objective import gauss_newton_step, physics_loss, physics_objective, real_of  # noqa: F401 - re-exported
+from .objective import ShuntMobius, gauss_newton_step, physics_loss, physics_objective, real_of  # noqa: F401 - re-exported
+from .steps import TrainingRun, run_phase
 
 REFERENCE_BATCH = 64  # the batch at which ``lr`` is quoted (sqrt rule above)
-N_VAL_POINTS = 20  # validation MAE is recorded this many times per run (cheap history, not every epoch)
 
 
 @dataclass(frozen=True)
@@ -100,7 +109,7 @@ class TrainConfig:
     precondition: bool
     threads: int | None
     twin_dtype: str
-    jacobian: str = "shunt"
+    jacobian: str = "mobius"
 
     def to_dict(self):
         return asdict(self)
@@ -240,12 +249,16 @@ def train_ensemble(train: InverseDataset, val: InverseDataset | None, config: Tr
     total_epochs = sum(p[1] for p in phases)
     bar = _progress(total_epochs, verbose, f"train {config.objective}")
     t_start = time.perf_counter()
+    mobius = ShuntMobius.fit(freq_t, rig, bounds, dtype) if config.jacobian == "mobius" else None
+    if config.jacobian == "mobius":
+        history["mobius"] = mobius is not None  # False: the twin's accelerations are not of that form here
+    run = TrainingRun(net, tr, va, freq_t, config, rig, bounds, dtype, gen, noise_gen, total_epochs, history, bar,
+                      mobius)
     with _cpu_threads(config.threads if device.type == "cpu" else None):
         for objective, n_epochs, peak in phases:
             # a fresh Adam per phase: the moment estimates of the other loss do not carry over
             opt = _adam(net, scaled_lr(peak, config.batch_size), device)
-            _run_phase(net, opt, tr, va, freq_t, config, rig, bounds, dtype, gen, noise_gen, objective, n_epochs,
-                       scaled_lr(peak, config.batch_size), total_epochs, history, bar)
+            run_phase(run, opt, objective, n_epochs, scaled_lr(peak, config.batch_size))
     if bar is not None:
         bar.close()
     history["train_s"] = time.perf_counter() - t_start
@@ -273,58 +286,6 @@ def _cpu_threads(n):
         yield
     finally:
         torch.set_num_threads(before)
-
-
-def _run_phase(net, opt, tr, va, freq_t, config, rig, bounds, dtype, gen, noise_gen, objective, n_epochs, peak,
-               total_epochs, history, bar):
-    """One phase of mini-batch epochs (all members at once), cosine learning rate from ``peak``."""
-    device = tr.x.device
-    batch = int(config.batch_size)
-    steps = n_epochs * max(1, math.ceil(tr.n_epoch / batch))
-    val_every = max(1, math.ceil(total_epochs / N_VAL_POINTS))
-    step = 0
-    for _ in range(n_epochs):
-        t0 = time.perf_counter()
-        order = tr.epoch_order(gen)
-        total = torch.zeros((), device=device)  # summed on the device: no host sync per step
-        net.train()
-        for i in range(0, tr.n_epoch, batch):
-            idx = order[..., i:i + batch]  # (B,) shared by the members, or (E, B): one mini-batch per member
-            x = tr.x[idx]
-            if config.noise:
-                eps = torch.randn(x.shape if x.ndim == 3 else (net.n_members,) + tuple(x.shape), generator=noise_gen,
-                                  device=device)
-                x = x + config.noise * tr.noise_unit[idx] * eps
-            t = min(1.0, step / max(1, steps))
-            for g in opt.param_groups:
-                g["lr"] = config.lr_final + 0.5 * (peak - config.lr_final) * (1 + math.cos(math.pi * t))
-            out = net(x)
-            if objective == "physics":
-                obj, loss = physics_objective(out, tr.target[idx], tr.s_n[idx], freq_t, rig, bounds, dtype,
-                                              config.precondition, config.jacobian)
-            else:
-                obj = loss = ((out - tr.y[idx]) ** 2).mean()
-            opt.zero_grad(set_to_none=True)
-            obj.backward()
-            opt.step()
-            total += loss.detach().to(total.dtype) * idx.shape[-1]
-            step += 1
-        history["loss"].append(float(total) / tr.n_epoch)
-        history["phase"].append(objective)
-        epoch = len(history["loss"])
-        if va is not None and (epoch % val_every == 0 or epoch == total_epochs):
-            net.eval()
-            with torch.no_grad():
-                pred = net(va.x).mean(dim=0)
-                history["val_mae"].append((pred - va.y).abs().mean(dim=0).tolist())
-                history["val_epoch"].append(epoch)
-        history["epoch_s"].append(time.perf_counter() - t0)
-        if bar is not None:
-            post = {"loss": f"{history['loss'][-1]:.3g}", "phase": objective[:4]}
-            if history["val_mae"]:
-                post["val"] = f"{max(history['val_mae'][-1]):.2e}"
-            bar.set_postfix(post, refresh=False)
-            bar.update(1)
 
 
 def _progress(total, verbose, desc):
