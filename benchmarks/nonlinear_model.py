@@ -3,20 +3,35 @@ level prediction against the best linear model (error against the noisy recordin
 noise-free truth the benchmark knows), tuning across levels, integrator speed.
 
 Recordings come from the INDEPENDENT simulator `benchmarks/_indep_nl_sim.py` (RK4, its own equations,
-shares no code with satmd; run at 2x the rate and decimated, see UP), 40 s at 2048 Hz, random force spectra, white noise 1 % on the
+shares no code with satmd; run at 2x the rate and decimated, see UP), ``--duration`` s at 2048 Hz, random force spectra, white noise 1 % on the
 accelerometers and 0.5 % on the force. Per element and seed: a rig drawn at random (m2, kp, R, L),
 the element at a strength that moves its equivalent parameter by ~12 % (kp, k1, L) or ~3 N·s/m (cp)
-at the top level, three levels: 1, 4 and 10 N RMS. The model (element + m2, kp, R, L) is fitted by
-`satmd.identification.nonlinear.fit_nonlinear` on the 1 and 10 N recordings (first ``--seconds`` s
-of each), the 4 N recording is held out and predicted; the best linear model (m2, kp, R, L fitted in
-the time domain on the same two recordings) predicts it too.
+at the top level, three levels: 1, 4 and 10 N RMS. Two hold-out designs, each fitted by
+`satmd.identification.nonlinear.fit_nonlinear` (element + m2, kp, R, L) on the first ``--seconds`` s
+of its two training recordings:
+
+- ``extrapolate`` (the headline): fit on 1 and 4 N, predict 10 N. It is the engineer's question
+  ("will the model hold at the drive levels the structure will see?"), and the one a linear model
+  cannot answer: nothing in the training data shows it the top level's equivalent stiffness,
+  damping or inductance.
+- ``interpolate``: fit on 1 and 10 N, predict 4 N (the easier case: the training levels bracket it).
+
+The linear side is the best linear model (`compare_models`): m2, kp, R, L fitted in the time domain
+to both training recordings together and to each alone, the one that predicts the held-out
+recording best chosen on that recording (favours the linear model: the ratio is conservative).
+Both models are driven by the same measured force, kept to its excited band, and judged the same
+way: the headline error is on the force's excited band (20-200 Hz here), where the structure is
+driven; out of band the recording holds accelerometer noise that no model predicts, which caps any
+ratio at the noise level. The broadband ratio and the ratio against the noise-free truth (which
+the benchmark knows) are reported beside it. Coverage: the strength's 95 % interval from both
+designs' fits (two intervals per rig).
 
 Tuning: on one seed per element, `tune_nonlinear` on the fitted model over 1, 4, 10 N; its design is
 simulated on the TRUE rig (satmd's integrator with the true element) and compared with the true
 optimum, a 9 x 9 direct-simulation grid search on the true rig refined once; also the cost of the
 low-level linear tuning on the true rig.
 
-Usage: python benchmarks/nonlinear_model.py [--seeds 4] [--seconds 30] [--elements a,b] [--no-tune]
+Usage: python benchmarks/nonlinear_model.py [--seeds 5] [--seconds 12] [--duration 16] [--elements a,b] [--no-tune]
 Writes benchmarks/results/nonlinear_model.json and prints one line of figures.
 """
 from __future__ import annotations
@@ -103,35 +118,53 @@ def _recordings(name, rigs, params, seconds, seed):
 
 
 def _clean_error(fit, rec, truth, seconds):
-    """RMS(prediction - noise-free truth) / RMS(truth) over a1 and a2 of the held-out recording."""
-    from satmd.identification.nonlinear import predict
+    """Error of the prediction against the noise-free truth: {"band", "broadband"} (a1 and a2 together)."""
+    from satmd.identification.nonlinear import band_error, predict
 
     p = predict(fit, rec, seconds)
     k = int(2.0 * FS)
     n = p["a1"].size
-    err = [np.sum((p[ch][k:] - truth[c, k:n]) ** 2) / np.sum(truth[c, k:n] ** 2) for c, ch in enumerate(("a1", "a2"))]
-    return float(np.sqrt(np.mean(err)))
+    sim, ref = np.vstack([p["a1"], p["a2"]])[:, k:], truth[:, k:n]
+    broad = np.sqrt(np.sum((sim - ref) ** 2, axis=1) / np.sum(ref ** 2, axis=1))
+    band = band_error(sim, ref, FS, p["band_hz"])
+    return {"band": float(np.sqrt(np.mean(band ** 2))), "broadband": float(np.sqrt(np.mean(broad ** 2)))}
 
 
-def _fit_case(name, rig, par, recs, seconds, clean_held):
+def _design(name, rig, par, recs, seconds, clean, train, held):
+    """One hold-out design: fit on the ``train`` levels, predict the ``held`` level."""
     from satmd.identification.nonlinear_compare import compare_models
 
-    t0 = time.perf_counter()
-    out = compare_models([recs[LEVELS[0]], recs[LEVELS[-1]]], [recs[LEVELS[1]]], name, seconds=seconds)
+    out = compare_models([recs[lv] for lv in train], [recs[held]], name, seconds=seconds)
     nl, lin = out.pop("fits")
     truth = {**{k: float(getattr(rig, k)) for k in ("m2", "kp", "R", "L")}, **par}
-    covered = {k: bool(nl.ci95[k][0] <= v <= nl.ci95[k][1]) for k, v in truth.items() if k in nl.ci95}
-    rel_err = {k: float(nl.values[k] / v - 1) for k, v in truth.items() if k in nl.values}
-    held = [r for r in out["levels"] if r["held_out"]][0]
-    vs_truth = {"linear": _clean_error(lin, recs[LEVELS[1]], clean_held, seconds),
-                "nonlinear": _clean_error(nl, recs[LEVELS[1]], clean_held, seconds)}
-    return {"truth": truth, "fitted": nl.values, "ci95": nl.ci95, "covered": covered, "rel_error": rel_err,
-            "held_out_td_error": held["td_error"], "held_out_ratio": held["td_ratio"],
-            "held_out_error_vs_noise_free_truth": vs_truth,
-            "held_out_ratio_vs_truth": vs_truth["linear"] / max(vs_truth["nonlinear"], 1e-300),
+    row = [r for r in out["levels"] if r["held_out"]][0]
+    lin_best = out.pop("linear_fits")[row["linear_model"]]  # the noise-free truth judges the same linear model
+    vs_truth = {"linear": _clean_error(lin_best, recs[held], clean[held], seconds),
+                "nonlinear": _clean_error(nl, recs[held], clean[held], seconds)}
+    ratio_truth = {k: vs_truth["linear"][k] / max(vs_truth["nonlinear"][k], 1e-300) for k in ("band", "broadband")}
+    return {"train_levels": list(train), "held_out_level": held,
+            "fitted": nl.values, "ci95": nl.ci95,
+            "covered": {k: bool(nl.ci95[k][0] <= v <= nl.ci95[k][1]) for k, v in truth.items() if k in nl.ci95},
+            "z": {k: float((nl.values[k] - v) / max(nl.std[k], 1e-300)) for k, v in truth.items() if k in nl.std},
+            "rel_error": {k: float(nl.values[k] / v - 1) for k, v in truth.items() if k in nl.values},
+            "held_out_linear_model": row["linear_model"], "band_hz": row["band_hz"],
+            "held_out_td_error": row["td_error"], "held_out_ratio": row["td_ratio"],
+            "held_out_td_error_broadband": row["td_error_broadband"], "held_out_ratio_broadband": row["td_ratio_broadband"],
+            "held_out_error_vs_noise_free_truth": vs_truth, "held_out_ratio_vs_truth": ratio_truth,
             "frf_residual": [{"level": r["level"], **r["frf_residual"]} for r in out["levels"]],
-            "td_error": [{"level": r["level"], **r["td_error"]} for r in out["levels"]],
-            "seconds": time.perf_counter() - t0, "fit": nl}
+            "td_error": [{"level": r["level"], **r["td_error"]} for r in out["levels"]], "fit": nl, "compare": out}
+
+
+DESIGNS = {"extrapolate": (LEVELS[:2], LEVELS[2]), "interpolate": ((LEVELS[0], LEVELS[2]), LEVELS[1])}
+
+
+def _fit_case(name, rig, par, recs, seconds, clean):
+    t0 = time.perf_counter()
+    out = {"truth": {**{k: float(getattr(rig, k)) for k in ("m2", "kp", "R", "L")}, **par}}
+    for design, (train, held) in DESIGNS.items():
+        out[design] = _design(name, rig, par, recs, seconds, clean, train, held)
+    out["seconds"] = time.perf_counter() - t0
+    return out
 
 
 def _tune_case(name, rig, par, fit):
@@ -191,7 +224,8 @@ def main(argv=None):
     t_all = time.perf_counter()
     result["speed"] = _speed()
     per = {}
-    for e_i, name in enumerate(args.elements.split(",")):
+    for name in args.elements.split(","):
+        e_i = indep.ELEMENTS.index(name)  # seeds by element, not by position: a subset reproduces the full run
         rng = np.random.default_rng(1000 + e_i)
         rigs = [Rig(m2=rng.uniform(0.4, 0.7), kp=rng.uniform(8e4, 1.5e5), R=rng.uniform(10, 60),
                     L=rng.uniform(0.04, 0.2)) for _ in range(args.seeds)]
@@ -201,24 +235,36 @@ def main(argv=None):
         sim_s = time.perf_counter() - t0
         cases = []
         for i, (rig, par) in enumerate(zip(rigs, params)):
-            case = _fit_case(name, rig, par, {lv: recs[(i, lv)] for lv in LEVELS}, args.seconds, clean[(i, LEVELS[1])])
+            case = _fit_case(name, rig, par, {lv: recs[(i, lv)] for lv in LEVELS}, args.seconds,
+                             {lv: clean[(i, lv)] for lv in LEVELS})
             if i == 0 and not args.no_tune:
-                case["tuning"] = _tune_case(name, rig, par, case["fit"])
-            case.pop("fit")
+                case["tuning"] = _tune_case(name, rig, par, case["interpolate"]["fit"])
+            for design in DESIGNS:
+                case[design].pop("fit")
+                case[design].pop("compare")
+                c = case[design]
+                print(name, i, design, {k: round(v, 4) for k, v in c["rel_error"].items()},
+                      {k: round(v, 2) for k, v in c["z"].items()},
+                      "ratio band %.1f broadband %.1f (vs truth %.1f) [%s]" % (
+                          c["held_out_ratio"], c["held_out_ratio_broadband"], c["held_out_ratio_vs_truth"]["band"],
+                          c["held_out_linear_model"]), flush=True)
+            print(name, i, "%.0f s" % case["seconds"], flush=True)
             cases.append(case)
-            print(name, i, {k: round(v, 4) for k, v in case["rel_error"].items()}, case["covered"],
-                  "ratio %.1f (vs truth %.1f)" % (case["held_out_ratio"], case["held_out_ratio_vs_truth"]),
-                  "%.0f s" % case["seconds"], flush=True)
         strength = [k for k in params[0] if k != "v0"][0]
-        per[name] = {
-            "strength_parameter": strength,
-            "coverage": float(np.mean([c["covered"][strength] for c in cases])),
-            "coverage_all_parameters": float(np.mean([v for c in cases for v in c["covered"].values()])),
-            "median_abs_rel_error": float(np.median([abs(c["rel_error"][strength]) for c in cases])),
-            "held_out_ratio_min": float(min(c["held_out_ratio"] for c in cases)),
-            "held_out_ratio_median": float(np.median([c["held_out_ratio"] for c in cases])),
-            "held_out_ratio_vs_truth_min": float(min(c["held_out_ratio_vs_truth"] for c in cases)),
-            "simulation_s": sim_s, "cases": cases}
+        per[name] = {"strength_parameter": strength, "simulation_s": sim_s, "cases": cases}
+        for design in DESIGNS:
+            cs = [c[design] for c in cases]
+            per[name][design] = {
+                "coverage": float(np.mean([c["covered"][strength] for c in cs])),
+                "coverage_all_parameters": float(np.mean([v for c in cs for v in c["covered"].values()])),
+                "median_abs_rel_error": float(np.median([abs(c["rel_error"][strength]) for c in cs])),
+                "z_strength": [c["z"][strength] for c in cs],
+                "held_out_ratio_min": float(min(c["held_out_ratio"] for c in cs)),
+                "held_out_ratio_median": float(np.median([c["held_out_ratio"] for c in cs])),
+                "held_out_ratio_broadband_min": float(min(c["held_out_ratio_broadband"] for c in cs)),
+                "held_out_ratio_vs_truth_min": float(min(c["held_out_ratio_vs_truth"]["band"] for c in cs)),
+                "held_out_ratio_vs_truth_broadband_min": float(min(c["held_out_ratio_vs_truth"]["broadband"] for c in cs))}
+        per[name]["coverage"] = float(np.mean([c[d]["covered"][strength] for c in cases for d in DESIGNS]))
         if "tuning" in cases[0]:
             per[name]["tuning"] = cases[0]["tuning"]
             print(name, "tuning", {k: v for k, v in cases[0]["tuning"].items() if "design" not in k}, flush=True)
@@ -231,8 +277,8 @@ def main(argv=None):
     path = ROOT / "benchmarks" / "results" / "nonlinear_model.json"
     path.write_text(json.dumps(result, indent=1, default=lambda o: o.tolist() if hasattr(o, "tolist") else str(o)))
     cov = ", ".join(f"{k} {100 * v['coverage']:.0f}%" for k, v in per.items())
-    ratio = ", ".join(f"{k} {v['held_out_ratio_min']:.1f}x ({v['held_out_ratio_vs_truth_min']:.0f}x vs truth)"
-                      for k, v in per.items())
+    ratio = "; ".join(f"{d}: " + ", ".join(f"{k} {v[d]['held_out_ratio_min']:.1f}x ({v[d]['held_out_ratio_vs_truth_min']:.0f}x vs truth)"
+                                             for k, v in per.items()) for d in DESIGNS)
     tune = ", ".join(f"{k} gap {v['tuning']['gap_to_true_optimum_db']:+.2f} dB cost {v['tuning']['cost_of_linear_tuning_db']:.2f} dB"
                      for k, v in per.items() if "tuning" in v)
     speed = result["speed"]

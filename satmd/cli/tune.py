@@ -54,6 +54,12 @@ def register(sub):
     p.add_argument("--freq-axis", default=None, metavar="START:STEP", help="frequency axis for .txt files")
     p.add_argument("--json", action="store_true", help="print the SPEC §10 JSON document only")
     p.add_argument("--plot", default=None, metavar="FIG.png", help="response before/after (or retuning over time)")
+    p.add_argument("--levels", default=None, metavar="1,4,10",
+                   help="tune R, L for a nonlinear rig: lowest worst-case peak over these drive levels (force RMS, N), "
+                        "by direct simulation; with --nonlinear")
+    p.add_argument("--nonlinear", action="append", default=[], metavar="NAME[:key=value,...]",
+                   help="SPEC 8b element: with --rig its values (cubic_absorber_spring:k3=2e11); with DATA "
+                        "(recordings) its name, fitted with m2, kp, R, L in the time domain")
     p.set_defaults(func=run)
 
 
@@ -64,6 +70,10 @@ def run(args):
     if (args.rig is None) == (not args.data):
         raise DataError("give DATA (a file, several files or a folder) or --rig, not both")
     files = data_files(args.data)
+    if args.levels is not None or args.nonlinear:  # a nonlinear rig across drive levels
+        from ._tune_levels import run_levels
+
+        return run_levels(args, options["band"], _model_rig, files)
     if args.plot:  # every output is checked before the first piece of work
         check_outputs([("--plot", args.plot, plot_suffixes())], inputs=files)
     if args.rig is not None:

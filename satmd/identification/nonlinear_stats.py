@@ -5,17 +5,32 @@ import math
 
 import numpy as np
 
+from .nonlinear_signal import band_gain
+
+
+def _gauss_newton_step(coords, x, data, weights, skip, simulate, residuals):
+    """The Gauss-Newton step from ``x`` on ``data`` (forward-difference Jacobian, one batched simulation)."""
+    h = 1e-6 * np.maximum(1.0, np.abs(x))
+    X = np.vstack([x] + [x + h[i] * np.eye(x.size)[i] for i in range(x.size)])
+    R = residuals(simulate(coords, X, data), data, weights, skip)
+    J = ((R[1:] - R[0]) / h[:, None]).T
+    return -np.linalg.lstsq(J, R[0], rcond=None)[0]
+
 
 def simex_shift(coords, x, data, weights, skip, draws: int, seed: int = 0, simulate=None, residuals=None):
     """Errors-in-variables correction: the model is driven by the *measured* force, noise included.
 
     That noise biases the fit (it enters the model's nonlinear force and its Jacobian). One step
-    of SIMEX (Cook & Stefanski 1994): add ``draws`` independent copies of in-band white noise of
-    the force-sensor noise's variance (estimated from the force's spectrum outside the excited
-    band), take a Gauss-Newton step from ``x`` for each, and extrapolate linearly in the noise
-    variance back to none: ``x0 = x - mean(step)``. Returns the shift and a covariance to add to
-    the sandwich: the steps' spread (x (1 + 1/draws)), the errors-in-variables part the
-    sandwich's first order misses (conservative). No out-of-band spectrum: no correction.
+    of SIMEX (Cook & Stefanski 1994): the estimate at twice the force noise, extrapolated linearly
+    in the noise variance back to none, ``x0 = 2 x1 - x2``. ``x1`` is the estimate on the data
+    (``x`` plus its own Gauss-Newton step ``s0``, which finishes the optimiser's convergence),
+    ``x2`` the mean estimate with ``draws`` independent copies of the force-sensor noise added (its
+    variance estimated from the force's spectrum outside the excited band, shaped like the drive's
+    band, `band_gain`): ``x + mean(s)``, so ``x0 = x + 2 s0 - mean(s)``. (Without ``s0`` an
+    unfinished optimisation would be doubled instead of corrected.) Returns the correction
+    ``x0 - x`` and a covariance to add to the sandwich: the steps' spread (x (1 + 1/draws)), the
+    errors-in-variables part the sandwich's first order misses (conservative). No out-of-band
+    spectrum: only ``s0``.
 
     Parameters
     ----------
@@ -29,29 +44,25 @@ def simex_shift(coords, x, data, weights, skip, draws: int, seed: int = 0, simul
     -------
     (ndarray, ndarray)
     """
-    if not any(d["force_noise_var"] > 0 for d in data):
-        return np.zeros(x.size), np.zeros((x.size, x.size))
+    s0 = _gauss_newton_step(coords, x, data, weights, skip, simulate, residuals)
+    if not any(d["force_noise_var"] > 0 for d in data) or draws < 1:
+        return s0, np.zeros((x.size, x.size))
     rng = np.random.default_rng(seed)
     steps = []
     for _ in range(draws):
         noisy = []
         for d in data:
             n = d["force"].size
-            spec = np.fft.rfft(rng.standard_normal(n)) * math.sqrt(d["force_noise_var"])
             f = np.fft.rfftfreq(n, 1.0 / d["fs"])
-            spec[(f < d["band"][0]) | (f > d["band"][1])] = 0.0
+            spec = np.fft.rfft(rng.standard_normal(n)) * math.sqrt(d["force_noise_var"]) * band_gain(f, d["band"])
             noisy.append({**d, "force": d["force"] + np.fft.irfft(spec, n)})
-        h = 1e-6 * np.maximum(1.0, np.abs(x))
-        X = np.vstack([x] + [x + h[i] * np.eye(x.size)[i] for i in range(x.size)])
-        R = residuals(simulate(coords, X, noisy), noisy, weights, skip)
-        J = ((R[1:] - R[0]) / h[:, None]).T
-        steps.append(-np.linalg.lstsq(J, R[0], rcond=None)[0])
+        steps.append(_gauss_newton_step(coords, x, noisy, weights, skip, simulate, residuals))
     steps = np.array(steps)
     # the steps' spread is what one more unit of force noise does to the estimate, through the model's
     # input *and* its Jacobian, which the sandwich's first order misses: added in full (conservative),
     # plus the uncertainty of their mean
     cov = np.cov(steps.T).reshape(x.size, x.size) * (1 + 1 / draws) if draws > 1 else np.zeros((x.size, x.size))
-    return steps.mean(axis=0), cov
+    return 2 * s0 - steps.mean(axis=0), cov
 
 
 def sandwich(J, r, block_sizes, channel_length, lags: int = 1024) -> np.ndarray:
