@@ -69,6 +69,10 @@ def register(sub):
                    help="force-sensor noise relative to the force RMS (default: half of --noise)")
     t.add_argument("--burn-in", type=real(0), default=None, metavar="S",
                    help="seconds of excitation before the record starts (default 0: starts at rest)")
+    t.add_argument("--ideal", action="store_true",
+                   help="an idealised recording: no noise unless --noise, the force cut sharply at the band edges "
+                        "(default: lab conditions, 2 %% noise on each accelerometer and 1 %% on the force, the "
+                        "shaker's force rolled off above the band and high-passed below it)")
     p.add_argument("--plot", default=None, metavar="OUT.png", help="also plot the FRFs")
     # options of one mode given in the other are refused, not ignored
     p.set_defaults(func=run, time_only=option_defaults(t.actions), frf_only=option_defaults([freq, channels]))
@@ -145,8 +149,8 @@ def run_time(args, rig, effects):
     if args.nonlinear or args.excitation == "multisine" or args.level is not None:
         return run_nonlinear(args, rig, effects, noise, (lo, hi))
     rec = simulate_recording(args.duration, args.fs, rig, effects, band_hz=(lo, hi), force_rms=args.force_rms,
-                             noise=noise[0] if noise else 0.0, seed=args.seed, excitation=args.excitation,
-                             force_noise=args.force_noise, burn_in_s=args.burn_in)
+                             noise=noise[0] if noise else None, seed=args.seed, excitation=args.excitation,
+                             force_noise=args.force_noise, burn_in_s=args.burn_in, ideal=args.ideal)
     save_recording(rec, args.out)
     print(f"wrote {args.out} ({rec.n_samples} samples at {rec.fs_hz:g} Hz = {rec.duration_s:g} s, "
           f"channels {', '.join(rec.channels)})")

@@ -30,8 +30,11 @@ class MismatchTest:
     chi2_per_point: np.ndarray  # Σ_channels |z|² at each frequency
 
 
-def standardized(fit) -> dict:
+def standardised(fit) -> dict:
     return fit.standardised_residuals()
+
+
+standardized = standardised  # the former spelling (issue 25: one spelling, -ise, across the package)
 
 
 def test_mismatch(fit, alpha: float = 1e-3, noise_dof: float | None = None) -> MismatchTest:
@@ -42,7 +45,7 @@ def test_mismatch(fit, alpha: float = 1e-3, noise_dof: float | None = None) -> M
     """
     from scipy import stats  # heavy: imported where used, not at `import satmd`
 
-    z = standardized(fit)
+    z = standardised(fit)
     freq = fit.freq_hz
     per_point = sum(np.abs(v) ** 2 for v in z.values())  # ~ χ²_{2C}
     C = len(z)

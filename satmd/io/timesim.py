@@ -21,8 +21,14 @@ impulse response has decayed to round-off (measured, not assumed). With
 rig, since the impulse response comes from `satmd.physics.frf` with effects.
 
 Noise. Independent white Gaussian noise on *every* channel: ``noise`` × RMS on
-each accelerometer and ``force_noise`` × RMS on the force (default half of
+each accelerometer (default 2 %) and ``force_noise`` × RMS on the force (default half of
 ``noise``: a load cell is usually cleaner than an accelerometer, never perfect).
+
+Defaults are the lab's, not an ideal: a random non-periodic force that a shaker
+rolls off above the band (`LAB_FORCE`, Butterworth order 4) and high-passes below
+it (order 2), the rig at rest when the record starts, and noise on every channel.
+``ideal=True`` gives the idealised recording instead (no noise unless asked, the force
+cut sharply at the band edges), kept to compare against.
 
 Lab conditions (`satmd.io.conditions`). ``force_spectrum=ForceSpectrum(...)``
 shapes the random force as a shaker does (roll-off, high-pass, pink colour,
@@ -40,19 +46,24 @@ import numpy as np
 from ..conventions import ACCEL_CHANNELS, RECORDING_CHANNELS
 from ..errors import DataError
 from ..physics import Rig, frf
+from .conditions import ForceSpectrum
 from .limits import check_memory
 from .recording import Recording
 
 EXCITATIONS = ("random", "sweep", "multisine")
 MAX_SAMPLES = 50_000_000  # ~1.2 GB of float64 per channel set: longer records are refused up front
 _RESPONSES = tuple((ch, name) for name, ch in RECORDING_CHANNELS.items())
+#: the force a shaker delivers by default: rolled off above the band and high-passed below it
+LAB_FORCE = ForceSpectrum(rolloff_order=4, highpass_order=2)
+#: default accelerometer noise relative to each channel's RMS (the force sensor gets half)
+LAB_NOISE = 0.02
 
 
 def simulate_recording(duration_s: float = 60.0, fs_hz: float = 1000.0, rig: Rig | None = None,
                        effects: Sequence = (), band_hz=(20.0, 200.0), force_rms: float = 1.0,
-                       noise: float = 0.0, seed: int | None = None, excitation: str = "random",
+                       noise: float | None = None, seed: int | None = None, excitation: str = "random",
                        force_noise: float | None = None, burn_in_s: float = 0.0, force_spectrum=None,
-                       sensor_noise=None) -> Recording:
+                       sensor_noise=None, ideal: bool = False) -> Recording:
     """A recording of force, acc1, acc2 for a force on the primary mass (see the module docstring).
 
     Parameters
@@ -71,8 +82,9 @@ def simulate_recording(duration_s: float = 60.0, fs_hz: float = 1000.0, rig: Rig
         anti-aliasing filter.
     force_rms : float
         RMS of the clean force in N.
-    noise : float
-        Accelerometer noise std relative to each accelerometer's RMS (0.02 = 2 %).
+    noise : float, optional
+        Accelerometer noise std relative to each accelerometer's RMS (default `LAB_NOISE` = 2 %;
+        0 with ``ideal``).
     seed : int, optional
         Random seed (same seed, same recording).
     excitation : {"random", "sweep", "multisine"}
@@ -82,9 +94,13 @@ def simulate_recording(duration_s: float = 60.0, fs_hz: float = 1000.0, rig: Rig
     burn_in_s : float
         Time the rig is excited before the record starts (0: the record starts at rest).
     force_spectrum : ForceSpectrum, optional
-        Shape of the random force (`satmd.io.conditions`; default: flat, cut sharply at the band edges).
+        Shape of the random force (`satmd.io.conditions`; default `LAB_FORCE`: rolled off above the band,
+        high-passed below it; with ``ideal``: flat, cut sharply at the band edges).
     sensor_noise : SensorNoise, optional
         Pink noise, drift and mains hum on the accelerometers (default: white noise only).
+    ideal : bool
+        The idealised recording: no noise unless ``noise`` is given, a flat force cut sharply at the band
+        edges unless ``force_spectrum`` is given (default False: lab conditions).
 
     Returns
     -------
@@ -97,6 +113,10 @@ def simulate_recording(duration_s: float = 60.0, fs_hz: float = 1000.0, rig: Rig
     for name, value in (("duration_s", duration_s), ("fs_hz", fs_hz), ("force_rms", force_rms)):
         if not np.isfinite(value) or value <= 0:
             raise DataError(f"{name} must be a finite number > 0, got {value}")
+    if noise is None:
+        noise = 0.0 if ideal else LAB_NOISE
+    if force_spectrum is None and not ideal:
+        force_spectrum = LAB_FORCE
     force_noise = 0.5 * noise if force_noise is None else force_noise
     for name, value in (("noise", noise), ("force_noise", force_noise), ("burn_in_s", burn_in_s)):
         if not np.isfinite(value) or value < 0:
@@ -139,9 +159,9 @@ def simulate_recording(duration_s: float = 60.0, fs_hz: float = 1000.0, rig: Rig
         signals[name] = x
     meta = {"generator": "satmd simulate --time", "excitation": excitation, "band_hz": f"{lo:g}:{hi:g}",
             "force_rms": f"{force_rms:g}", "noise": f"{noise:g}", "force_noise": f"{force_noise:g}",
-            "burn_in_s": f"{burn_in_s:g}", "seed": str(seed)}
+            "burn_in_s": f"{burn_in_s:g}", "seed": str(seed), "conditions": "ideal" if ideal else "lab"}
     meta.update({k: f"{float(v):.12g}" for k, v in rig.as_dict().items()})
-    if force_spectrum is not None:
+    if force_spectrum is not None and excitation == "random":
         meta["force_spectrum"] = ", ".join(f"{k}={v}" for k, v in force_spectrum.to_dict().items())
     if sensor_noise is not None:
         meta["sensor_noise"] = ", ".join(f"{k}={v}" for k, v in sensor_noise.to_dict().items())

@@ -168,8 +168,8 @@ def test_uff_recording_mapped_to_a_pressure_is_refused(tmp_path):
 
 # --- time simulation --------------------------------------------------------------
 def test_simulation_is_seeded_band_limited_and_scaled():
-    a = simulate_recording(4.0, 400.0, seed=1, band_hz=(30, 90), force_rms=2.0, excitation="multisine")
-    b = simulate_recording(4.0, 400.0, seed=1, band_hz=(30, 90), force_rms=2.0, excitation="multisine")
+    a = simulate_recording(4.0, 400.0, seed=1, band_hz=(30, 90), force_rms=2.0, excitation="multisine", ideal=True)
+    b = simulate_recording(4.0, 400.0, seed=1, band_hz=(30, 90), force_rms=2.0, excitation="multisine", ideal=True)
     np.testing.assert_array_equal(a["acc2"], b["acc2"])
     assert np.sqrt(np.mean(a["force"] ** 2)) == pytest.approx(2.0)
     spec = np.abs(np.fft.rfft(a["force"]))
@@ -178,9 +178,19 @@ def test_simulation_is_seeded_band_limited_and_scaled():
 
 
 def test_default_recording_is_random_not_periodic_and_starts_at_rest():
-    r = simulate_recording(20.0, 2000.0, seed=3, noise=0.02)
-    assert r.meta["excitation"] == "random" and float(r.meta["force_noise"]) == pytest.approx(0.01)
-    clean = simulate_recording(20.0, 2000.0, seed=3)
+    r = simulate_recording(20.0, 2000.0, seed=3)  # the defaults are the lab's: noise on every channel
+    assert r.meta["excitation"] == "random" and r.meta["conditions"] == "lab"
+    assert float(r.meta["noise"]) == pytest.approx(0.02) and float(r.meta["force_noise"]) == pytest.approx(0.01)
+    lab_clean = simulate_recording(20.0, 2000.0, seed=3, noise=0.0, force_noise=0.0)
+    assert np.std(r["acc1"] - lab_clean["acc1"]) == pytest.approx(0.02 * np.std(lab_clean["acc1"]), rel=0.1)
+    # the shaker rolls the force off above the band (20-200 Hz): some force at 300 Hz, far less than in the band
+    spec = np.abs(np.fft.rfft(lab_clean["force"])) ** 2
+    f = np.fft.rfftfreq(lab_clean.n_samples, 1 / 2000.0)
+    ratio = spec[(f > 280) & (f < 320)].mean() / spec[(f > 50) & (f < 150)].mean()
+    assert 1e-4 < ratio < 0.3
+    clean = simulate_recording(20.0, 2000.0, seed=3, ideal=True)
+    assert clean.meta["conditions"] == "ideal" and float(clean.meta["noise"]) == 0.0
+    r = simulate_recording(20.0, 2000.0, seed=3, ideal=True, noise=0.02)
     # at rest at t = 0: the absorber (no direct path from the force) starts from nothing
     assert abs(clean["acc2"][0]) < 0.02 * np.std(clean["acc2"])
     # not periodic in the record: the force's first and last samples do not join up
@@ -211,7 +221,7 @@ def test_lpm_recovers_the_model_at_full_resolution(excitation):
     """Noise-free: the LPM estimate equals the model to well below any realistic noise, peaks included."""
     rig = Rig(R=30.0)
     effects = [effect("time_delay", tau_s=2e-4)]
-    r = simulate_recording(40.0, 1000.0, rig, effects, seed=2, band_hz=(20, 250), excitation=excitation)
+    r = simulate_recording(40.0, 1000.0, rig, effects, seed=2, band_hz=(20, 250), excitation=excitation, ideal=True)
     d = estimate_frf(r, band=(40, 200))
     assert d.estimator["method"] == "lpm" and d.freq_hz[0] >= 40 and d.freq_hz[-1] <= 200
     model = frf(d.freq_hz, rig, effects, outputs=("a1", "a2"))
@@ -237,7 +247,7 @@ def test_lpm_std_is_honest_with_noise_on_every_channel():
 
 
 def test_lpm_finds_the_excited_band_and_says_so():
-    r = simulate_recording(30.0, 1000.0, noise=0.02, seed=1, band_hz=(30, 150))
+    r = simulate_recording(30.0, 1000.0, noise=0.02, seed=1, band_hz=(30, 150), ideal=True)  # sharp band edges
     d = estimate_frf(r, band=(10, 400))
     assert 30 <= d.freq_hz[0] < 31 and 149 < d.freq_hz[-1] <= 150
     names = [m["name"] for m in d.estimator["measurement"]]
@@ -245,7 +255,7 @@ def test_lpm_finds_the_excited_band_and_says_so():
 
 
 def test_welch_resolution_bias_is_named_as_a_measurement_finding():
-    r = simulate_recording(120.0, 1000.0, noise=0.02, seed=1)
+    r = simulate_recording(120.0, 1000.0, noise=0.02, seed=1, ideal=True)
     d = estimate_frf(r, nperseg=1024, band=(30, 150))
     assert "resolution_bias" in [m["name"] for m in d.estimator["measurement"]]
     assert not estimate_frf(r, band=(30, 150)).estimator["measurement"]
@@ -257,7 +267,7 @@ def test_noise_free_estimate_matches_the_model_in_phase_and_magnitude():
     """Guards the classic sign error (conjugated FRFs): the estimate must equal the analytic model."""
     rig = Rig(R=30.0)
     effects = [effect("time_delay", tau_s=2e-4)]
-    r = simulate_recording(10.0, 1000.0, rig, effects, seed=2, band_hz=(20, 250))
+    r = simulate_recording(10.0, 1000.0, rig, effects, seed=2, band_hz=(20, 250), ideal=True)
     d = estimate_frf(r, nperseg=2048, band=(40, 200))
     model = frf(d.freq_hz, rig, effects, outputs=("a1", "a2"))
     for ch in ("a1", "a2"):  # what is left is the window's resolution bias at the peaks
