@@ -9,8 +9,6 @@ from pathlib import Path
 import pytest
 
 ROOT = Path(__file__).resolve().parents[1]
-# new files other engineers are writing while the linter arrived (issue 25): reported apart, to leave this list
-PENDING: set[str] = set()
 
 
 def _findings() -> list[str]:
@@ -27,14 +25,8 @@ def _findings() -> list[str]:
 
 
 def test_ruff_is_clean():
-    bad = [s for s in _findings() if s.split(":")[0] not in PENDING]
+    bad = _findings()
     assert not bad, "ruff findings (`ruff check satmd`):\n" + "\n".join(bad)
-
-
-@pytest.mark.xfail(strict=False, reason="files written by others this session (PENDING)")
-def test_ruff_is_clean_in_pending_files():
-    bad = [s for s in _findings() if s.split(":")[0] in PENDING]
-    assert not bad, "\n".join(bad)
 
 
 def test_mypy_is_clean():

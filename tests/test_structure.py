@@ -325,21 +325,6 @@ def test_the_layering_check_sees_an_upward_import():
 # Literals of a convention, written once in satmd.conventions: anywhere else they drift apart.
 CONVENTION_LITERALS = {("m2", "kp", "R", "L"): "DEFAULT_FREE", ("a1", "a2"): "ACCEL_CHANNELS",
                        (("acc1", "a1"), ("acc2", "a2")): "RECORDING_CHANNELS", 1e-300: "TINY"}
-# files other engineers are restructuring while this rule arrived (issue 25); each is to take the
-# name from satmd.conventions, then leave this list (the pending test reports XPASS when all have)
-PENDING_LITERALS = {"satmd/inverse/training.py", "satmd/inverse/objective.py"}
-# the bare 1e-300 (satmd.conventions.TINY) is still written in these files (issue 25): new files may not
-PENDING_TINY = {f"satmd/{p}.py" for p in (
-    "discovery/adequacy", "discovery/nonlinear", "discovery/nonlinear_discover", "discovery/nonlinear_findings",
-    "discovery/nonlinear_name", "discovery/nonlinear_periodic", "discovery/nonlinear_stats",
-    "identification/nonlinear_compare", "identification/nonlinear_signal", "io/forcefloor", "io/lpm",
-    "physics/nonlinear/base", "physics/nonlinear/elements", "physics/nonlinear/linearise", "report/fig_nonlinear")}
-
-
-def _pending(finding: str) -> bool:
-    path = finding.split(":")[0]
-    return path in PENDING_LITERALS or (path in PENDING_TINY and finding.endswith("conventions.TINY)"))
-
 
 def _literal(node):
     """The value a node writes literally (a tuple/list/set or dict of constants, or a number), else None."""
@@ -371,14 +356,7 @@ LITERALS = _convention_literals()
 
 
 def test_no_convention_literal_outside_the_conventions():
-    done = [s for s in LITERALS if not _pending(s)]
-    assert not done, "facts written again instead of taken from satmd.conventions:\n" + "\n".join(done)
-
-
-@pytest.mark.xfail(strict=False, reason="files under restructuring this session (PENDING_LITERALS, PENDING_TINY)")
-def test_no_convention_literal_pending():
-    pending = [s for s in LITERALS if _pending(s)]
-    assert not pending, "\n".join(pending)
+    assert not LITERALS, "facts written again instead of taken from satmd.conventions:\n" + "\n".join(LITERALS)
 
 
 def _frame_inspections(trees=None) -> list[str]:
@@ -431,8 +409,7 @@ def test_the_convention_checks_see_what_they_look_for():
         "satmd.a.b:3: private name _helper from satmd.a.c"]
 
 
-# private names imported from another module of the same package (issue 25); others' new files pending
-PENDING_PRIVATE = {"satmd/discovery/nonlinear_periodic.py"}
+# private names imported from another module of the same package (issue 25)
 
 
 def _private_names_across_modules(imports=None) -> list[str]:
@@ -449,7 +426,7 @@ def _private_names_across_modules(imports=None) -> list[str]:
 
 
 def test_no_private_name_imported_from_another_module():
-    bad = [s for s in _private_names_across_modules() if s.split(":")[0] not in PENDING_PRIVATE]
+    bad = _private_names_across_modules()
     assert not bad, "private names used outside their module (make them public within the package):\n" + "\n".join(bad)
 
 

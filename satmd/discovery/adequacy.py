@@ -18,6 +18,8 @@ Decided before any effect is named, in two steps:
 """
 from __future__ import annotations
 
+from ..conventions import TINY
+
 import math
 
 from ..identification.adequacy import Adequacy, Reason, implausible_values
@@ -72,7 +74,7 @@ def _near(v, b, lo, hi) -> bool:
     if not (math.isfinite(b) and math.isfinite(lo) and math.isfinite(hi)):
         return False
     if lo > 0 and hi / lo >= 10:  # a range over decades: its edge in log terms
-        return abs(math.log(max(v, 1e-300) / b)) <= EDGE * math.log(hi / lo)
+        return abs(math.log(max(v, TINY) / b)) <= EDGE * math.log(hi / lo)
     return abs(v - b) <= EDGE * (hi - lo)
 
 

@@ -27,7 +27,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..conventions import ACCEL_CHANNELS
+from ..conventions import ACCEL_CHANNELS, TINY
 from .nonlinear_stats import (
     NonlinearTest,
     distortion_regressors,
@@ -196,7 +196,7 @@ def multisine_frf(recording):
     for c, y in outs.items():
         b = multisine_bla(u, y, lines, recording.fs_hz)
         chans[c], std[c] = b["bla"], b["std"]
-        info[f"var_nl/var_total {c}"] = float(np.nanmedian(b["var_nl"] / np.maximum(b["var_total"], 1e-300)))
+        info[f"var_nl/var_total {c}"] = float(np.nanmedian(b["var_nl"] / np.maximum(b["var_total"], TINY)))
     meta = {"estimator": "multisine_bla", "realisations": str(u.shape[0]), "periods": str(u.shape[1])}
     meta.update({k: f"{v:.3g}" for k, v in info.items()})
     if "force_rms" in recording.meta:

@@ -20,6 +20,8 @@ this module does not import the package it serves.
 """
 from __future__ import annotations
 
+from ..conventions import TINY
+
 from dataclasses import replace
 
 import numpy as np
@@ -38,7 +40,7 @@ def pooled(datas):
     first = datas[0]
     chans, std = {}, {}
     for c in first.channels:
-        w = np.stack([1.0 / np.maximum(d.std[c], 1e-300) ** 2 for d in datas])
+        w = np.stack([1.0 / np.maximum(d.std[c], TINY) ** 2 for d in datas])
         H = np.stack([d.channels[c] for d in datas])
         chans[c] = np.sum(w * H, axis=0) / w.sum(axis=0)
         std[c] = 1.0 / np.sqrt(w.sum(axis=0))

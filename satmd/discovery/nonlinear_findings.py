@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..conventions import ACCEL_CHANNELS, DEFAULT_FREE
+from ..conventions import ACCEL_CHANNELS, DEFAULT_FREE, TINY
 from .nonlinear import (
     EXPERIMENT_LEVEL,
     EXPERIMENT_MULTISINE,
@@ -112,7 +112,7 @@ def analyse_recordings(recordings, rig=None, free=DEFAULT_FREE, alpha: float = 1
             pt = parameter_test(cmp, alpha / 4)
             tests += [level_test, NonlinearTest(pt.name, pt.p_value, level_test.bands_hz, pt.alpha, pt.details)]
     detected = any(t.significant for t in tests)
-    spread = max(levels) / max(min(levels), 1e-300)
+    spread = max(levels) / max(min(levels), TINY)
     moved = level_test is not None and (level_test.significant or tests[-1].significant)
     if detected and moved and spread > 1.5:
         findings.append(_name_from_levels(datas, rig, free, levels, recordings, cmp))
@@ -241,7 +241,7 @@ def analyse_generic(frfs: list, stds: list, freq, levels, tests=(), alpha: float
         order = np.argsort(levels)
         fn = [m["f_n_hz"] for m in fits]
         dz = (fn[order[-1]] - fn[order[0]]) / max(np.hypot(fits[order[-1]]["f_n_std"], fits[order[0]]["f_n_std"]),
-                                                    1e-300)
+                                                    TINY)
         character = "hardening" if dz > 3 else "softening" if dz < -3 else "level-dependent damping"
         bands = next((t.bands_hz for t in tests if t.name == "level_dependence"), [])
         where = ", ".join(f"{a:.1f}–{b:.1f} Hz" for a, b in bands)

@@ -14,6 +14,8 @@ its strength with a 95 % interval (`fit_strength`).
 """
 from __future__ import annotations
 
+from ..conventions import TINY
+
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -149,7 +151,7 @@ def compare_hypotheses(datas, rig, free, channels, start: dict, levels) -> dict:
     lo, hi = order[0], order[-1]
     fb = fits[best]
     diff = fb.per_record[hi] - fb.per_record[lo]
-    z = diff / max(np.hypot(fb.per_record_std[hi], fb.per_record_std[lo]), 1e-300)
+    z = diff / max(np.hypot(fb.per_record_std[hi], fb.per_record_std[lo]), TINY)
     return {"fits": fits, "best": best, "equivalent": equivalent, "direction": "up" if diff > 0 else "down",
             "z": float(z), "order": order}
 
@@ -182,7 +184,7 @@ def parameter_test(cmp: dict, alpha: float = 1e-3):
         v = np.asarray(fit.per_record, float)
         n_par = len(fit.shared) + v.size
         scale = max(fit.chi2 / max(fit.n_data - n_par, 1), 1.0)
-        var = np.maximum(np.asarray(fit.per_record_std, float) ** 2 * scale, 1e-300)
+        var = np.maximum(np.asarray(fit.per_record_std, float) ** 2 * scale, TINY)
         mean = np.sum(v / var) / np.sum(1.0 / var)
         chi[p] = float(np.sum((v - mean) ** 2 / var))
         pvals[p] = float(stats.chi2.sf(chi[p], v.size - 1))
@@ -265,7 +267,7 @@ def fit_strength(cls, values, stds, rigs, forces, fs_hz):
     best = None
     nominal0 = float(values.min() if p != "L" else values.max())
     for s0 in _strength_starts(cls, rms, values):
-        raw0 = np.log(max(s0, 1e-300)) if positive else s0
+        raw0 = np.log(max(s0, TINY)) if positive else s0
         lo_b = [1e-6 * abs(nominal0), np.log(1e-10) if positive else -np.inf]
         hi_b = [1e3 * abs(nominal0), np.log(1e10) if positive else np.inf]
         raw0 = float(np.clip(raw0, lo_b[1] + 1, hi_b[1] - 1))
@@ -290,9 +292,9 @@ def _strength_starts(cls, rms, values):
     r = np.array([float(x[sig]) for x in rms])
     dv = values[np.argmax(r)] - values[np.argmin(r)]
     if cls.strength == "k3":
-        return [dv / (3 * max(r.max() ** 2 - r.min() ** 2, 1e-300))]
+        return [dv / (3 * max(r.max() ** 2 - r.min() ** 2, TINY))]
     if cls.strength == "c2":
-        return [max(dv / (np.sqrt(8 / np.pi) * max(r.max() - r.min(), 1e-300)), 1e-6)]
+        return [max(dv / (np.sqrt(8 / np.pi) * max(r.max() - r.min(), TINY)), 1e-6)]
     if cls.strength == "Fc":
-        return [max(-dv / (np.sqrt(2 / np.pi) * max(1 / r.min() - 1 / r.max(), 1e-300)), 1e-6)]
+        return [max(-dv / (np.sqrt(2 / np.pi) * max(1 / r.min() - 1 / r.max(), TINY)), 1e-6)]
     return [r.max() * f for f in (1.0, 2.0, 4.0, 10.0, 30.0)]

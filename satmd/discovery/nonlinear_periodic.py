@@ -19,9 +19,11 @@ single structure) the level dependence is read from a one-mode FRF
 """
 from __future__ import annotations
 
+from ..conventions import TINY
+
 import numpy as np
 
-from .nonlinear_stats import NonlinearTest, _chi2_score, band_scan
+from .nonlinear_stats import NonlinearTest, chi2_score, band_scan
 
 
 def periodic_blocks(x, period: int, periods: int | None = None, skip: int = 1) -> np.ndarray:
@@ -119,8 +121,8 @@ def detection_lines_test(u, y, lines, fs_hz: float, band=None, alpha: float = 1e
     var = Y[..., det].var(axis=1, ddof=1)  # per-period noise variance
     from scipy import stats
 
-    F = P * np.abs(mean) ** 2 / np.maximum(var, 1e-300)  # F(2, 2(P-1)) per realisation and line
-    score = _chi2_score(stats.f.sf(F, 2, 2 * (P - 1)), 2).sum(axis=0)
+    F = P * np.abs(mean) ** 2 / np.maximum(var, TINY)  # F(2, 2(P-1)) per realisation and line
+    score = chi2_score(stats.f.sf(F, 2, 2 * (P - 1)), 2).sum(axis=0)
     freq = det * fs_hz / N
     p, bands, p_g, p_b = band_scan(freq, score, 2 * M, alpha)
     odd = det % 2 == 1
@@ -152,7 +154,7 @@ def one_mode_fit(freq, H, std, band=None) -> dict:
     fpk = float(freq[np.argmax(np.abs(H))])
     lo, hi = band if band is not None else (0.7 * fpk, 1.35 * fpk)
     sel = (freq >= lo) & (freq <= hi)
-    f, h, s = freq[sel], H[sel], np.maximum(std[sel], 1e-300)
+    f, h, s = freq[sel], H[sel], np.maximum(std[sel], TINY)
     w = 2 * np.pi * f
 
     def linear_part(fn, zeta):

@@ -29,6 +29,8 @@ global sum and the band scan of `band_scan` apply to both tests alike.
 """
 from __future__ import annotations
 
+from ..conventions import TINY
+
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -113,11 +115,11 @@ def band_scan(freq, score, dof, alpha, widths=WIDTHS):
     return min(1.0, 2 * min(p_global, p_band)), bands, p_global, p_band
 
 
-def _chi2_score(p, dof):
+def chi2_score(p, dof):
     """The χ²(dof) value with upper tail p (a common scale for tests of different dof)."""
     from scipy import stats
 
-    return stats.chi2.isf(np.clip(p, 1e-300, 1.0), dof)
+    return stats.chi2.isf(np.clip(p, TINY, 1.0), dof)
 
 
 # --- one record: distortion regressors ----------------------------------------------------------------
@@ -146,7 +148,7 @@ def distortion_regressors(signals: dict, shapes=("cube",)) -> dict:
     out = {}
     for name, r in signals.items():
         r = np.asarray(r, float)
-        s = (r - r.mean()) / max(r.std(), 1e-300)
+        s = (r - r.mean()) / max(r.std(), TINY)
         for shape in (shapes[name] if isinstance(shapes, dict) else shapes):
             g = _SHAPES[shape](s)
             g = g - g.mean()
@@ -208,12 +210,12 @@ def linearity_test(force, responses: dict, fs_hz: float, regressors: dict, band=
         Y = np.fft.rfft(np.asarray(y, float) - np.mean(y))[idx]
         rss0 = _rss(K0, Y)
         rss1 = _rss(K1, Y)
-        F = ((rss0 - rss1) / nz) / np.maximum(rss1 / q1, 1e-300)
+        F = ((rss0 - rss1) / nz) / np.maximum(rss1 / q1, TINY)
         p = stats.f.sf(F, dof, 2 * q1)
-        s = _chi2_score(p, dof)
+        s = chi2_score(p, dof)
         scores += s
         per_channel[name] = s
-        explained[name] = float(np.sum(rss0 - rss1) / max(np.sum(rss0), 1e-300))
+        explained[name] = float(np.sum(rss0 - rss1) / max(np.sum(rss0), TINY))
     freq = centres * df
     dof_all = dof * len(responses)
     # bands of ≥ 3 windows: a lone window's F tail is where non-Gaussian regressors would lie
@@ -339,11 +341,11 @@ def level_dependence(freq, frfs: list, stds: list, alpha: float = 1e-3, name: st
                                         for m in model_errors]))
         # estimator error scales with the FRF's dynamic range: near an antiresonance it is not relative to |H|
         level = np.maximum(np.abs(H), 0.05 * np.abs(H).max(axis=1, keepdims=True))
-        w = 1.0 / np.maximum(sd ** 2 + (rel_floor * level) ** 2, 1e-300)
+        w = 1.0 / np.maximum(sd ** 2 + (rel_floor * level) ** 2, TINY)
         mean = np.sum(w * H, axis=0) / np.sum(w, axis=0)  # weighted mean, the "one linear system" estimate
         chi = np.sum(w * np.abs(H - mean) ** 2, axis=0)  # χ² with 2(k-1) dof per point
         if dof_noise:
-            chi = _chi2_score(stats.f.sf(chi / (2 * (k - 1)), 2 * (k - 1), dof_noise), 2 * (k - 1))
+            chi = chi2_score(stats.f.sf(chi / (2 * (k - 1)), 2 * (k - 1), dof_noise), 2 * (k - 1))
         scores += chi
         per_channel[c] = chi
         dof += 2 * (k - 1)

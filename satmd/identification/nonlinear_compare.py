@@ -8,6 +8,8 @@ model's equivalent FRF moves with level as the data do.
 """
 from __future__ import annotations
 
+from ..conventions import TINY
+
 import numpy as np
 from scipy.signal import csd, welch
 
@@ -98,7 +100,7 @@ def compare_models(train, held_out, element, seconds: float | None = 30.0, best_
                                     "nonlinear": frf_residual(rec, p_nl, seconds=seconds)}}
             for key in ("", "_broadband"):
                 e = row["td_error" + key]
-                row["td_ratio" + key] = e["linear"] / max(e["nonlinear"], 1e-300)
+                row["td_ratio" + key] = e["linear"] / max(e["nonlinear"], TINY)
             rows.append(row)
     return {"nonlinear": nl.to_dict(), "linear": lin.to_dict(), "levels": rows, "fits": (nl, lin),
             "linear_fits": linears}

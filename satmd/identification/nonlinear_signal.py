@@ -12,6 +12,8 @@ ends: the first seconds are skipped anyway (the rig's unknown initial state), th
 """
 from __future__ import annotations
 
+from ..conventions import TINY
+
 import numpy as np
 
 ROLL = 1.3  # the drive's raised-cosine roll-off: from hi to ROLL * hi, and from lo to lo / ROLL
@@ -101,4 +103,4 @@ def band_error(sim, meas, fs, band_hz) -> np.ndarray:
     keep = (f >= band_hz[0]) & (f <= band_hz[1])
     e = np.sum(np.abs(np.fft.rfft(sim - meas, axis=-1)[:, keep]) ** 2, axis=-1)
     m = np.sum(np.abs(np.fft.rfft(meas, axis=-1)[:, keep]) ** 2, axis=-1)
-    return np.sqrt(e / np.maximum(m, 1e-300))
+    return np.sqrt(e / np.maximum(m, TINY))

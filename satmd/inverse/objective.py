@@ -16,6 +16,7 @@ try:
 except ImportError as exc:  # pragma: no cover
     raise ImportError("satmd.inverse needs torch: pip install 'satmd[nn]'") from exc
 
+from ..conventions import ACCEL_CHANNELS
 from ..physics import Rig
 from ..physics.torch import frf as torch_frf
 from .dataset import BOUNDS
@@ -40,7 +41,7 @@ def _denormalised(out, bounds):
 def _complex_residuals(norm_out, target, s_n, freq_t, rig, bounds):
     """Scaled complex residuals of eq. 22, (..., n, 2F): [d1, d2] / s_n (the twin in the targets' dtype)."""
     R, L = _denormalised(norm_out, bounds)
-    pred = torch_frf(freq_t, rig.replace(R=R, L=L), dtype=target.dtype, device=freq_t.device, outputs=("a1", "a2"))
+    pred = torch_frf(freq_t, rig.replace(R=R, L=L), dtype=target.dtype, device=freq_t.device, outputs=ACCEL_CHANNELS)
     return torch.cat([pred["a1"] - target[..., 0, :], pred["a2"] - target[..., 1, :]], dim=-1) * (1.0 / s_n)[..., None]
 
 
@@ -162,7 +163,7 @@ class ShuntMobius:
 
         def twin(points):
             p = np.asarray(points, float)
-            out = torch_frf(freq.cpu(), rig.replace(R=p[:, 0], L=p[:, 1]), dtype=torch.complex128, outputs=("a1", "a2"))
+            out = torch_frf(freq.cpu(), rig.replace(R=p[:, 0], L=p[:, 1]), dtype=torch.complex128, outputs=ACCEL_CHANNELS)
             return np.stack([out["a1"].numpy(), out["a2"].numpy()], axis=1)  # (k, 2, F)
 
         def zs(points):

@@ -7,6 +7,8 @@ floor; a force that keeps rolling off up to Nyquist gets no correction and a
 """
 from __future__ import annotations
 
+from ..conventions import TINY
+
 import numpy as np
 
 
@@ -46,7 +48,7 @@ def force_noise_floor(power: np.ndarray, f: np.ndarray, start: int, level: float
     blocks = region[: n_blocks * m].reshape(n_blocks, m)
     fb = f[start: start + n_blocks * m].reshape(n_blocks, m).mean(axis=1)
     lev = np.median(blocks, axis=1) / np.log(2)
-    db = 10 * np.log10(np.maximum(lev, 1e-300))
+    db = 10 * np.log10(np.maximum(lev, TINY))
     sd = 10 / np.log(10) * 1.25 / np.sqrt(m)  # scatter of a block median's level [dB]
     tol = max(1.0, 3.0 * sd)
     bound = float(lev.min() * (1 + 3 * 1.25 / np.sqrt(m)))
@@ -55,7 +57,7 @@ def force_noise_floor(power: np.ndarray, f: np.ndarray, start: int, level: float
     best = max(true_runs(near, bridge=1), key=lambda r: r[1] - r[0])
     r0, r1 = best
     run = slice(r0, r1 + 1)
-    octaves = np.log2(fb[r1] / max(fb[r0], 1e-300))
+    octaves = np.log2(fb[r1] / max(fb[r0], TINY))
     slope = None
     flat = False
     if r1 - r0 + 1 >= 6 and octaves >= 0.5:

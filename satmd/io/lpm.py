@@ -39,7 +39,7 @@ from numbers import Real
 import numpy as np
 
 from ..validation import Interval, Whole, validate_params
-from ..conventions import RECORDING_CHANNELS
+from ..conventions import RECORDING_CHANNELS, TINY
 from ..errors import DataError
 from .forcefloor import force_noise_floor, true_runs as _runs
 
@@ -205,10 +205,10 @@ def _local_fits(spectra, fs, n, lo, hi, width_hz, degree, smooth, verdict) -> LP
     bias = np.zeros(centres.size)
     bound = np.zeros(centres.size)
     if floor is not None:
-        bias = floor / np.maximum(sxx - floor, 1e-300 * sxx + 1e-300)
+        bias = floor / np.maximum(sxx - floor, TINY * sxx + TINY)
         bound = bias * verdict["floor_rel_std"]  # what the floor's own scatter leaves
     elif verdict["bound"] is not None:
-        bound = np.minimum(verdict["bound"] / np.maximum(sxx - verdict["bound"], 1e-300 * sxx + 1e-300), 1.0)
+        bound = np.minimum(verdict["bound"] / np.maximum(sxx - verdict["bound"], TINY * sxx + TINY), 1.0)
     out_h, out_std, out_coh, dof = {}, {}, {}, None
     raw_h, resid, var, raw_s2 = {}, {}, {}, {}
     for name, ch in _RESPONSES.items():
@@ -274,7 +274,7 @@ def _line_windows(resid, var, lev, s2, q, freq, half_hz, signal, alpha: float = 
         mains |= np.abs(freq - m * np.maximum(np.round(freq / m), 1.0)) <= half_hz + 0.05
     out = None
     for ch, r in resid.items():
-        z = np.abs(r) ** 2 / np.maximum(var[ch][:, None] * (1.0 - lev), 1e-300)
+        z = np.abs(r) ** 2 / np.maximum(var[ch][:, None] * (1.0 - lev), TINY)
         z[np.abs(r) ** 2 <= 1e-12 * signal[ch][:, None]] = 0.0
         count = np.sum(z > np.log(r.size / alpha), axis=1)
         limit = stats.chi2.isf(alpha / max(freq.size, 1), 2 * max(q, 1)) / (2 * max(q, 1))
@@ -293,12 +293,12 @@ def _channel_correlation(resid, h, var, q, half, keep=None):
     """
     s12 = np.sum(resid["a1"] * np.conj(resid["a2"]), axis=1) / max(q, 1)
     g12 = h["a1"] * np.conj(h["a2"])
-    w = (1.0 if keep is None else keep) / np.maximum(var["a1"] * var["a2"], 1e-300)  # line windows: no weight
+    w = (1.0 if keep is None else keep) / np.maximum(var["a1"] * var["a2"], TINY)  # line windows: no weight
     kernel = np.ones(2 * min(half, (s12.size - 1) // 2) + 1)
     num = np.convolve(w * np.real(s12 * np.conj(g12)), kernel, mode="same")
     den = np.convolve(w * np.abs(g12) ** 2, kernel, mode="same")
-    s_x = np.maximum(num / np.maximum(den, 1e-300), 0.0)
-    rho = s_x * g12 / np.maximum(np.sqrt(var["a1"]) * np.sqrt(var["a2"]), 1e-300)
+    s_x = np.maximum(num / np.maximum(den, TINY), 0.0)
+    rho = s_x * g12 / np.maximum(np.sqrt(var["a1"]) * np.sqrt(var["a2"]), TINY)
     scale = np.maximum(np.abs(rho) / 0.99, 1.0)  # a correlation stays inside the unit disc
     return rho / scale
 
@@ -325,7 +325,7 @@ def _smooth_noise(s2, g, q, half, keep=None):
 
     model = np.full_like(s2, np.median(s2[mask > 0]) if mask.any() else np.median(s2))
     for _ in range(3):
-        w = mask / np.maximum(model * model, 1e-300)
+        w = mask / np.maximum(model * model, TINY)
         s00, s01, s11 = local(w), local(w * g), local(w * g * g)
         t0, t1 = local(w * s2), local(w * g * s2)
         det = s00 * s11 - s01 * s01
@@ -333,13 +333,13 @@ def _smooth_noise(s2, g, q, half, keep=None):
             a = (t0 * s11 - t1 * s01) / det
             b = (s00 * t1 - s01 * t0) / det
         bad = ~np.isfinite(a) | ~np.isfinite(b) | (a < 0) | (b < 0)
-        a_only, b_only = t0 / np.maximum(s00, 1e-300), t1 / np.maximum(s11, 1e-300)
+        a_only, b_only = t0 / np.maximum(s00, TINY), t1 / np.maximum(s11, TINY)
         res_a = local(w * (s2 - a_only * 1.0) ** 2)
         res_b = local(w * (s2 - b_only * g) ** 2)
         use_a = res_a <= res_b
         a = np.where(bad, np.where(use_a, a_only, 0.0), a)
         b = np.where(bad, np.where(use_a, 0.0, b_only), b)
-        model = np.maximum(a + b * g, 1e-300)
+        model = np.maximum(a + b * g, TINY)
     counts = local(mask)
     dof = float(2 * max(q, 1) * np.median(counts) - 4)
     return model, dof

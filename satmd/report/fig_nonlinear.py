@@ -5,6 +5,8 @@
 """
 from __future__ import annotations
 
+from ..conventions import TINY
+
 from pathlib import Path
 
 import numpy as np
@@ -61,7 +63,7 @@ def nonlinear_comparison_figure(comparison, path=None, title: str = ""):
             ax.bar(x + (k - 0.5) * 0.38, vals, width=0.38, color=COLORS[model], label=model)
         for i, r in enumerate(rows):
             lin, nl = float(r[key]["linear"]), float(r[key]["nonlinear"])
-            ax.annotate(f"{lin / max(nl, 1e-300):.1f}×", (x[i], max(lin, nl)), ha="center", va="bottom", fontsize=8)
+            ax.annotate(f"{lin / max(nl, TINY):.1f}×", (x[i], max(lin, nl)), ha="center", va="bottom", fontsize=8)
             if r.get("held_out"):
                 ax.axvspan(x[i] - 0.5, x[i] + 0.5, color="tab:orange", alpha=0.08, lw=0)
         ax.set_yscale("log")

@@ -16,6 +16,8 @@ small-signal limit), which is what the linear model of a rig at low level is.
 """
 from __future__ import annotations
 
+from ...conventions import TINY
+
 from dataclasses import asdict, dataclass
 from typing import Any, ClassVar, cast
 
@@ -57,7 +59,7 @@ def gaussian_mean(fun, sigma, width=None):
 
     out = np.empty(s.shape)
     for idx, sv in np.ndenumerate(s):
-        sv, w = max(float(sv), 1e-300), float(width)
+        sv, w = max(float(sv), TINY), float(width)
         dens = lambda v: np.exp(-0.5 * (v / sv) ** 2) / (sv * np.sqrt(2 * np.pi)) * fun(v)  # noqa: E731
         total = 0.0
         for lo, hi in ((-9 * sv, 0.0), (0.0, 9 * sv)):

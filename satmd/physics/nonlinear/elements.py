@@ -8,6 +8,8 @@ Stein's lemma), which is what a linear fit at that level sees.
 """
 from __future__ import annotations
 
+from ...conventions import TINY
+
 import math
 
 import numpy as np
@@ -179,9 +181,9 @@ class InductorSaturation(NonlinearElement):
     def equivalent_value(self, rig, rms):
         # E[L0 / (1 + (i/a)²)] for i ~ N(0, s²) = L0 √(π/2) (a/s) erfcx(a / (√2 s)), with s the true current's RMS
         a = self.params["isat"]
-        s = np.maximum(np.asarray(rms["i"], float), 1e-300)
+        s = np.maximum(np.asarray(rms["i"], float), TINY)
         r = a / s
-        return rig.L * np.where(r > 1e6, 1.0 - 1.0 / np.maximum(r, 1e-300) ** 2,
+        return rig.L * np.where(r > 1e6, 1.0 - 1.0 / np.maximum(r, TINY) ** 2,
                                 math.sqrt(math.pi / 2) * r * erfcx(r / math.sqrt(2)))
 
     def explain(self, rig) -> str:

@@ -7,6 +7,8 @@ force spectrum, so the two are iterated to their fixed point.
 """
 from __future__ import annotations
 
+from ...conventions import TINY
+
 import numpy as np
 
 from ...errors import DataError
@@ -97,7 +99,7 @@ def equivalent_rig(rig: Rig, elements, band_hz=(20.0, 200.0), force_rms: float =
         values = {p: np.asarray(getattr(rig, p), float) + dv for p, dv in changes.items()}
         values = {p: np.maximum(v, 1e-6 * np.abs(np.asarray(getattr(rig, p), float))) for p, v in values.items()}
         if prev is not None:
-            step = max(float(np.max(np.abs(values[p] - prev[p]) / np.maximum(np.abs(prev[p]), 1e-300)))
+            step = max(float(np.max(np.abs(values[p] - prev[p]) / np.maximum(np.abs(prev[p]), TINY)))
                        for p in values)
             if step < rtol:
                 break
