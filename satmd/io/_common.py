@@ -157,13 +157,13 @@ def parse_dof(text: str):
         if not t[1:].isdigit() or int(t[1:]) < 1:
             raise ValueError(f"{text!r}: a record number is #1, #2, ...")
         return "index", int(t[1:]), None
-    node, sep, d = t.partition(":")
+    node_text, sep, d = t.partition(":")
     if not sep:
         raise ValueError(f"{text!r}: expected NODE:DIR (e.g. 3:+Z or 3:3) or #RECORD")
     try:
-        node = int(node)
+        node = int(node_text)
     except ValueError:
-        raise ValueError(f"{text!r}: node {node!r} is not an integer") from None
+        raise ValueError(f"{text!r}: node {node_text!r} is not an integer") from None
     d = d.strip()
     sign = -1 if d.startswith("-") else 1
     body = d.lstrip("+-").lower()

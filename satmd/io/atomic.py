@@ -134,7 +134,8 @@ def atomic_write(path, mode: str = "wb"):
     tmp = temp_name(path)
     _track(tmp)
     try:
-        with open(tmp, mode, **({"encoding": "utf-8", "newline": "\n"} if "b" not in mode else {})) as fh:
+        text = "b" not in mode
+        with open(tmp, mode, encoding="utf-8" if text else None, newline="\n" if text else None) as fh:
             yield fh
         _commit_or_defer(tmp, path)
     except BaseException as exc:

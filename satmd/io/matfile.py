@@ -93,7 +93,8 @@ def read_mat5(path, raw: bytes) -> dict:
     order = {b"IM": "<", b"MI": ">"}.get(raw[126:128])
     if order is None:
         raise FormatError(path, "corrupt MATLAB header (no endian indicator)")
-    out, pos, inflated = {}, 128, 0
+    out: dict[str, np.ndarray] = {}
+    pos, inflated = 128, 0
     while pos < len(raw):
         etype, data, pos = _element(path, raw, pos, order)
         if etype == 15:  # miCOMPRESSED: zlib stream holding one or more elements
@@ -231,7 +232,10 @@ def read_frf_variables(path) -> FRFData:
     path = Path(path)
     v = _variables_with(path, "freq_hz", "fs_hz", " (it looks like a recording: use satmd estimate-frf)")
     freq = _vector(path, "freq_hz", v["freq_hz"])
-    channels, std, coh, used = {}, {}, {}, {"freq_hz"}
+    channels: dict[str, np.ndarray] = {}
+    std: dict[str, np.ndarray] = {}
+    coh: dict[str, np.ndarray] = {}
+    used = {"freq_hz"}
     for ch in CHANNELS:
         if ch in v:
             channels[ch] = _vector(path, ch, v[ch], complex_ok=True)

@@ -54,6 +54,7 @@ def model_transmissibility(freq_hz, rig=None, effects=()) -> np.ndarray:
     from ..physics import frf
 
     r = frf(freq_hz, rig, effects, outputs=ACCEL_CHANNELS)
+    assert r.a1 is not None and r.a2 is not None  # both were asked for
     return r.a2 / r.a1
 
 

@@ -144,7 +144,7 @@ def _map_channels(path, frfs, channel_map) -> dict:
     else:
         raise FormatError(path, f"{len(frfs)} FRF records ({listing}): say which are A1 and A2 with "
                                 f"channel_map a1=NODE:DIR,a2=NODE:DIR (or a1=#N,a2=#M)")
-    seen = {}
+    seen: dict[int, str] = {}
     for ch, (rec, _) in chosen.items():
         if rec.index in seen:
             raise FormatError(path, f"channel_map: {seen[rec.index]} and {ch} both name dataset {rec.index}; "

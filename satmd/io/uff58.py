@@ -108,7 +108,8 @@ def match_records(records, kind, a, b) -> list:
 # --- reading ----------------------------------------------------------------------
 def _markers(raw: bytes) -> list[int]:
     """Offsets of the '    -1' dataset delimiters, by pyuff's own rule."""
-    out, i, n = [], -1, len(raw)
+    out: list[int] = []
+    i, n = -1, len(raw)
     while True:
         i = raw.find(MARKER, i + 1)
         if i < 0:

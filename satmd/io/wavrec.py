@@ -93,7 +93,8 @@ def read_recording_wav(path, channel_map=None, scale=None) -> Recording:
         rec = Recording(float(fs), channels, units, meta, {n: f"WAV channel {k + 1}" for k, n in enumerate(names)})
     except DataError as exc:
         raise FormatError(path, str(exc)) from None
-    extremes = {n: tuple(sorted(g * x for x in limits)) for n, g in gains.items()} if is_int else None
+    extremes = ({n: tuple(sorted(g * x for x in limits)) for n, g in gains.items()}
+                if is_int and limits is not None else None)
     warn_clipping(path, rec, extremes)
     return rec
 
