@@ -15,6 +15,10 @@ from satmd.inverse.dataset import crossfit_folds
 from satmd.inverse.objective import gauss_newton_step, gauss_newton_step_fd
 
 V1_META = Path(__file__).parent / "data" / "model_v1.json"  # written by satmd before issue 29 (format 1)
+# format 2 as written before the Möbius step (commit 8ce9393's parent: jacobian="shunt"), and what that version
+# predicted with the weights `_saved_folder` writes
+V2_META = Path(__file__).parent / "data" / "model_v2_shunt.json"
+V2_PREDICT = Path(__file__).parent / "data" / "model_v2_shunt_predict.json"
 
 
 def test_each_validation_pair_is_held_out_from_one_member(tiny_data):
@@ -70,14 +74,15 @@ def test_shunt_jacobian_step_matches_finite_differences():
     torch.testing.assert_close(a, b, rtol=0, atol=1e-4 * float(b.abs().max()))
 
 
-def _v1_folder(tmp_path):
-    """The format-1 model.json satmd wrote before issue 29, with weights of its network's shape."""
+def _saved_folder(tmp_path, source=V1_META):
+    """The model.json ``source`` that satmd wrote before (format 1 by default), with seeded weights of its
+    network's shape."""
     from satmd.inverse.nets import EnsembleNet
 
-    meta = json.loads(V1_META.read_text())
-    folder = tmp_path / "v1"
+    meta = json.loads(source.read_text())
+    folder = tmp_path / source.stem
     folder.mkdir()
-    shutil.copy(V1_META, folder / "model.json")
+    shutil.copy(source, folder / "model.json")
     net = EnsembleNet(meta["network"]["n_members"], meta["network"]["sizes"], torch.Generator().manual_seed(0))
     torch.save(net.state_dict(), folder / "weights.pt")
     return folder
@@ -85,7 +90,7 @@ def _v1_folder(tmp_path):
 
 @pytest.mark.filterwarnings("ignore:R_std")  # random weights: the std spans the box
 def test_format_1_models_still_load(tmp_path):
-    m = InverseModel.load(_v1_folder(tmp_path))
+    m = InverseModel.load(_saved_folder(tmp_path))
     assert json.loads(V1_META.read_text())["schema"] == "satmd-inverse/1"
     assert m.calibration == "holdout" and m.jacobian == "fd"  # how format-1 models were trained
     p = m.predict(pairs_dataset(BLIND_PAIRS[:2]), check=False)
@@ -96,8 +101,21 @@ def test_format_1_models_still_load(tmp_path):
     assert InverseModel.load(tmp_path / "again").jacobian == "fd"
 
 
+@pytest.mark.filterwarnings("ignore:R_std", "ignore:L_std")  # random weights: the std spans the box
+def test_format_2_models_saved_before_the_moebius_step_load_and_predict_as_before(tmp_path):
+    meta = json.loads(V2_META.read_text())
+    assert meta["schema"] == "satmd-inverse/2" and meta["params"]["jacobian"] == "shunt"
+    m = InverseModel.load(_saved_folder(tmp_path, V2_META))
+    assert m.jacobian == "shunt" and m.calibration == "crossfit"  # its own settings, not today's defaults
+    p = m.predict(pairs_dataset(BLIND_PAIRS[:2]), check=False)
+    before = json.loads(V2_PREDICT.read_text())
+    assert sorted(before) == ["L", "L_std", "R", "R_std"]
+    for k, v in before.items():
+        np.testing.assert_allclose(p[k], v, rtol=1e-6, atol=0)
+
+
 def test_a_newer_format_is_refused_with_the_reason(tmp_path):
-    folder = _v1_folder(tmp_path)
+    folder = _saved_folder(tmp_path)
     meta = json.loads(V1_META.read_text())
     meta["schema"] = "satmd-inverse/7"
     (folder / "model.json").write_text(json.dumps(meta))
