@@ -118,7 +118,8 @@ def test_kaufman_jacobian_is_the_derivative_of_the_projected_residual_at_a_fit(s
 
     exact = varpro._kaufman(cols, y - sk.offset(p, Zt), sk.derivatives(p, Zt), sk.intercept)
     numeric = approx_derivative(residual, p, method="3-point")
-    np.testing.assert_allclose(exact, numeric, atol=1e-6 * max(1.0, np.abs(numeric).max()))
+    # 3-point differences carry a truncation + round-off error of ~1e-6 of the largest entry; 1e-5 leaves margin
+    np.testing.assert_allclose(exact, numeric, atol=1e-5 * max(1.0, np.abs(numeric).max()))
 
 
 def test_search_recovers_a_planted_skeleton_exactly():
