@@ -138,7 +138,7 @@ def dumps_json(obj, command: str, **kw) -> str:
     """JSON text with non-finite numbers written as null (standard JSON has no NaN); a note names them."""
     from ..jsonsafe import jsonable
 
-    nulled = []
+    nulled: list[str] = []
     text = json.dumps(jsonable(obj, nulled), allow_nan=False, **kw)
     if nulled:
         shown = ", ".join(nulled[:6]) + (f" and {len(nulled) - 6} more" if len(nulled) > 6 else "")
@@ -198,11 +198,11 @@ def parse_band(text: str | None, what: str = "--band"):
     """'LO:HI' (either may be empty) -> (lo, hi) in Hz; ``what`` names the option in messages."""
     if not text:
         return None, None
-    lo, sep, hi = text.partition(":")
+    lo_text, sep, hi_text = text.partition(":")
     if not sep:
         raise SatmdError(f"{what} {text!r}: expected LO:HI in Hz")
-    lo = parse_number(lo, f"{what} LO") if lo else None
-    hi = parse_number(hi, f"{what} HI") if hi else None
+    lo = parse_number(lo_text, f"{what} LO") if lo_text else None
+    hi = parse_number(hi_text, f"{what} HI") if hi_text else None
     if lo is not None and hi is not None and lo >= hi:
         raise SatmdError(f"{what} {text!r}: LO must be below HI")
     for x, end in ((lo, "LO"), (hi, "HI")):

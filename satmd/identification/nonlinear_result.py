@@ -2,8 +2,13 @@
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
 
 import numpy as np
+
+if TYPE_CHECKING:
+    from ..physics import Rig
+    from ..physics.nonlinear import NonlinearElement
 
 
 @dataclass(frozen=True)
@@ -26,8 +31,8 @@ class NonlinearFit:
     settings : what was fitted and how (seconds used, skipped start, weights).
     """
 
-    element: object
-    rig: object
+    element: NonlinearElement | None
+    rig: Rig
     values: dict
     std: dict
     ci95: dict

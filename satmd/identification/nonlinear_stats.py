@@ -57,12 +57,12 @@ def simex_shift(coords, x, data, weights, skip, draws: int, seed: int = 0, simul
             spec = np.fft.rfft(rng.standard_normal(n)) * math.sqrt(d["force_noise_var"]) * band_gain(f, d["band"])
             noisy.append({**d, "force": d["force"] + np.fft.irfft(spec, n)})
         steps.append(_gauss_newton_step(coords, x, noisy, weights, skip, simulate, residuals))
-    steps = np.array(steps)
+    step_arr = np.array(steps)
     # the steps' spread is what one more unit of force noise does to the estimate, through the model's
     # input *and* its Jacobian, which the sandwich's first order misses: added in full (conservative),
     # plus the uncertainty of their mean
-    cov = np.cov(steps.T).reshape(x.size, x.size) * (1 + 1 / draws) if draws > 1 else np.zeros((x.size, x.size))
-    return 2 * s0 - steps.mean(axis=0), cov
+    cov = np.cov(step_arr.T).reshape(x.size, x.size) * (1 + 1 / draws) if draws > 1 else np.zeros((x.size, x.size))
+    return 2 * s0 - step_arr.mean(axis=0), cov
 
 
 def sandwich(J, r, block_sizes, channel_length, lags: int = 1024) -> np.ndarray:

@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import time
 from dataclasses import dataclass, field
+from typing import cast
 
 import numpy as np
 from scipy.optimize import minimize
@@ -177,9 +178,12 @@ def tune_nonlinear(rig: Rig, elements, levels, band_hz=(20.0, 200.0), output: st
                 best = res
         return np.clip(best.x, lo, hi)
 
+    def rl(x) -> tuple[float, float]:  # (R, L) at (log R, log L); cast: mypy cannot size an array's unpacking
+        return cast("tuple[float, float]", np.exp(x))
+
     starts = [np.log([float(rig.R), float(rig.L)]), np.log([40.0, 0.2]), np.log([20.0, 0.08])]
-    x_lin = minimax(lambda x: _db(np.max(equivalent_peaks(rig, [], *np.exp(x), [1.0], band_hz, output))), starts)
-    x_eq = minimax(lambda x: _db(np.max(equivalent_peaks(rig, elements, *np.exp(x), levels, band_hz, output))),
+    x_lin = minimax(lambda x: _db(np.max(equivalent_peaks(rig, [], *rl(x), [1.0], band_hz, output))), starts)
+    x_eq = minimax(lambda x: _db(np.max(equivalent_peaks(rig, elements, *rl(x), levels, band_hz, output))),
                    [x_lin])
     sim = dict(band_hz=band_hz, output=output, duration_s=duration_s, fs_hz=fs_hz, seed=seed)
     x = x_eq
@@ -188,8 +192,8 @@ def tune_nonlinear(rig: Rig, elements, levels, band_hz=(20.0, 200.0), output: st
         X = np.clip(x + np.stack([gr.ravel(), gl.ravel()], axis=1), lo, hi)
         worst = _db(simulated_peaks(rig, elements, np.exp(X[:, 0]), np.exp(X[:, 1]), levels, **sim)).max(axis=1)
         x = X[int(np.argmin(worst))]
-    peaks = _db(simulated_peaks(rig, elements, *np.exp(x), levels, **sim))[0]
-    lin_peaks = _db(simulated_peaks(rig, elements, *np.exp(x_lin), levels, **sim))[0]
+    peaks = _db(simulated_peaks(rig, elements, *rl(x), levels, **sim))[0]
+    lin_peaks = _db(simulated_peaks(rig, elements, *rl(x_lin), levels, **sim))[0]
     return NonlinearTuneResult(
         design={"R": float(np.exp(x[0])), "L": float(np.exp(x[1]))}, peaks_db=[float(p) for p in peaks],
         worst_db=float(peaks.max()), linear_design={"R": float(np.exp(x_lin[0])), "L": float(np.exp(x_lin[1]))},
