@@ -207,10 +207,11 @@ def _discover_frf(data: FRFData, rig, free, candidates, channels, alpha, max_eff
         dof = max(final.fit.dof - disc.n_parameters, 1)
         after = {"chi2_reduced": disc.chi2_after / dof, "rel_error": _rel_error(final.fit, disc)}
         n_terms = sum(disc.terms.values())
-    if test1.significant and disc.structured_fraction < NOISE_LIKE:
+    if test1.significant and structured < NOISE_LIKE:
         # no smooth structure left to take: a statement about the noise model, not about physics
         noise_notes.append(_noise_like(final.fit))
     elif test1.significant:
+        assert disc is not None  # found when test1 is significant
         effects.append(UnexplainedFinding(
             name=UNEXPLAINED, parameters={}, equivalent=[],
             delta_bic=round(float(final.fit.chi2 - disc.chi2_after - disc.n_parameters * _log_n(final.fit)), 2),

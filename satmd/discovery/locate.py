@@ -69,7 +69,7 @@ def test_mismatch(fit, alpha: float = 1e-3, noise_dof: float | None = None) -> M
     p_adj = np.minimum(np.array([p for p, _, _ in windows]) * n_tests, 1.0)
     hit = p_adj < alpha / 2
     spans = sorted((i0, i1) for (p, i0, i1), h in zip(windows, hit) if h)
-    bands = []
+    bands: list[list[int]] = []
     for i0, i1 in spans:
         if bands and i0 <= bands[-1][1] + 1:
             bands[-1][1] = max(bands[-1][1], i1)

@@ -55,6 +55,7 @@ def estimate_channel_std(residual: np.ndarray, magnitude: np.ndarray, nu: float 
         res = minimize(nll, np.array(x0), method="Nelder-Mead", options={"xatol": 1e-4, "fatol": 1e-6, "maxiter": 600})
         if best is None or res.fun < best.fun:
             best = res
+    assert best is not None  # three starts
     s = np.sqrt(sigma2(best.x))
     # the t-likelihood scale is not the Gaussian std: rescale by the Gaussian consistency factor
     return s * _t_scale_correction(nu)

@@ -119,7 +119,8 @@ def distortion_test(recording, band=None, alpha: float = 1e-3) -> NonlinearTest:
         responses = {ch: recording[c] for c, ch in zip(("acc1", "acc2"), ACCEL_CHANNELS) if c in recording.channels}
         predicted = linear_prediction(recording, band)
         a1, a2 = predicted.get(ACCEL_CHANNELS[0]), predicted.get(ACCEL_CHANNELS[1])
-        signals, shapes = {}, {}
+        signals: dict[str, np.ndarray] = {}
+        shapes: dict[str, tuple[str, ...]] = {}
         if a1 is not None:
             signals["u1"], shapes["u1"] = integrate(a1, fs, 2, band), ("cube",)
         if a1 is not None and a2 is not None:
@@ -315,9 +316,10 @@ def concentrated_bands(test: NonlinearTest, share: float = 0.25, smooth: int = 7
     freq = test.details.get("freq_hz")
     if score is None or not test.bands_hz:
         return test.bands_hz
+    assert freq is not None  # stored with the scores
     s = np.convolve(score, np.ones(smooth) / smooth, mode="same")
     on = s >= share * s.max()
-    sig = np.zeros(freq.size, bool)
+    sig = np.zeros(freq.size, np.bool_)
     for a, b in test.bands_hz:
         sig |= (freq >= a) & (freq <= b)
     on &= sig

@@ -243,7 +243,7 @@ def analyse_generic(frfs: list, stds: list, freq, levels, tests=(), alpha: float
         dz = (fn[order[-1]] - fn[order[0]]) / max(np.hypot(fits[order[-1]]["f_n_std"], fits[order[0]]["f_n_std"]),
                                                     TINY)
         character = "hardening" if dz > 3 else "softening" if dz < -3 else "level-dependent damping"
-        bands = next((t.bands_hz for t in tests if t.name == "level_dependence"), [])
+        bands: list = next((t.bands_hz for t in tests if t.name == "level_dependence"), [])
         where = ", ".join(f"{a:.1f}–{b:.1f} Hz" for a, b in bands)
         findings.append({
             "name": UNEXPLAINED_NL, "parameters": {}, "ci95": {}, "equivalent": [], "character": character,

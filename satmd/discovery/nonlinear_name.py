@@ -188,7 +188,7 @@ def parameter_test(cmp: dict, alpha: float = 1e-3):
         mean = np.sum(v / var) / np.sum(1.0 / var)
         chi[p] = float(np.sum((v - mean) ** 2 / var))
         pvals[p] = float(stats.chi2.sf(chi[p], v.size - 1))
-    worst = min(pvals, key=pvals.get)
+    worst = min(pvals, key=pvals.__getitem__)
     p_value = min(1.0, pvals[worst] * len(MOVING))
     return NonlinearTest("level_dependence_parameters", p_value, [], alpha,
                          {"chi2": chi, "p": pvals, "parameter": worst})

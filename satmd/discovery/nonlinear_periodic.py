@@ -173,6 +173,7 @@ def one_mode_fit(freq, H, std, band=None) -> dict:
         sol = least_squares(resid, [fpk, z0], bounds=([lo, 1e-4], [hi, 0.9]), x_scale="jac")
         if best is None or sol.cost < best.cost:
             best = sol
+    assert best is not None  # three starts
     dof = max(2 * sel.sum() - 6, 1)
     try:
         cov = np.linalg.inv(best.jac.T @ best.jac) * max(2 * best.cost / dof, 1.0)

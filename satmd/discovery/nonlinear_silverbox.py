@@ -128,7 +128,8 @@ def silverbox_verdicts(directory, alpha: float = 1e-3) -> dict:
     """
     from ..physics.nonlinear import NONLINEAR
 
-    out, words = {}, []
+    out: dict[str, object] = {}
+    words: list[str] = []
     for key, fn in (("ladder", ladder_report), ("snls", snls_report)):
         rep = fn(directory, alpha)
         f = rep.findings[0] if rep.findings else {}

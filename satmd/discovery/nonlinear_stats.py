@@ -32,6 +32,7 @@ from __future__ import annotations
 from ..conventions import TINY
 
 from dataclasses import dataclass, field
+from typing import Callable
 
 import numpy as np
 
@@ -123,8 +124,8 @@ def chi2_score(p, dof):
 
 
 # --- one record: distortion regressors ----------------------------------------------------------------
-_SHAPES = {"square": lambda s: s * s, "cube": lambda s: s ** 3, "absv": lambda s: np.abs(s) * s,
-           "sign": np.sign}
+_SHAPES: dict[str, Callable[[np.ndarray], np.ndarray]] = {
+    "square": lambda s: s * s, "cube": lambda s: s ** 3, "absv": lambda s: np.abs(s) * s, "sign": np.sign}
 
 
 def distortion_regressors(signals: dict, shapes=("cube",)) -> dict:
@@ -200,6 +201,7 @@ def linearity_test(force, responses: dict, fs_hz: float, regressors: dict, band=
     Xw = X[idx]
     xs = np.sqrt(np.mean(np.abs(Xw) ** 2, axis=1))[:, None, None]
     K0 = np.concatenate([Xw[..., None] / xs * powers, np.broadcast_to(powers, Xw.shape + (degree + 1,))], axis=2)
+    assert Z is not None  # nz > 0
     Zw = Z[idx]  # (M, W, nz)
     Zw = Zw / np.sqrt(np.mean(np.abs(Zw) ** 2, axis=1, keepdims=True))
     K1 = np.concatenate([K0, Zw], axis=2)

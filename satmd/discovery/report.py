@@ -3,9 +3,14 @@ from __future__ import annotations
 
 import json
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
 
 from .findings import UNEXPLAINED
 from .select import MIN_DELTA_BIC
+
+if TYPE_CHECKING:
+    from ..identification.adequacy import Adequacy
+    from .nonlinear import NonlinearReport
 
 SCHEMA = "satmd-discovery/1"
 
@@ -29,8 +34,8 @@ class DiscoveryReport:
     # --- from recordings: how the FRFs were estimated, and what the chain did (SPEC §9) ---
     estimator: dict = field(default_factory=dict)
     measurement: list = field(default_factory=list)  # dicts: name, explanation, remedy, corrected
-    nonlinear: object = None  # NonlinearReport (SPEC §9 ``nonlinear`` block), when time data or levels were given
-    adequacy: object = None  # Adequacy (SPEC §9 ``model_adequate``); None: adequate (nothing spoke against it)
+    nonlinear: NonlinearReport | None = None  # (SPEC §9 ``nonlinear`` block), when time data or levels were given
+    adequacy: Adequacy | None = None  # (SPEC §9 ``model_adequate``); None: adequate (nothing spoke against it)
 
     @property
     def model_adequate(self) -> bool:
@@ -87,6 +92,7 @@ class DiscoveryReport:
                  f"(p = {self.p_values.get('global', float('nan')):.2g} globally, "
                  f"{self.p_values.get('band', float('nan')):.2g} in the worst band)"]
         if not self.model_adequate:
+            assert self.adequacy is not None  # only an Adequacy says "not adequate"
             lines.append(f"    MODEL NOT ADEQUATE: {self.adequacy.summary}. No physics is named: the SATMD model, "
                          "with any vocabulary effects, does not describe these data.")
             lines += [f"      - {r.kind}: {r.message}" for r in self.adequacy_reasons]

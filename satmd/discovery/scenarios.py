@@ -12,7 +12,7 @@ import numpy as np
 
 from ..conventions import SPEC_RANGES
 from ..physics import Rig
-from ..physics.effects import VOCABULARY_NAMES, effect
+from ..physics.effects import VOCABULARY_NAMES, Effect, effect
 from ..simulation import simulate
 
 GRIDS = {"paper60": (40.0, 130.0, 60), "lin200": (30.0, 160.0, 200)}
@@ -83,7 +83,7 @@ def concealed_case(seed: int, names=None, n_effects: int = 1, std_given: bool = 
     freq = np.linspace(lo, hi, n)
     rig = random_rig(rng)
     pool = list(names or VOCABULARY_NAMES)
-    picked = []
+    picked: list[Effect] = []
     while len(picked) < n_effects:
         name = str(rng.choice(pool))
         kind = name.split(":")[0]

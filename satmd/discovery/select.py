@@ -13,6 +13,7 @@ equivalent explanation, because FRFs alone cannot tell them apart.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -23,6 +24,11 @@ from ..io.frfdata import CHANNELS
 from ..physics.effects import at_rest
 from .candidates import candidate_starts
 
+if TYPE_CHECKING:
+    from ..identification import FitResult
+    from ..io.frfdata import FRFData
+    from ..physics import Rig
+
 MIN_DELTA_BIC = 10.0
 
 
@@ -30,7 +36,7 @@ MIN_DELTA_BIC = 10.0
 class Model:
     names: tuple  # effect names, in the order found
     effects: list  # fitted Effect objects
-    fit: object  # FitResult
+    fit: FitResult
 
     @property
     def bic(self):
@@ -39,8 +45,8 @@ class Model:
 
 @dataclass
 class Search:
-    data: object
-    rig: object
+    data: FRFData
+    rig: Rig | None
     base_free: tuple
     channels: tuple
     candidates: tuple
@@ -57,7 +63,7 @@ class Search:
         channel = param.rsplit("_", 1)[-1]
         return channel not in CHANNELS or channel in self.channels
 
-    def fit(self, effects, starts) -> object:
+    def fit(self, effects, starts) -> FitResult:
         problem = Problem(self.data, self.rig, self.free_names(effects), self.channels, effects)
         bounds = {n: (lo, hi) for n, lo, hi in zip(problem.names, problem.lower, problem.upper)}
         # a start taken from another fit may sit a rounding error outside a bound: bring it inside
@@ -130,7 +136,7 @@ def select(search: Search, nominal: Model, still_significant, max_effects: int =
     """
     layer, reached = [nominal], [nominal]
     for _ in range(max_effects):
-        grown = {}
+        grown: dict[frozenset, Model] = {}
         for parent in layer:
             if not still_significant(parent.fit):
                 continue
