@@ -19,6 +19,7 @@ from __future__ import annotations
 import dataclasses
 import platform
 import time
+from typing import Any
 
 import numpy as np
 
@@ -99,7 +100,7 @@ def run_ablation(kinds=KINDS, noises=NOISES, presets=PRESETS, per_pair: int = 40
     blind = pairs_dataset(BLIND_PAIRS, per_pair=per_pair, seed=seed + 1000)
     off = pairs_dataset(OFF_CURVE_PAIRS, per_pair=off_per_pair, seed=seed + 2000)
     t_start = time.perf_counter()
-    out = {"schema": "satmd-inverse-ablation/1", "kinds": list(kinds), "noises": list(noises),
+    out: dict[str, Any] = {"schema": "satmd-inverse-ablation/1", "kinds": list(kinds), "noises": list(noises),
            "presets": list(presets), "per_pair": per_pair, "off_per_pair": off_per_pair, "n_test": len(blind),
            "n_off_curve": len(off),
            "quick": quick, "seed": seed, "model_kwargs": model_kwargs,

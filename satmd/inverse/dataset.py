@@ -215,7 +215,9 @@ def make_dataset(
     n_samples = sizes.get("n_samples") if n_samples is None else n_samples
     rng = np.random.default_rng(seed)
     freq_hz = np.asarray(freq_hz, float)
+    val_groups: np.ndarray | list[int]
     if preset == "paper":
+        assert samples_per_pair is not None  # PRESET_SIZES["paper"] has it
         if samples_per_pair < 1:
             raise SatmdError(f"samples_per_pair must be >= 1, got {samples_per_pair}")
         R, L, group = jitter_pairs(PAPER_PAIRS, samples_per_pair, rng)
@@ -225,6 +227,7 @@ def make_dataset(
         n_val = int(round(val_fraction * n_groups))
         val_groups = rng.choice(np.arange(1, n_groups - 1), size=n_val, replace=False) if n_val else []
     else:
+        assert n_samples is not None  # PRESET_SIZES["box"] has it
         if n_samples < 2:
             raise SatmdError(f"n_samples must be >= 2, got {n_samples}")
         (r0, r1), (l0, l1) = BOX_RANGE["R"], BOX_RANGE["L"]

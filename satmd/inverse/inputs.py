@@ -209,13 +209,15 @@ def forward_check(inputs: Inputs, R, L, rig: Rig | None, residual_ref: float, no
     res, exp = [], []
     for (f, a, s), r, l in zip(inputs.raw, np.asarray(R, float), np.asarray(L, float)):
         model = frf(f, rig.replace(R=r, L=max(l, 1e-9)), outputs=ACCEL_CHANNELS)
+        assert model.a1 is not None and model.a2 is not None  # both were asked for
         norm2 = float(np.sum(np.abs(a) ** 2))
         res.append(np.linalg.norm(np.stack([model.a1, model.a2]) - a) / np.sqrt(norm2))
         sd = np.abs(a) * noise if s is None else s
         exp.append(np.sqrt(residual_ref ** 2 + 2 * float(np.sum(sd ** 2)) / norm2))  # Re and Im each carry σ²
-    res, exp = np.array(res), np.array(exp)
-    ratio = res / exp
-    return {"residual": res, "residual_expected": exp, "residual_ratio": ratio, "explained": ratio <= CHECK_LIMIT}
+    residual, expected = np.array(res), np.array(exp)
+    ratio = residual / expected
+    return {"residual": residual, "residual_expected": expected, "residual_ratio": ratio,
+            "explained": ratio <= CHECK_LIMIT}
 
 
 def check_message(check: dict, R, L, rig: Rig | None) -> str | None:
@@ -282,6 +284,7 @@ def trust_check(out: dict, bounds: dict, std_scale) -> str | None:
         if wide.any() and not bad.any():
             notes.append(f"{name}_std {float(np.max(s)):.3g} spans the whole training box ({span:g})")
         distrust = wide if distrust is None else distrust | wide
+    assert distrust is not None  # set for R and L
     scale = float(np.max(np.asarray(std_scale, dtype=float)))
     if scale > MAX_STD_SCALE:
         notes.append(f"the model's std calibration factor is {scale:.3g}: its ensemble has no spread of its own "

@@ -36,6 +36,7 @@ import inspect
 import time
 from numbers import Integral, Real
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -44,6 +45,9 @@ from ..physics import PAPER_GRID_HZ, Rig
 from .dataset import BOUNDS, PRESETS, InverseDataset, complex_to_features, make_dataset
 from .params import PRESET_SIZES, Grid, Interval, Options, validate
 from .strategies import CALIBRATIONS, KINDS, NET_KINDS, STRATEGIES  # noqa: F401 - NET_KINDS re-exported
+
+if TYPE_CHECKING:
+    from .training import Scaler
 
 _LEARNED = ("ensemble_", "networks_", "scaler_", "std_scale_", "history_", "fit_info_")
 
@@ -110,6 +114,7 @@ class InverseModel:
         "verbose": [bool], "rig": [None, Rig], "freq_hz": [Grid()],
     }
     bounds = BOUNDS  # output normalisation of eq. 20 (SPEC §5), not a hyperparameter
+    scaler_: Scaler  # learned (set by fit or load; an annotation only: no attribute before then)
 
     def __init__(self, kind="physics", preset="paper", noise=0.0, *, epochs=90, warm_start_epochs=50,
                  batch_size=64, lr=1e-3, physics_lr=3e-4, lr_final=1e-5, n_members=5, precondition=True,

@@ -85,9 +85,9 @@ def model_from_meta(cls, meta: dict, state: dict | None = None):
         raise DataError(_schema_refusal(meta))
     if CHECKSUM in meta and meta[CHECKSUM] != _checksum(meta):  # models saved before the checksum have none
         raise DataError("contents differ from what was saved (checksum mismatch); edited by hand?")
-    for key, kind in (("params", dict), ("rig", dict), ("bounds", dict), ("freq_hz", list), ("std_scale", list)):
-        if not isinstance(meta.get(key), kind):
-            raise DataError(f"{key!r} missing or not a {kind.__name__}")
+    for key, typ in (("params", dict), ("rig", dict), ("bounds", dict), ("freq_hz", list), ("std_scale", list)):
+        if not isinstance(meta.get(key), typ):
+            raise DataError(f"{key!r} missing or not a {typ.__name__}")
     kind = meta.get("kind")
     if kind not in KINDS:
         raise DataError(f"unknown kind {kind!r} (known: {', '.join(KINDS)})")

@@ -13,7 +13,7 @@ from __future__ import annotations
 import math
 import time
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import torch
 
@@ -44,7 +44,7 @@ class TrainingRun:
     noise_gen: torch.Generator
     total_epochs: int
     history: dict
-    bar: object
+    bar: Any  # `satmd._progress.progress`: a tqdm bar or a LineProgress; None: quiet
     mobius: ShuntMobius | None = None
 
     @property

@@ -212,6 +212,7 @@ def residual_ref(model, ds: InverseDataset, member=None) -> float:
         span, lo = _span_lo(model)
         mean = lo + member_outputs(model, a, member) * span
     rec = frf(ds.freq_hz, model.rig_or_default.replace(R=mean[:, 0], L=np.maximum(mean[:, 1], 1e-9)), outputs=ACCEL_CHANNELS)
+    assert rec.a1 is not None and rec.a2 is not None  # both were asked for
     err = np.linalg.norm((np.stack([rec.a1, rec.a2], axis=1) - a).reshape(len(a), -1), axis=1)
     return float(max(np.quantile(err / np.linalg.norm(a.reshape(len(a), -1), axis=1), 0.99), 1e-4))
 
@@ -262,7 +263,8 @@ class HybridStrategy(NetStrategy):
         return least_squares(model, inputs.a, inputs.std, mean)
 
 
-STRATEGIES = {"physics": NetStrategy("physics"), "supervised": NetStrategy("supervised"),
-              "optimization": OptimizationStrategy(), "hybrid": HybridStrategy()}
+STRATEGIES: dict[str, NetStrategy | OptimizationStrategy] = {
+    "physics": NetStrategy("physics"), "supervised": NetStrategy("supervised"),
+    "optimization": OptimizationStrategy(), "hybrid": HybridStrategy()}
 KINDS = tuple(STRATEGIES)
 NET_KINDS = tuple(k for k, s in STRATEGIES.items() if s.has_net)

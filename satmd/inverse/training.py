@@ -72,6 +72,7 @@ import contextlib
 import math
 import time
 from dataclasses import asdict, dataclass
+from typing import Any
 
 import numpy as np
 
@@ -176,7 +177,7 @@ class _Batches:
         # members: per ensemble member, the indices of the samples it trains on (None: every member, every sample)
         self.members = None if members is None else [
             torch.as_tensor(np.flatnonzero(m), device=device) for m in np.asarray(members, bool)]
-        self.n_epoch = self.n if members is None else max(len(m) for m in self.members)
+        self.n_epoch = self.n if self.members is None else max(len(m) for m in self.members)
         self.x = torch.as_tensor(scaler.transform(ds.features()), device=device)
         # per-feature noise scale in standardised units: |A| / feature scale
         mag = np.abs(np.concatenate([ds.a1, ds.a2], axis=-1))
@@ -245,7 +246,7 @@ def train_ensemble(train: InverseDataset, val: InverseDataset | None, config: Tr
     if main_epochs:
         phases.append((config.objective, main_epochs, main_lr))
 
-    history = {"loss": [], "val_mae": [], "val_epoch": [], "epoch_s": [], "phase": []}
+    history: dict[str, Any] = {"loss": [], "val_mae": [], "val_epoch": [], "epoch_s": [], "phase": []}
     total_epochs = sum(p[1] for p in phases)
     bar = _progress(total_epochs, verbose, f"train {config.objective}")
     t_start = time.perf_counter()
