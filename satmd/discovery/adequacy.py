@@ -37,8 +37,10 @@ def assess_fit(fit) -> Adequacy:
     """The verdict of the nominal fit before the search: inadequate only when it reproduces little of the
     data (then `FitResult.adequacy`, with the readings that name a mistake). Implausible values alone are
     left to the search: a missing effect can push the nominal model's free parameters anywhere; the best
-    augmented fit is judged again (`after_search`)."""
+    augmented fit is judged again (`after_search`). A channel that copies another is absent whatever the fit."""
     quick = assess_one(fit, readings=False)
+    if any(r.kind == "channel" for r in quick.reasons):
+        return quick
     if quick.adequate or not any(r.kind == "poor_fit" for r in quick.reasons):
         return Adequacy(True)
     if fit.adequacy is not None:

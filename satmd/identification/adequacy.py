@@ -132,6 +132,9 @@ def assess_fit(fit, readings: bool = True, refit=None) -> Adequacy:
     -------
     Adequacy
     """
+    copied = copied_channel(fit.data.select(fit.channels))
+    if copied is not None:  # certain whatever the fit: two sensors cannot give the same numbers to 1e-9
+        return Adequacy(False, (copied,))
     reasons = []
     rel = float(fit.rel_error)
     absurd = implausible_values(fit)
@@ -162,6 +165,18 @@ def implausible_values(fit) -> dict:
     return out
 
 
+def copied_channel(data) -> Reason | None:
+    """A ``channel`` reason when one channel is a copy of another (to 1e-9 relative): one sensor is missing
+    or mislabelled, whatever a fit makes of it; None otherwise."""
+    names = list(data.names)
+    for i, a in enumerate(names):
+        for b in names[i + 1:]:
+            if np.allclose(data[a], data[b], rtol=1e-9, atol=0):
+                return Reason("channel", f"channel {b} is a copy of channel {a}: one sensor is missing or "
+                                         "mislabelled", {"channels": [a, b]})
+    return None
+
+
 def _refit(identify, fit, data, channels=None):
     p = fit._problem  # noqa: SLF001 - same package: the fitted problem's rig, free names and effects
     chans = tuple(channels or p.channels)
@@ -176,12 +191,6 @@ def _explain_failure(fit, rel, identify) -> list:
     data = fit.data.select(fit.channels)
     out = []
     names = list(data.names)
-    for i, a in enumerate(names):
-        for b in names[i + 1:]:
-            if np.allclose(data[a], data[b], rtol=1e-9, atol=0):
-                out.append(Reason("channel", f"channel {b} is a copy of channel {a}: one sensor is missing or "
-                                             "mislabelled", {"channels": [a, b]}))
-                return out
     # noise has neither smooth parts nor a smooth magnitude (a long delay turns a smooth FRF's phase fast,
     # so its parts alone may look rough while its magnitude stays smooth)
     lag = {c: max(_lag1(data[c].real, data[c].imag), _lag1(np.abs(data[c]))) for c in names}

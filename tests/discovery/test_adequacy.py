@@ -79,6 +79,19 @@ def test_a_copied_channel_is_named():
     assert _kinds(rep)[0] == "channel"
 
 
+def test_a_copied_channel_is_named_even_when_the_fit_looks_good():
+    """Below the absorber's frequency a1 and a2 nearly agree, so a copy of a1 fits well (relative error
+    ~0.04): the copy is still no measurement of a2, and no search or parameter is run on it."""
+    f = np.linspace(30, 60, 60)
+    d = simulate(f, Rig(m2=0.3, kp=2e5, R=30.0, L=0.1), noise=(0.01, 0.002), seed=1)
+    copy = FRFData(f, {"a1": d["a1"], "a2": d["a1"].copy()}, {"a1": d.std["a1"], "a2": d.std["a1"].copy()})
+    fit = identify(copy, warn=False)
+    assert fit.rel_error < 0.1 and not fit.model_adequate and _kinds(fit.adequacy) == ["channel"]
+    rep = discover(copy)
+    assert not rep.model_adequate and rep.effects == [] and _kinds(rep) == ["channel"]
+    assert "copy of channel a1" in rep.adequacy.summary
+
+
 def test_another_structure_gets_no_physics():
     """A 1-DOF oscillator at 300 Hz, as the issue's user measured it."""
     f = np.linspace(150, 600, 60)
