@@ -10,6 +10,10 @@ from __future__ import annotations
 from ..conventions import TINY
 
 import numpy as np
+from scipy import stats
+
+#: relative std of the median of m exponential bins, times √m: 1 / (2 f(ln 2) ln 2) with f(x) = e^{-x}
+_MEDIAN_REL_SD = 1.0 / np.log(2)
 
 
 def force_noise_floor(power: np.ndarray, f: np.ndarray, start: int, level: float) -> dict:
@@ -51,7 +55,10 @@ def force_noise_floor(power: np.ndarray, f: np.ndarray, start: int, level: float
     db = 10 * np.log10(np.maximum(lev, TINY))
     sd = 10 / np.log(10) * 1.25 / np.sqrt(m)  # scatter of a block median's level [dB]
     tol = max(1.0, 3.0 * sd)
-    bound = float(lev.min() * (1 + 3 * 1.25 / np.sqrt(m)))
+    # an upper bound on the floor from the lowest block: its median of m exponential bins scatters by
+    # 1/(ln 2 √m) relative; the lowest of n_blocks is a minimum, so the margin covers all of them at 1 %
+    z = float(stats.norm.isf(0.01 / n_blocks))
+    bound = float(lev.min() * (1 + z * _MEDIAN_REL_SD / np.sqrt(m)))
     ref = np.percentile(db, 10)
     near = db <= ref + tol
     best = max(true_runs(near, bridge=1), key=lambda r: r[1] - r[0])
@@ -71,7 +78,7 @@ def force_noise_floor(power: np.ndarray, f: np.ndarray, start: int, level: float
         out["slope_db_per_octave"] = float(np.polyfit(x, db[tail], 1)[0]) if np.ptp(x) > 0 else None
         return {**out, "floor": None, "status": "no_plateau"}
     floor = float(np.median(blocks[run]) / np.log(2))
-    out["floor_rel_std"] = float(1.25 / np.sqrt(blocks[run].size))
+    out["floor_rel_std"] = float(_MEDIAN_REL_SD / np.sqrt(blocks[run].size))
     if floor * 1e3 >= level:  # not 30 dB below the excitation: a flat stretch of force, not noise
         return {**out, "floor": None, "status": "not_below_excitation"}
     return {**out, "floor": floor, "status": "estimated"}
