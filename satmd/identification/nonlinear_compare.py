@@ -73,9 +73,10 @@ def compare_models(train, held_out, element, seconds: float | None = 30.0, best_
     dict
         ``nonlinear`` and ``linear`` (NonlinearFit.to_dict() of the joint linear fit), and
         ``levels``: one entry per recording (train then held out) with ``level``, ``held_out``,
-        ``td_error`` (on the excited band, the headline), ``td_error_broadband`` and
-        ``frf_residual`` {"linear", "nonlinear"}, ``linear_model`` (which linear fit was best),
-        ``td_ratio`` and ``td_ratio_broadband`` = linear / nonlinear; ``fits`` (nonlinear, joint
+        ``td_error`` (where the response is excited, the headline: `predict`'s ``rel_error_excited``),
+        ``td_error_band`` (the force's whole band), ``td_error_broadband`` and ``frf_residual``
+        {"linear", "nonlinear"}, ``linear_model`` (which linear fit was best, chosen on the headline
+        error), ``td_ratio``, ``td_ratio_band`` and ``td_ratio_broadband`` = linear / nonlinear; ``fits`` (nonlinear, joint
         linear NonlinearFit) and ``linear_fits`` {name: NonlinearFit} (not JSON: pop them).
     """
     nl = fit_nonlinear(train, element, seconds=seconds, **fit_options)
@@ -90,15 +91,15 @@ def compare_models(train, held_out, element, seconds: float | None = 30.0, best_
         for rec in recs:
             p_nl = predict(nl, rec, seconds)
             preds = {k: predict(f, rec, seconds) for k, f in linears.items()}
-            best = min(preds, key=lambda k: preds[k]["rel_error_band"]["both"])
+            best = min(preds, key=lambda k: preds[k]["rel_error_excited"]["both"])
             p_lin = preds[best]
             row = {"level": float(np.sqrt(np.mean(np.asarray(rec["force"]) ** 2))), "held_out": held,
-                   "linear_model": best, "band_hz": p_nl["band_hz"],
-                   "td_error": {"linear": p_lin["rel_error_band"]["both"], "nonlinear": p_nl["rel_error_band"]["both"]},
-                   "td_error_broadband": {"linear": p_lin["rel_error"]["both"], "nonlinear": p_nl["rel_error"]["both"]},
-                   "frf_residual": {"linear": frf_residual(rec, p_lin, seconds=seconds),
-                                    "nonlinear": frf_residual(rec, p_nl, seconds=seconds)}}
-            for key in ("", "_broadband"):
+                   "linear_model": best, "band_hz": p_nl["band_hz"]}
+            for key, pkey in (("", "rel_error_excited"), ("_band", "rel_error_band"), ("_broadband", "rel_error")):
+                row["td_error" + key] = {"linear": p_lin[pkey]["both"], "nonlinear": p_nl[pkey]["both"]}
+            row["frf_residual"] = {"linear": frf_residual(rec, p_lin, seconds=seconds),
+                                   "nonlinear": frf_residual(rec, p_nl, seconds=seconds)}
+            for key in ("", "_band", "_broadband"):
                 e = row["td_error" + key]
                 row["td_ratio" + key] = e["linear"] / max(e["nonlinear"], TINY)
             rows.append(row)

@@ -17,6 +17,8 @@ from ..conventions import TINY
 import numpy as np
 
 ROLL = 1.3  # the drive's raised-cosine roll-off: from hi to ROLL * hi, and from lo to lo / ROLL
+EXCITED_DB = 20.0  # a response bin is "excited" within this many dB of the response's in-band peak (smoothed)
+SMOOTH_HZ = 2.0  # width of the running mean that smooths the response's spectrum for that choice
 TAIL_S = 0.5  # seconds at a record's end left out of errors (the band-limit's end effect; measured < 1e-5 before)
 
 
@@ -103,4 +105,60 @@ def band_error(sim, meas, fs, band_hz) -> np.ndarray:
     keep = (f >= band_hz[0]) & (f <= band_hz[1])
     e = np.sum(np.abs(np.fft.rfft(sim - meas, axis=-1)[:, keep]) ** 2, axis=-1)
     m = np.sum(np.abs(np.fft.rfft(meas, axis=-1)[:, keep]) ** 2, axis=-1)
+    return np.sqrt(e / np.maximum(m, TINY))
+
+
+def excited_bins(meas, fs, band_hz, db: float = EXCITED_DB, smooth_hz: float = SMOOTH_HZ) -> np.ndarray:
+    """Bins (of ``rfft`` of length ``meas.shape[-1]``) where each channel's measured response is excited.
+
+    Excited: in the force's band and within ``db`` of the channel's in-band peak, the power
+    spectrum smoothed over ``smooth_hz`` (a running mean, so a single noisy bin decides nothing).
+    That is where the structure answers the drive (its resonances and their flanks); elsewhere in
+    the band the accelerometers' noise is a large share of the recording, and an error there
+    measures the sensor, not the model. The bins come from the *measured* signal only, so every
+    model is judged on the same ones.
+
+    Parameters
+    ----------
+    meas : (channels, n) measured signals.
+    fs : sample rate [Hz].
+    band_hz : (lo, hi) the force's excited band.
+    db : how far below the peak a bin still counts.
+    smooth_hz : smoothing width [Hz].
+
+    Returns
+    -------
+    ndarray (channels, n // 2 + 1) of bool
+    """
+    meas = np.atleast_2d(meas)
+    f = np.fft.rfftfreq(meas.shape[-1], 1.0 / fs)
+    inband = (f >= band_hz[0]) & (f <= band_hz[1])
+    width = max(1, int(round(smooth_hz * meas.shape[-1] / fs)))
+    kernel = np.ones(width) / width
+    out = np.zeros((meas.shape[0], f.size), bool)
+    for c, x in enumerate(meas):
+        p = np.convolve(np.abs(np.fft.rfft(x)) ** 2, kernel, mode="same")
+        peak = float(np.max(p[inband])) if np.any(inband) else 0.0
+        out[c] = inband & (p >= peak * 10.0 ** (-db / 10.0))
+    return out
+
+
+def excited_error(sim, meas, fs, band_hz, db: float = EXCITED_DB) -> np.ndarray:
+    """Relative error per channel on the bins where the response is excited (`excited_bins`).
+
+    Parameters
+    ----------
+    sim, meas : (channels, n) simulated and measured signals (same samples).
+    fs : sample rate [Hz].
+    band_hz : (lo, hi) the force's excited band.
+    db : see `excited_bins`.
+
+    Returns
+    -------
+    ndarray (channels,)
+    """
+    sim, meas = np.atleast_2d(sim), np.atleast_2d(meas)
+    keep = excited_bins(meas, fs, band_hz, db)
+    e = np.sum(np.abs(np.fft.rfft(sim - meas, axis=-1)) ** 2 * keep, axis=-1)
+    m = np.sum(np.abs(np.fft.rfft(meas, axis=-1)) ** 2 * keep, axis=-1)
     return np.sqrt(e / np.maximum(m, TINY))

@@ -24,9 +24,13 @@ def simex_shift(coords, x, data, weights, skip, draws: int, seed: int = 0, simul
     of SIMEX (Cook & Stefanski 1994): the estimate at twice the force noise, extrapolated linearly
     in the noise variance back to none, ``x0 = 2 x1 - x2``. ``x1`` is the estimate on the data
     (``x`` plus its own Gauss-Newton step ``s0``, which finishes the optimiser's convergence),
-    ``x2`` the mean estimate with ``draws`` independent copies of the force-sensor noise added (its
-    variance estimated from the force's spectrum outside the excited band, shaped like the drive's
-    band, `band_gain`): ``x + mean(s)``, so ``x0 = x + 2 s0 - mean(s)``. (Without ``s0`` an
+    ``x2`` the mean estimate with ``draws`` copies of the force-sensor noise added (its variance
+    estimated from the force's spectrum outside the excited band, shaped like the drive's band,
+    `band_gain`): ``x + mean(s)``, so ``x0 = x + 2 s0 - mean(s)``. The copies come in antithetic
+    pairs (+e, -e): a step's part linear in the added noise, as large as the estimate's own noise,
+    cancels in the mean instead of being carried into the estimate (with 4 independent draws it
+    moved an inductor's isat by up to 2 %, as much as its interval); what remains is the part even
+    in the noise, the bias being corrected. (Without ``s0`` an
     unfinished optimisation would be doubled instead of corrected.) Returns the correction
     ``x0 - x`` and a covariance to add to the sandwich: the steps' spread (x (1 + 1/draws)), the
     errors-in-variables part the sandwich's first order misses (conservative). No out-of-band
@@ -49,13 +53,17 @@ def simex_shift(coords, x, data, weights, skip, draws: int, seed: int = 0, simul
         return s0, np.zeros((x.size, x.size))
     rng = np.random.default_rng(seed)
     steps = []
-    for _ in range(draws):
-        noisy = []
-        for d in data:
-            n = d["force"].size
-            f = np.fft.rfftfreq(n, 1.0 / d["fs"])
-            spec = np.fft.rfft(rng.standard_normal(n)) * math.sqrt(d["force_noise_var"]) * band_gain(f, d["band"])
-            noisy.append({**d, "force": d["force"] + np.fft.irfft(spec, n)})
+    noise: list = []
+    for j in range(draws):
+        if j % 2 == 0:  # antithetic pairs: +e and -e, so the steps' part linear in the noise cancels in their mean
+            noise = []
+            for d in data:
+                n = d["force"].size
+                f = np.fft.rfftfreq(n, 1.0 / d["fs"])
+                spec = np.fft.rfft(rng.standard_normal(n)) * math.sqrt(d["force_noise_var"]) * band_gain(f, d["band"])
+                noise.append(np.fft.irfft(spec, n))
+        sign = 1.0 if j % 2 == 0 else -1.0
+        noisy = [{**d, "force": d["force"] + sign * e} for d, e in zip(data, noise)]
         steps.append(_gauss_newton_step(coords, x, noisy, weights, skip, simulate, residuals))
     step_arr = np.array(steps)
     # the steps' spread is what one more unit of force noise does to the estimate, through the model's

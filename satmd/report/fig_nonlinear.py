@@ -32,7 +32,7 @@ def nonlinear_comparison_figure(comparison, path=None, title: str = ""):
     """Per drive level: FRF residual and time-domain error of the linear and the nonlinear model.
 
     Left: the relative FRF residual (H1 of each model's simulated response against the measured
-    H1, over the excited band). Right: the relative time-domain error on the excited band (the
+    H1, over the excited band). Right: the relative time-domain error where the response is excited (the
     headline of `compare_models`); levels held out of the fit are marked "held out" (a
     prediction), the others were fitted. Bars are on a log scale; the ratio linear / nonlinear
     is written above each pair.
@@ -56,7 +56,7 @@ def nonlinear_comparison_figure(comparison, path=None, title: str = ""):
     fig, axes = plt.subplots(1, 2, figsize=(10.0, 3.8))
     x = np.arange(len(rows))
     labels = [f"{r['level']:.3g} N" + ("\nheld out" if r.get("held_out") else "\nfitted") for r in rows]
-    panels = (("frf_residual", "FRF residual (relative)"), ("td_error", "time-domain error on the excited band"))
+    panels = (("frf_residual", "FRF residual (relative)"), ("td_error", "time-domain error where the response is excited"))
     for ax, (key, ylabel) in zip(axes, panels):
         for k, model in enumerate(("linear", "nonlinear")):
             vals = np.array([max(float(r[key][model]), 1e-12) for r in rows])

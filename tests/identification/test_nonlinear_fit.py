@@ -87,3 +87,25 @@ def test_inductor_saturation_by_name():
     lo, hi = fit.ci95["isat"]
     assert abs(fit.values["isat"] / 0.2 - 1) < 0.05 and lo < hi
     assert fit.equivalent_linear["L"][1] < fit.equivalent_linear["L"][0] < TRUE.L  # L down with level
+
+
+def test_error_where_the_response_is_excited():
+    from satmd.identification.nonlinear_signal import band_error, excited_bins, excited_error
+
+    fs, n = 1024.0, 16384
+    rng = np.random.default_rng(5)
+    f = np.fft.rfftfreq(n, 1 / fs)
+    x = np.fft.rfft(rng.standard_normal(n)) * ((f > 20) & (f < 200))
+    h = 1.0 / (1 - (f / 80.0) ** 2 + 2j * 0.02 * f / 80.0)  # a resonance at 80 Hz
+    clean = np.fft.irfft(x * h, n)[None]
+    noisy = clean + 0.05 * clean.std() * rng.standard_normal(n)
+    keep = excited_bins(noisy, fs, (20.0, 200.0))[0]
+    assert keep[np.argmin(abs(f - 80.0))] and not keep[np.argmin(abs(f - 190.0))] and not keep[np.argmin(abs(f - 300.0))]
+    assert excited_error(noisy, noisy, fs, (20.0, 200.0))[0] == 0.0
+    # a perfect model judged on a noisy recording: the excited bins hold less of the noise than the whole band
+    on_excited = excited_error(clean, noisy, fs, (20.0, 200.0))[0]
+    on_band = band_error(clean, noisy, fs, (20.0, 200.0))[0]
+    assert 0 < on_excited < 0.5 * on_band
+    # a model off at the resonance is judged there, where it matters: its error is not diluted
+    off = np.fft.irfft(x / (1 - (f / 81.0) ** 2 + 2j * 0.02 * f / 81.0), n)[None]
+    assert excited_error(off, noisy, fs, (20.0, 200.0))[0] > band_error(off, noisy, fs, (20.0, 200.0))[0]
