@@ -24,7 +24,6 @@ import re
 import sys
 from pathlib import Path
 
-import numpy as np
 
 ROOT = Path(__file__).resolve().parents[1]
 RESULTS = ROOT / "benchmarks" / "results"
@@ -407,18 +406,6 @@ def _from_benchmark(name: str):
     return None if fn is None else (lambda: fn(load(name)))
 
 
-def discovery_out_of_model() -> str:
-    o = load("discovery")["out_of_model"]
-    rows = ["| family | files | `model_adequate` false | with a physics effect | reason named first (files) |",
-            "|---|---|---|---|---|"]
-    for fam, f in o["families"].items():
-        why = ", ".join(f"`{k}` {v}" for k, v in sorted(f["reasons"].items(), key=lambda kv: -kv[1])) or "—"
-        rows.append(f"| {fam.replace('_', ' ')} | {f['n']} | {f['inadequate']} | {f['with_effects']} | {why} |")
-    rows.append(f"| **all** | {o['n']} | {o['inadequate']} ({pct(o['inadequate_rate'])}) | {o['with_effects']} | "
-                f"median {o['median_time_s']:.1f} s per file |")
-    return "\n".join(rows)
-
-
 REGIONS = {
     "table2": table2,
     "ablation-run": ablation_run,
@@ -427,7 +414,6 @@ REGIONS = {
     "loop-speedup": loop_speedup,
     "preconditioner": preconditioner,
     "discovery-noise": discovery_noise,
-    "discovery-out-of-model": discovery_out_of_model,
     "distill": distill,
     "tuning": tuning,
     "tuning-summary": tuning_summary,
