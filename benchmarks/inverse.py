@@ -28,7 +28,9 @@ physics model twice per job, back to back: the method before issue 29
 (``calibration="holdout"``: train on 80 % of the pairs, calibrate, train again
 from scratch on all; finite-difference Jacobian) and the new default
 (``calibration="crossfit"``: one training, each validation pair held out from
-one member, whose out-of-fold predictions calibrate the std; shunt Jacobian).
+one member, whose out-of-fold predictions calibrate the std; ``jacobian="mobius"``:
+residuals and the exact Gauss-Newton step from a Möbius map of the shunt
+impedance, no twin call per step, back-propagation by hand).
 Jobs: every seed of ``--seeds`` at 1 torch thread and noise 0 (Table 2 MAE on
 the six blind pairs, MAE on the 246 blind FRFs), the first seed at each of
 ``--thread-counts`` (wall and CPU seconds, ratio new/old in the same run), and

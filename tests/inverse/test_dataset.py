@@ -45,7 +45,7 @@ def test_seeded():
 
 
 def test_feature_order_matches_torch_twin():
-    torch = pytest.importorskip("torch")
+    pytest.importorskip("torch")
     from satmd.physics.torch import features, frf as tfrf
 
     ds = pairs_dataset([(22.0, 0.064)])

@@ -74,3 +74,17 @@ def test_backpropagation_by_hand_matches_autograd():
     (net(x[0]) * g_out).sum().backward()
     for mine, ref in zip(by_hand, net.parameters()):
         torch.testing.assert_close(mine, ref.grad, rtol=1e-5, atol=1e-6)
+
+
+def test_direct_fused_adam_is_torch_adam_bit_for_bit(tiny_data, monkeypatch):
+    from satmd.inverse import InverseModel
+    from satmd.inverse.training import FusedAdam
+
+    kw = dict(epochs=3, warm_start_epochs=1, n_members=2, seed=7, verbose=False, mc_samples=4)
+    test = pairs_dataset(BLIND_PAIRS)
+    direct = InverseModel("physics", **kw).fit(tiny_data)
+    monkeypatch.setattr(FusedAdam, "available", staticmethod(lambda device: False))  # torch.optim.Adam(fused=True)
+    torch_adam = InverseModel("physics", **kw).fit(tiny_data)
+    for a, b in zip(direct.ensemble_.parameters(), torch_adam.ensemble_.parameters()):
+        assert torch.equal(a, b)
+    np.testing.assert_array_equal(direct.predict(test)["R"], torch_adam.predict(test)["R"])
