@@ -355,26 +355,39 @@ def recordings() -> str:
 
     def null_row(label, x):
         cal = x["std_calibration_rms"]
-        floor = (f"{x['floor_within_1_5']}/{x['floor_corrected']} within ×1.5, {x['n'] - x['floor_corrected']} "
-                 f"not corrected")
+        res = " / ".join(f"{cal[k]:.3f}" for k in sorted(cal) if k.startswith("resonance_"))
+        floor = (f"{x['floor_within_1_5']}/{x['floor_corrected']} within ×1.5"
+                 + (f" ({x['floor_ratio_range'][0]:.2f}–{x['floor_ratio_range'][1]:.2f})" if x["floor_ratio_range"] else "")
+                 + f", {x['n'] - x['floor_corrected']} not corrected")
         sig = f" ({x['significant']} significant, noise-like)" if x.get("significant") else ""
-        return (f"| {label} | {x['false_alarms']}/{x['n']}{sig} | {cal['near']:.3f} / {cal['elsewhere']:.3f} | {floor} | "
+        return (f"| {label} | {x['false_alarms']}/{x['n']}{sig} | {res or '—'} | {cal['elsewhere']:.3f} | {floor} | "
                 f"{', '.join(x['measurement_findings']) or '—'} |")
 
-    rows = ["| null recordings | false alarms (physics named) | std calibration: RMS of error/std near resonances / elsewhere "
-            "| force-noise floor | measurement findings |", "|---|---|---|---|---|",
-            null_row("all", nu)]
+    head = ("| {} | false alarms (physics named) | std calibration near each resonance (RMS of error/std, lowest "
+            "first) | elsewhere | force-noise floor (estimate/truth) | measurement findings |")
+    rows = [head.format("null recordings"), "|---|---|---|---|---|---|", null_row("all", nu)]
     for sim, x in r["nulls_by_simulator"].items():
         rows.append(null_row(f"{sim} simulator", x))
-    for sim, fams in r["nulls_by_family"].items():
-        for fam, x in fams.items():
-            if x["n"]:
-                rows.append(null_row(f"&nbsp;&nbsp;{sim}: {fam}", x))
-    rows += ["", "| concealed single effects (counted over the cases the FRF path detects at the same information) "
-             "| result |", "|---|---|", f"| all ({se['n']} recordings) | {found(se)} |"]
+    fams = r["nulls_by_family"]
+    if fams and isinstance(next(iter(fams.values())), dict) and "satmd" not in fams:  # one table per family
+        for fam, conds in fams.items():
+            rows += ["", head.format(f"nulls by {fam}"), "|---|---|---|---|---|---|"]
+            for cond, by_sim in conds.items():
+                for sim, x in by_sim.items():
+                    if x["n"]:
+                        rows.append(null_row(f"{cond}, {sim}", x))
+    def sec(x):
+        return f"{x['median_seconds']:.0f} s" if x.get("median_seconds") is not None else "—"
+
+    def wrong(x):
+        return "; ".join(f"{', '.join(m['reported']) or 'nothing'}" for m in x.get("missed_or_spurious", [])) or "—"
+
+    rows += ["", "| concealed single effects (counted over the cases where the effect is detectable at the same "
+             "information) | result | median seconds per recording | reported instead (missed or spurious) |",
+             "|---|---|---|---|", f"| all ({se['n']} recordings) | {found(se)} | {sec(se)} | |"]
     for sim, effects in r["per_effect"].items():
         for name, x in effects.items():
-            rows.append(f"| &nbsp;&nbsp;{sim}: {name} ({x['n']}) | {found(x)} |")
+            rows.append(f"| {sim}: {name} ({x['n']}) | {found(x)} | {sec(x)} | {wrong(x)} |")
     rows += ["", "| other | result |", "|---|---|",
              "| `identify` 95 % interval coverage on the null recordings | "
              + ", ".join(f"{k} {v:.2f}" for k, v in cov.items()) + " |"]
