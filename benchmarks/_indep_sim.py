@@ -192,9 +192,12 @@ def record(p, seconds, fs, rng, effect=None, force=None, noise=None, oversample=
     x = shaker_force((n + tail) * oversample, fine, rng, **force)
     A, B, Cy, D = state_space(p, mode, Cs)
     a1, a2 = respond(x, fine, A, B, Cy, D)
-    if tau:  # acquisition latency on both accelerometers: delay on the fine grid (linear interpolation)
-        t = np.arange(x.size) / fine
-        a1, a2 = (np.interp(t - tau, t, a, left=0.0) for a in (a1, a2))
+    if tau:  # acquisition latency on both accelerometers: an exact band-limited delay on the fine grid
+        # (linear interpolation, used before, low-passes by a(1-a)(ωh)²/2: 5e-4 at 400 Hz with fs 5 kHz, a gain
+        # error ∝ f² that the stated truth e^{-iωτ} does not have). Zero-padded so nothing wraps into the start.
+        m = x.size + 2 * int(np.ceil(tau * fine)) + 1024
+        w = 2 * np.pi * np.fft.rfftfreq(m, 1.0 / fine)
+        a1, a2 = (np.fft.irfft(np.fft.rfft(a, m) * np.exp(-1j * w * tau), m)[:x.size] for a in (a1, a2))
     a1, a2 = gains[0] * a1, gains[1] * a2
     # the DAQ: the same zero-phase anti-aliasing low-pass (0.45 fs) on every channel, then decimation
     aa = sg.butter(10, 0.45 * fs, fs=fine, output="sos")

@@ -336,7 +336,12 @@ def main():
     ap.add_argument("--out", default=str(ROOT / "benchmarks" / "results" / "recordings.json"))
     ap.add_argument("--part", choices=("all", "nulls", "effects"), default="all", help="run only these cases")
     ap.add_argument("--seed-offset", type=int, default=0, help="first seed (parts run apart do not overlap)")
-    ap.add_argument("--merge", nargs="+", metavar="PART", help="merge part files (their cases) into --out")
+    ap.add_argument("--merge", nargs="+", metavar="PART",
+                    help="merge part files (their cases) into --out; a case of a later part replaces the same case "
+                         "(simulator, seed, truth) of an earlier one (a rerun after a fix)")
+    ap.add_argument("--effects", nargs="+", metavar="NAME", help="run only these effects")
+    ap.add_argument("--sims", nargs="+", choices=("satmd", "independent"), default=["satmd", "independent"],
+                    help="run only these simulators' effect cases")
     a = ap.parse_args()
     if a.quick:
         a.nulls, a.per_effect = 10, 1
@@ -352,8 +357,14 @@ def main():
         return
     if a.merge:  # the statistics over parts run separately (each with its own --seed-offset)
         parts = [json.loads(Path(f).read_text()) for f in a.merge]
-        nulls = [r for p in parts for r in p["cases"]["nulls"]]
-        cases = [r for p in parts for r in p["cases"]["effects"]]
+        def latest(kind):
+            out = {}
+            for p in parts:
+                for r in p["cases"][kind]:
+                    out[(r["sim"], r["seed"], tuple(r.get("truth", ())))] = r
+            return list(out.values())
+
+        nulls, cases = latest("nulls"), latest("effects")
         timing = next((p["timing_120s_2kHz"] for p in parts if p["timing_120s_2kHz"]["null"]["median_s"]),
                       {"null": {"median_s": None}, "hidden_effect": {"median_s": None}})
         summarise(nulls, cases, timing, a, sum(p["benchmark_seconds"] for p in parts), parts=list(a.merge))
@@ -369,6 +380,7 @@ def main():
             jobs = [("satmd", name, 100 * k + k0 + i) for k, name in enumerate(EFFECTS) for i in range(a.per_effect)]
             jobs += [("independent", name, 100 * k + k0 + i) for k, name in enumerate(INDEP_EFFECTS)
                      for i in range(a.per_effect)]
+            jobs = [j for j in jobs if j[0] in a.sims and (not a.effects or j[1] in a.effects)]
             cases = _progress(pool.map(run_effect, jobs), "effects")
     timing = seconds_per_recording() if not a.quick and a.per_effect and a.part == "all" else \
         {"null": {"median_s": None}, "hidden_effect": {"median_s": None}}
