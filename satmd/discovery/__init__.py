@@ -32,7 +32,7 @@ from .._fleet import fleet_map
 from ..identification import identify
 from ..io.frfdata import FRFData, require_data
 from ..physics import Rig
-from .adequacy import after_search, assess_fit, inadequate_report, withdraw_if_inadequate
+from .adequacy import after_search, assess_fit, drop_stretched, inadequate_report, withdraw_if_inadequate
 from .candidates import default_candidates
 from .discrepancy import fit_discrepancy
 from .findings import UNEXPLAINED, EffectFinding, UnexplainedFinding
@@ -184,6 +184,8 @@ def _discover_frf(data: FRFData, rig, free, candidates, channels, alpha, max_eff
         return test_mismatch(fit, alpha, noise_dof).significant
 
     final = select_effects(search, nominal, significant, max_effects)
+    # a good, plausible nominal fit: a candidate the search stretches is left out, not held against the model
+    search, final, _ = drop_stretched(search, nominal, final, rig)
     effects = []
     if final.names:
         equiv = equivalents(search, final, nominal)

@@ -15,6 +15,16 @@ Decided before any effect is named, in two steps:
    ≥ ``STRUCTURE_REL_ERROR`` with most of it smooth) mean that the vocabulary
    does not describe these data: the effects are withdrawn and the verdict
    says why.
+
+Between the two, `drop_stretched`: when the nominal fit already describes the
+data with plausible values (relative error below ``STRUCTURE_REL_ERROR``, no
+parameter implausible), a candidate that the search stretches (an effect at the
+edge of its range, or one that drives the free parameters to absurd values)
+says nothing against the model: such a candidate only trades a small misfit
+for absurd values. It is dropped (not named, not held against the model) and
+the effects that remain acceptable are kept. A
+nominal fit that is poor or implausible gets no such benefit: step 2 judges
+its best augmented fit as it stands.
 """
 from __future__ import annotations
 
@@ -27,7 +37,7 @@ from ..identification.adequacy import assess_fit as assess_one
 from ..identification.statistics import POOR_REL_ERROR
 
 __all__ = ["Adequacy", "Reason", "assess_fit", "after_search", "effects_at_edge", "inadequate_report",
-           "withdraw_if_inadequate", "STRUCTURE_REL_ERROR"]
+           "withdraw_if_inadequate", "trusted", "stretched", "drop_stretched", "STRUCTURE_REL_ERROR"]
 
 STRUCTURE_REL_ERROR = 0.15  # misfit left by the best vocabulary model beyond which it is another structure
 EDGE = 0.005  # share of a search range (log width for ranges over a decade) that counts as its edge
@@ -110,6 +120,87 @@ def after_search(fit, effects, rig, discrepancy=None) -> list:
                                             "smooth: another structure, not a missing effect",
                           {"rel_error": rel, "structured_fraction": float(discrepancy.structured_fraction)}))
     return out
+
+
+def trusted(fit) -> bool:
+    """True when ``fit`` describes the data with plausible values: relative FRF error below
+    ``STRUCTURE_REL_ERROR`` (finite) and no parameter implausible (`implausible_values`)."""
+    rel = float(fit.rel_error)
+    return math.isfinite(rel) and rel < STRUCTURE_REL_ERROR and not implausible_values(fit)
+
+
+def stretched(model, rig) -> list:
+    """The evidence that ``model`` (a `select.Model`) is stretched: its effects at the edge of their own search
+    ranges, and an ``implausible`` reason when its free parameters sit at absurd values (empty when neither)."""
+    out = effects_at_edge(model.effects, rig)
+    absurd = implausible_values(model.fit)
+    if absurd:
+        out.append(Reason("implausible", "the augmented fit needs " + "; ".join(absurd.values()),
+                          {"parameters": {n: float(model.fit.values[n]) for n in sorted(absurd)}}))
+    return out
+
+
+def _blame(search, model, nominal, rig, reasons) -> list:
+    """The effects of ``model`` that stretch it: those at the edge of their range; for absurd free parameters,
+    the one whose removal gives a plausible fit at the lowest BIC, or all of them when no single removal does."""
+    edge = [r.evidence["effect"] for r in reasons if r.kind == "effect_at_bound"]
+    if edge:
+        return list(dict.fromkeys(n for n in model.names if n in edge))
+    without = {n: search.remove(model, n, nominal) for n in model.names}
+    fine = [n for n, m in without.items() if not implausible_values(m.fit) and not effects_at_edge(m.effects, rig)]
+    if fine:
+        return [min(fine, key=lambda n: without[n].bic)]
+    return list(model.names)
+
+
+def drop_stretched(search, nominal, final, rig) -> tuple:
+    """Drop the effects the search stretched, when the nominal fit is `trusted` (module docstring).
+
+    Each stretched effect (`_blame`) leaves the model, which is refitted without it; an effect left that no
+    longer earns its place (removing it costs at most ``MIN_DELTA_BIC``) leaves too. No new effect is added:
+    the candidates the selection passed over stay passed over (a chain of stretched stand-ins for one
+    missing thing is no licence to name the next one). What is still unexplained afterwards is the
+    mismatch test's business (an ``unexplained`` finding, or a noise note).
+
+    Parameters
+    ----------
+    search : `select.Search` of the discovery.
+    nominal : `select.Model` of the nominal fit.
+    final : `select.Model` the selection ended at.
+    rig : the rig of fixed values (for the effects' search ranges).
+
+    Returns
+    -------
+    (search, final, dropped)
+        The search without the dropped candidates (for the equivalents), the model that remains
+        (``final`` itself when nothing was dropped) and, per dropped effect, the evidence against it
+        ({name: [Reason, ...]}).
+    """
+    from dataclasses import replace
+
+    from .select import MIN_DELTA_BIC
+
+    dropped: dict = {}
+    if not final.names or not trusted(nominal.fit):
+        return search, final, dropped
+    while final.names:
+        reasons = stretched(final, rig)
+        if not reasons:
+            break
+        for n in _blame(search, final, nominal, rig, reasons):
+            dropped[n] = [r for r in reasons if r.kind != "effect_at_bound" or r.evidence.get("effect") == n]
+            final = search.remove(final, n, nominal)
+        changed = True
+        while changed and final.names:  # what is left must still earn its place
+            changed = False
+            for n in final.names:
+                without = search.remove(final, n, nominal)
+                if without.bic - final.bic <= MIN_DELTA_BIC:
+                    final, changed = without, True
+                    break
+    if dropped:  # the equivalents are sought among the candidates that were not stretched
+        search = replace(search, candidates=tuple(c for c in search.candidates if c not in dropped))
+    return search, final, dropped
 
 
 def inadequate_report(verdict, fit, alpha: float, t0: float):

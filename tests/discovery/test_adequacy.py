@@ -8,7 +8,8 @@ import pytest
 from satmd import Rig, effect, simulate
 from satmd.cli import main
 from satmd.discovery import discover
-from satmd.discovery.adequacy import Adequacy, Reason, after_search, effects_at_edge
+from satmd.discovery.adequacy import (Adequacy, Reason, after_search, drop_stretched, effects_at_edge,
+                                     implausible_values, trusted)
 from satmd.errors import DataError
 from satmd.identification import identify
 from satmd.io import FRFData, load_frf, save_frf
@@ -178,3 +179,75 @@ def test_tune_refuses_an_inadequate_model_unless_forced(tmp_path, capsys):
     assert len(errors) == 1 and "noise-like" in errors[0]  # one line (identify's own warnings may precede it)
     assert main(["tune", str(path), "--no-discover", "--json", "--force"]) == 0
     assert json.loads(capsys.readouterr().out)["design"]
+
+
+def _spy_drops(monkeypatch):
+    """Record what `drop_stretched` drops inside `discover` (the discovery calls it by this module name)."""
+    import satmd.discovery as discovery
+
+    seen = []
+    real = discovery.drop_stretched
+
+    def spy(search, nominal, final, rig):
+        out = real(search, nominal, final, rig)
+        seen.append({"trusted": trusted(nominal.fit), "selected": final.names, "kept": out[1].names,
+                     "dropped": out[2]})
+        return out
+
+    monkeypatch.setattr(discovery, "drop_stretched", spy)
+    return seen
+
+
+def test_a_candidate_stretched_on_a_good_nominal_fit_is_dropped_not_held_against_the_model(monkeypatch):
+    """An in-model rig whose piezo barely couples (e 20x low) with structural damping: the nominal fit is good
+    and plausible; structural damping alone fits better only with the shunt opened to absurd values (R at its
+    1e5 bound, L ~70 H). That candidate is dropped (not named), and the SATMD model stays adequate."""
+    f = np.linspace(40, 130, 200)
+    d = simulate(f, Rig(m2=0.4, kp=1.2e5, R=88.0, L=0.33), effects=[effect("parameter_offset:e", value=0.0325),
+                 effect("structural_damping", eta=0.025)], noise=(0.01, 0.002), seed=3)
+    seen = _spy_drops(monkeypatch)
+    rep = discover(d, candidates=["structural_damping", "sensor_gain", "time_delay"])
+    assert trusted(rep.nominal_fit) and rep.nominal_fit.rel_error < 0.05
+    assert len(seen) == 1 and "structural_damping" in seen[0]["selected"]  # the search did stretch it ...
+    assert [r.kind for r in seen[0]["dropped"]["structural_damping"]] == ["implausible"]
+    assert rep.model_adequate and rep.adequacy_reasons == []  # ... and it is not held against the model
+    assert "structural_damping" not in rep.effect_names
+    assert implausible_values(rep.final_fit) == {}  # what is reported is plausible
+
+
+def test_drop_stretched_needs_a_trusted_nominal_fit():
+    """With a good, plausible nominal fit an effect at the edge of its range leaves the model (and the
+    candidates); with an implausible nominal fit nothing is dropped (the verdict after the search stands)."""
+    from types import SimpleNamespace
+
+    from satmd.discovery.select import Model, Search
+
+    d = _rig_data(11)
+    fit = identify(d, warn=False)
+    nominal = Model((), [], fit)
+    search = Search(d, Rig(), ("m2", "kp", "R", "L"), ("a1", "a2"), ("sensor_gain", "time_delay"))
+    edge = Model(("sensor_gain",), [effect("sensor_gain", gain_a1=0.5, gain_a2=1.0)], fit)
+    s2, kept, dropped = drop_stretched(search, nominal, edge, Rig())
+    assert kept is nominal and list(dropped) == ["sensor_gain"] and s2.candidates == ("time_delay",)
+    assert dropped["sensor_gain"][0].kind == "effect_at_bound"
+    fine = Model(("sensor_gain",), [effect("sensor_gain", gain_a1=1.05, gain_a2=1.0)], fit)
+    assert drop_stretched(search, nominal, fine, Rig()) == (search, fine, {})
+    absurd = Model((), [], SimpleNamespace(rel_error=0.02, values={**fit.values, "L": 1e-5}, pinned=("L",)))
+    assert not trusted(absurd.fit)
+    assert drop_stretched(search, absurd, edge, Rig()) == (search, edge, {})
+    poor = Model((), [], SimpleNamespace(rel_error=0.3, values=dict(fit.values), pinned=()))
+    assert drop_stretched(search, poor, edge, Rig()) == (search, edge, {})
+
+
+def test_another_structure_that_reaches_the_search_stays_inadequate(monkeypatch):
+    """The rig on a host with a second heavy mode (mass ratio 0.6, beyond the vocabulary's 0.3): the nominal
+    fit reproduces 60 % of the data, so the search runs; its stretched effects are not dropped and the
+    verdict stays 'not adequate', with no physics named."""
+    d = simulate(np.linspace(40, 130, 120), Rig(m2=0.55, kp=1.05e5, R=30.0, L=0.1),
+                 effects=[effect("extra_mode", f_hz=100.0, zeta=0.02, mass_ratio=0.6)], noise=(0.01, 0.002), seed=4)
+    seen = _spy_drops(monkeypatch)
+    rep = discover(d, candidates=["extra_mode", "sensor_gain", "structural_damping"])
+    assert 0.15 <= rep.nominal_fit.rel_error < 0.5 and not trusted(rep.nominal_fit)
+    assert len(seen) == 1 and seen[0]["dropped"] == {} and seen[0]["kept"] == seen[0]["selected"]
+    assert not rep.model_adequate and rep.effects == []
+    assert set(_kinds(rep)) & {"structure_left", "effect_at_bound", "implausible"}
