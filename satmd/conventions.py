@@ -19,5 +19,9 @@ RECORDING_CHANNELS = {"acc1": "a1", "acc2": "a2"}
 #: SPEC §9: where the true values of the default free parameters may lie.
 SPEC_RANGES = {"m2": (0.3, 0.8), "kp": (5e4, 2e5), "R": (5.0, 100.0), "L": (0.02, 0.5)}
 
+#: BIC an effect or hypothesis must gain to be named; models closer than this are equivalent explanations
+#: ("very strong" evidence on Kass & Raftery's scale), in linear and nonlinear discovery alike.
+MIN_DELTA_BIC = 10.0
+
 #: A positive floor for divisions and logarithms (far below any physical quantity, above 0).
 TINY = 1e-300

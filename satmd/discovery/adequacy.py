@@ -178,7 +178,7 @@ def drop_stretched(search, nominal, final, rig) -> tuple:
     """
     from dataclasses import replace
 
-    from .select import MIN_DELTA_BIC
+    from ..conventions import MIN_DELTA_BIC
 
     dropped: dict = {}
     if not final.names or not trusted(nominal.fit):

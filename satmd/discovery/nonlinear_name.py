@@ -7,14 +7,14 @@ inductor lowers L. With recordings at several levels, every hypothesis "only p
 moves" (p in kp, k1, cp, L) is a joint fit of all recordings with the free
 parameters shared and p free per recording (`joint_fit`); the hypothesis with
 the lowest BIC names the parameter, the sign of its change with level the
-element; hypotheses within ΔBIC < 10 are reported as equivalents (the data
+element; hypotheses within ``MIN_DELTA_BIC`` of BIC are reported as equivalents (the data
 cannot tell them apart). Then the element's own equivalent linearisation at
 each level's signal RMS (`satmd.physics.nonlinear.response_rms`) is inverted for
 its strength with a 95 % interval (`fit_strength`).
 """
 from __future__ import annotations
 
-from ..conventions import TINY
+from ..conventions import MIN_DELTA_BIC, TINY
 
 from dataclasses import dataclass, field
 
@@ -24,7 +24,6 @@ from ..physics import frf
 from ..physics.nonlinear import NONLINEAR, response_rms
 
 MOVING = ("kp", "k1", "cp", "L")
-MIN_DELTA_BIC = 10.0
 
 
 @dataclass(frozen=True)
@@ -135,7 +134,7 @@ def compare_hypotheses(datas, rig, free, channels, start: dict, levels) -> dict:
     -------
     dict
         ``fits`` {hypothesis: JointFit} ("none" for all shared), ``best`` (a
-        name of `MOVING`), ``equivalent`` (others within ΔBIC < 10),
+        name of `MOVING`), ``equivalent`` (others within ``MIN_DELTA_BIC``),
         ``direction`` ("up"/"down" with level), ``z`` (change high − low over
         its std), ``order`` (recordings sorted by level).
     """

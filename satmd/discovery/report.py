@@ -6,7 +6,7 @@ from dataclasses import dataclass, field
 from typing import TYPE_CHECKING
 
 from .findings import UNEXPLAINED
-from .select import MIN_DELTA_BIC
+from ..conventions import MIN_DELTA_BIC
 
 if TYPE_CHECKING:
     from ..identification.adequacy import Adequacy

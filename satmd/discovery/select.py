@@ -17,6 +17,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from ..conventions import MIN_DELTA_BIC
 from ..numerics import distinct_best
 from ..identification import identify
 from ..identification.problem import Problem
@@ -29,7 +30,6 @@ if TYPE_CHECKING:
     from ..io.frfdata import FRFData
     from ..physics import Rig
 
-MIN_DELTA_BIC = 10.0
 
 
 @dataclass

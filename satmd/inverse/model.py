@@ -357,13 +357,9 @@ class InverseModel:
 
     def save(self, path) -> Path:
         """Write ``path/model.json`` (metadata) and ``path/weights.pt`` (state_dict), together; no pickle."""
-        from .persistence import write_folder
+        from .persistence import ensemble_state, write_folder
 
-        meta = self.to_dict()
-        state = None
-        if getattr(self, "ensemble_", None) is not None:
-            state = {k: v.detach().cpu().contiguous() for k, v in self.ensemble_.state_dict().items()}
-        return write_folder(path, meta, state)
+        return write_folder(path, self.to_dict(), ensemble_state(self))
 
     @classmethod
     def load(cls, path) -> "InverseModel":

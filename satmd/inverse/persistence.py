@@ -201,6 +201,14 @@ def _ensemble(net: dict, state: dict, n_freq: int):
     return ensemble
 
 
+def ensemble_state(model) -> dict | None:
+    """The ensemble's weights as CPU tensors (the ``state_dict`` `write_folder` saves), or None (no nets)."""
+    ensemble = getattr(model, "ensemble_", None)
+    if ensemble is None:
+        return None
+    return {k: v.detach().cpu().contiguous() for k, v in ensemble.state_dict().items()}
+
+
 def write_folder(path, meta: dict, state: dict | None) -> Path:
     """Write ``model.json`` and ``weights.pt`` (when ``state``) into ``path``, both or neither."""
     from ..io.atomic import all_or_none, atomic_write

@@ -40,7 +40,7 @@ def _inadequate_rows(grid) -> list:
 def build(ctx) -> str:
     from ..discovery import discover
     from ..discovery.scenarios import concealed_case
-    from ..discovery.select import MIN_DELTA_BIC
+    from ..conventions import MIN_DELTA_BIC
     from ..physics import Rig, effect
     from ..simulation import simulate
 
