@@ -368,6 +368,11 @@ def recordings() -> str:
     rows = [head.format("null recordings"), "|---|---|---|---|---|---|", null_row("all", nu)]
     for sim, x in r["nulls_by_simulator"].items():
         rows.append(null_row(f"{sim} simulator", x))
+    for sim, x in r.get("nulls_three_resonances", {}).items():
+        cal, pts = x["std_calibration_rms"], x["points"]
+        res = " / ".join(f"{cal[k]:.3f} ({pts[k]} points)" for k in sorted(cal) if k.startswith("resonance_"))
+        rows.append(f"| rigs with three resonances in band, {sim} simulator ({x['n']}, calibration only) | — | {res} "
+                    f"| {cal['elsewhere']:.3f} | — | — |")
     fams = r["nulls_by_family"]
     if fams and isinstance(next(iter(fams.values())), dict) and "satmd" not in fams:  # one table per family
         for fam, conds in fams.items():

@@ -192,6 +192,45 @@ def calibration(data, truth):
     return out
 
 
+def resonance_groups(rig, band):
+    """The resonances `calibration` would see in ``band`` (|a1|, |a2| peaks above a fifth of the largest,
+    merged within 5 %), on a fine grid of the true FRF: [Hz, ...]."""
+    from satmd.physics import frf
+
+    f = np.linspace(band[0], band[1], 4000)
+    r = frf(f, rig, [], outputs=("a1", "a2"))
+    peaks = []
+    for m in (np.abs(r.a1), np.abs(r.a2)):
+        peaks += [f[i] for i in range(1, m.size - 1) if m[i] >= m[i - 1] and m[i] >= m[i + 1] and m[i] > 0.2 * m.max()]
+    groups: list = []
+    for p in sorted(peaks):
+        if groups and p <= 1.05 * groups[-1][-1]:
+            groups[-1].append(p)
+        else:
+            groups.append([p])
+    return [float(np.mean(g)) for g in groups]
+
+
+def run_resonant(job):
+    """A null recording of a rig with three resonances in its band (the seed is skipped otherwise: None):
+    the LPM estimate's std calibration only (a few % of random rigs have a third resonance in band, too few
+    points in the null population to tell a bias near it from scatter)."""
+    from satmd.discovery.scenarios import random_rig
+    from satmd.io import estimate_frf
+
+    sim, seed = job
+    rng = np.random.default_rng(1000 + seed)
+    rig = random_rig(rng)
+    band = draw_settings(rng)[2]["band"]
+    if len(resonance_groups(rig, band)) < 3:
+        return None
+    rng = np.random.default_rng(1000 + seed)  # the same draws again, as run_null makes them
+    rig = random_rig(rng)
+    rec, truth, _, cond = make_recording(sim, rng, rig, [], seed)
+    return {"sim": sim, "seed": seed, **cond, "resonances_hz": resonance_groups(rig, cond["band_hz"]),
+            "calibration": calibration(estimate_frf(rec), truth)}
+
+
 def run_null(job):
     from satmd import discover
     from satmd.discovery.scenarios import random_rig
@@ -334,7 +373,9 @@ def main():
     ap.add_argument("--timing-only", action="store_true",
                     help="rerun only the seconds-per-recording figures into an existing --out file")
     ap.add_argument("--out", default=str(ROOT / "benchmarks" / "results" / "recordings.json"))
-    ap.add_argument("--part", choices=("all", "nulls", "effects"), default="all", help="run only these cases")
+    ap.add_argument("--part", choices=("all", "nulls", "effects", "resonant"), default="all", help="run only these cases")
+    ap.add_argument("--resonant", type=int, default=150,
+                    help="null recordings per simulator of rigs with three resonances in band (calibration only)")
     ap.add_argument("--seed-offset", type=int, default=0, help="first seed (parts run apart do not overlap)")
     ap.add_argument("--merge", nargs="+", metavar="PART",
                     help="merge part files (their cases) into --out; a case of a later part replaces the same case "
@@ -344,7 +385,7 @@ def main():
                     help="run only these simulators' effect cases")
     a = ap.parse_args()
     if a.quick:
-        a.nulls, a.per_effect = 10, 1
+        a.nulls, a.per_effect, a.resonant = 10, 1, 4
     if a.timing_only:  # rerun only the timings (on a quiet machine) into an existing result file
         result = json.loads(Path(a.out).read_text())
         timing = seconds_per_recording()
@@ -360,20 +401,30 @@ def main():
         def latest(kind):
             out = {}
             for p in parts:
-                for r in p["cases"][kind]:
+                for r in p["cases"].get(kind, []):
                     out[(r["sim"], r["seed"], tuple(r.get("truth", ())))] = r
             return list(out.values())
 
-        nulls, cases = latest("nulls"), latest("effects")
+        nulls, cases, resonant = latest("nulls"), latest("effects"), latest("resonant")
         timing = next((p["timing_120s_2kHz"] for p in parts if p["timing_120s_2kHz"]["null"]["median_s"]),
                       {"null": {"median_s": None}, "hidden_effect": {"median_s": None}})
-        summarise(nulls, cases, timing, a, sum(p["benchmark_seconds"] for p in parts), parts=list(a.merge))
+        summarise(nulls, cases, timing, a, sum(p["benchmark_seconds"] for p in parts), parts=list(a.merge),
+                  resonant=resonant)
         return
     t_start = time.perf_counter()
     sims = ("satmd", "independent")
     k0 = a.seed_offset
-    nulls, cases = [], []
+    nulls, cases, resonant = [], [], []
     with ProcessPoolExecutor(a.workers) as pool:
+        if a.part in ("all", "resonant"):  # seeds drawn until each simulator has --resonant such rigs
+            for sim in sims:
+                got, seed = [], k0 + 100_000
+                while len(got) < a.resonant:
+                    batch = [(sim, seed + i) for i in range(400)]
+                    got += [r for r in pool.map(run_resonant, batch) if r is not None]
+                    seed += 400
+                resonant += got[:a.resonant]
+            print(f"resonant nulls: {len(resonant)}", flush=True)
         if a.part in ("all", "nulls"):
             nulls = _progress(pool.map(run_null, [(sim, k0 + i) for i in range(a.nulls) for sim in sims]), "nulls")
         if a.part in ("all", "effects"):
@@ -384,10 +435,10 @@ def main():
             cases = _progress(pool.map(run_effect, jobs), "effects")
     timing = seconds_per_recording() if not a.quick and a.per_effect and a.part == "all" else \
         {"null": {"median_s": None}, "hidden_effect": {"median_s": None}}
-    summarise(nulls, cases, timing, a, time.perf_counter() - t_start)
+    summarise(nulls, cases, timing, a, time.perf_counter() - t_start, resonant=resonant)
 
 
-def summarise(nulls, cases, timing, a, seconds, parts=None):
+def summarise(nulls, cases, timing, a, seconds, parts=None, resonant=()):
     """Statistics over the cases, written to ``a.out``, and the line of figures."""
     t_start = time.perf_counter() - seconds
     sims = ("satmd", "independent")
@@ -405,10 +456,7 @@ def summarise(nulls, cases, timing, a, seconds, parts=None):
                                        if not r["found"] or r["spurious"]]}
 
     def null_stats(rows):
-        keys = sorted({"near", "elsewhere"} | {k for r in rows for k in r["calibration"]},
-                      key=lambda k: (k != "near", k != "elsewhere", k))
-        cal = {k: float(np.sqrt(sum(r["calibration"].get(k, [0, 0])[0] for r in rows)
-                                / max(sum(r["calibration"].get(k, [0, 0])[1] for r in rows), 1))) for k in keys}
+        cal = calibration_rms(rows)
         ratios = [r["floor_ratio"] for r in rows if r["floor_ratio"] is not None]
         return {"n": len(rows), "false_alarms": sum(r["alarm"] for r in rows),
                 "significant": sum(r.get("significant", r["alarm"]) for r in rows),
@@ -420,6 +468,19 @@ def summarise(nulls, cases, timing, a, seconds, parts=None):
                 "floor_within_1_5": int(sum(bool(1 / 1.5 <= x <= 1.5) for x in ratios)),
                 "floor_ratio_range": [float(min(ratios)), float(max(ratios))] if ratios else None}
 
+    def calibration_rms(rows, counts=False):
+        keys = sorted({"near", "elsewhere"} | {k for r in rows for k in r["calibration"]},
+                      key=lambda k: (k != "near", k != "elsewhere", k))
+        n = {k: sum(r["calibration"].get(k, [0, 0])[1] for r in rows) for k in keys}
+        rms = {k: float(np.sqrt(sum(r["calibration"].get(k, [0, 0])[0] for r in rows) / max(n[k], 1))) for k in keys}
+        return (rms, n) if counts else rms
+
+    resonant_stats = {}
+    for sim in sims:
+        rows = [r for r in resonant if r["sim"] == sim]
+        if rows:
+            rms, n = calibration_rms(rows, counts=True)
+            resonant_stats[sim] = {"n": len(rows), "std_calibration_rms": rms, "points": n}
     per_family = {fam: {cond: {sim: null_stats([r for r in nulls if r["sim"] == sim and pick(r)]) for sim in sims}
                         for cond, pick in conds.items()} for fam, conds in FAMILIES.items()}
     coverage = {p: float(np.mean([n["cover"][p] for n in nulls])) for p in PARAMS}
@@ -431,6 +492,7 @@ def summarise(nulls, cases, timing, a, seconds, parts=None):
         "nulls": null_stats(nulls),
         "nulls_by_simulator": {sim: null_stats([r for r in nulls if r["sim"] == sim]) for sim in sims},
         "nulls_by_family": per_family,
+        "nulls_three_resonances": resonant_stats,
         "identify_coverage_95": coverage,
         "single_effects": rates(cases),
         "single_effects_by_simulator": {sim: rates([c for c in cases if c["sim"] == sim]) for sim in sims},
@@ -440,7 +502,7 @@ def summarise(nulls, cases, timing, a, seconds, parts=None):
         "timing_120s_2kHz": timing,
         "benchmark_seconds": time.perf_counter() - t_start,
         "parts": parts,
-        "cases": {"nulls": nulls, "effects": cases},
+        "cases": {"nulls": nulls, "effects": cases, "resonant": list(resonant)},
     }
     Path(a.out).parent.mkdir(parents=True, exist_ok=True)
     Path(a.out).write_text(json.dumps(result, indent=1, default=float))

@@ -33,6 +33,7 @@ from ..identification import identify
 from ..io.frfdata import FRFData, require_data
 from ..physics import Rig
 from .adequacy import after_search, assess_fit, drop_stretched, inadequate_report, withdraw_if_inadequate
+from .budget import bias_note, bias_share
 from .candidates import default_candidates
 from .discrepancy import fit_discrepancy
 from .findings import UNEXPLAINED, EffectFinding, UnexplainedFinding
@@ -185,8 +186,8 @@ def _discover_frf(data: FRFData, rig, free, candidates, channels, alpha, max_eff
 
     final = select_effects(search, nominal, significant, max_effects)
     # a good, plausible nominal fit: a candidate the search stretches is left out, not held against the model
-    search, final, _ = drop_stretched(search, nominal, final, rig)
-    effects = []
+    search, final, set_aside = drop_stretched(search, nominal, final, rig)
+    effects, bias_notes = [], []
     if final.names:
         equiv = equivalents(search, final, nominal)
         without = {n: search.remove(final, n, nominal) for n in final.names}
@@ -196,6 +197,10 @@ def _discover_frf(data: FRFData, rig, free, candidates, channels, alpha, max_eff
             # what accounting for this effect does to the free parameters (vs the model without it)
             ref = without[name].fit.values
             shifts = {k: final.fit.values[k] / ref[k] - 1 for k in free if ref[k]}
+            share = bias_share(final.fit, without[name].fit, data.bias_bound)
+            if share <= 1.0:  # the estimator's own bias could make it: kept in the fit, not named (budget.py)
+                bias_notes.append(bias_note(name, describe_effect(eff, rig, shifts), share, data.bias_bound))
+                continue
             effects.append(EffectFinding(name=name, parameters={k: float(v) for k, v in eff.params.items()
                                                                 if search.measured(k)},
                                          equivalent=equiv[name], delta_bic=round(float(dbic[name]), 2),
@@ -224,7 +229,7 @@ def _discover_frf(data: FRFData, rig, free, candidates, channels, alpha, max_eff
                            parameters={k: final.fit.values[k] for k in free}, fit_before=before, fit_after=after,
                            nominal_fit=nominal_fit, final_fit=final.fit, discrepancy=disc, p_values=p_values,
                            whiteness=test0.whiteness, wall_time=time.perf_counter() - t0,
-                           measurement=noise_notes)
+                           measurement=bias_notes + noise_notes, set_aside=set_aside)
     return withdraw_if_inadequate(report, after_search(final.fit, final.effects, rig, disc))
 
 

@@ -305,9 +305,7 @@ def _take(d, freqs):
     meta = dict(d.meta)
     if isinstance(meta.get("model_error"), dict):
         meta["model_error"] = {c: v[j] for c, v in meta["model_error"].items()}
-    return replace(d, freq_hz=d.freq_hz[j], meta=meta, channels={c: v[j] for c, v in d.channels.items()},
-                   std={c: v[j] for c, v in d.std.items()}, coherence={c: v[j] for c, v in d.coherence.items()},
-                   correlation={k: v[j] for k, v in d.correlation.items()})
+    return replace(d.take(j), meta=meta)
 
 
 def concentrated_bands(test: NonlinearTest, share: float = 0.25, smooth: int = 7) -> list:

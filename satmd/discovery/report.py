@@ -36,6 +36,7 @@ class DiscoveryReport:
     measurement: list = field(default_factory=list)  # dicts: name, explanation, remedy, corrected
     nonlinear: NonlinearReport | None = None  # (SPEC §9 ``nonlinear`` block), when time data or levels were given
     adequacy: Adequacy | None = None  # (SPEC §9 ``model_adequate``); None: adequate (nothing spoke against it)
+    set_aside: dict = field(default_factory=dict)  # {effect: [Reason]}: candidates the search stretched, left out
 
     @property
     def model_adequate(self) -> bool:
@@ -63,7 +64,9 @@ class DiscoveryReport:
             "parameters": dict(self.parameters),
             "fit_before": dict(self.fit_before),
             "fit_after": dict(self.fit_after),
-        } | chain | ({"nonlinear": self.nonlinear.to_dict()} if self.nonlinear is not None else {})
+        } | chain | ({"nonlinear": self.nonlinear.to_dict()} if self.nonlinear is not None else {}) | (
+            {"set_aside": [{"name": n, "reasons": [r.to_dict() for r in rs]} for n, rs in self.set_aside.items()]}
+            if self.set_aside else {})
 
     def to_json(self, **kw) -> str:
         return json.dumps(self.to_dict(), **kw)
@@ -107,6 +110,10 @@ class DiscoveryReport:
             if e.equivalent:
                 lines.append(f"     equally good explanations (|ΔBIC| < {MIN_DELTA_BIC:g}): {', '.join(e.equivalent)} "
                              "— these FRFs cannot tell them apart")
+        for name, reasons in self.set_aside.items():
+            why = "; ".join(r.message for r in reasons) or "stretched past a plausible magnitude"
+            lines.append(f"    set aside: {name} improved the fit only when stretched ({why}); the nominal fit is "
+                         "good and plausible, so it is not named")
         lines.append(f"    after: χ²_red = {self.fit_after['chi2_reduced']:.3g}, "
                      f"relative error {self.fit_after['rel_error']:.3g}")
         lines.append("    fitted free parameters: " + ", ".join(f"{k} = {v:.6g}" for k, v in self.parameters.items()))

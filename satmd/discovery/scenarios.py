@@ -121,18 +121,31 @@ def _without(data, effects, i):
     return identify(data, effects=[e for j, e in enumerate(effects) if j != i], warn=False)
 
 
+REACH = 0.8  # share of the way from neutral to the edge of the search range a scaled effect may go
+
+
 def scaled(eff, factor: float):
-    """The effect with its departure from neutral multiplied by ``factor``."""
+    """The effect with its departure from neutral multiplied by ``factor``, kept within `REACH` of the way to
+    the edge of the effect's own search range (a magnitude discovery could not find is no test of it);
+    a drawn value already further out stays where it is."""
     p = dict(eff.params)
     if eff.name == "sensor_gain":
         p = {k: 1 + factor * (v - 1) for k, v in p.items()}
     elif eff.name == "extra_mode":
-        p["mass_ratio"] = min(p["mass_ratio"] * factor, 0.2)
+        p["mass_ratio"] = p["mass_ratio"] * factor
     elif eff.name.startswith("parameter_offset:"):
         nominal = float(getattr(Rig(), eff.parameter))
-        p["value"] = max(nominal * (1 + factor * (p["value"] / nominal - 1)), 0.05 * nominal)
+        p["value"] = nominal * (1 + factor * (p["value"] / nominal - 1))
     else:
         p = {k: v * factor for k, v in p.items()}
+    bounds = eff.bounds(Rig())
+    for spec in eff.parameter_specs:
+        neutral = float(getattr(Rig(), eff.parameter)) if eff.name.startswith("parameter_offset:") else spec.neutral
+        if neutral is None or spec.name not in p:
+            continue
+        lo, hi = (neutral + REACH * (b - neutral) for b in bounds[spec.name])
+        old = float(eff.params[spec.name])
+        p[spec.name] = float(np.clip(p[spec.name], min(lo, old), max(hi, old)))
     return eff.replace(**p)
 
 

@@ -135,7 +135,7 @@ def _estimate_lpm(recording: Recording, band, width_hz) -> FRFData:
             "noise": "local-polynomial residual, noise spectra smoothed over "
                      f"{s['smooth_windows']} windows"}
     return FRFData(est.freq_hz, est.frf, std, meta, coherence=est.coherence, estimator=info,
-                   correlation=est.correlation)
+                   correlation=est.correlation, bias_bound=est.force_noise_bias_bound)
 
 
 def _estimate_welch(recording: Recording, nperseg, window, overlap, estimator, band) -> FRFData:

@@ -36,6 +36,10 @@ class FRFData:
     estimator : dict, JSON-ready; how FRFs estimated from a recording were
         made (method, settings, ``noise_dof`` behind the std, measurement-chain
         findings); empty for FRFs read from a file or simulated.
+    bias_bound : (n,) float array or None; the relative systematic error the
+        estimator may have left at each point (an uncorrected force-noise
+        bias pulls H towards zero by up to this share); None when none is
+        known (files, simulations).
     """
 
     freq_hz: np.ndarray
@@ -45,6 +49,7 @@ class FRFData:
     coherence: dict = field(default_factory=dict)
     estimator: dict = field(default_factory=dict)
     correlation: dict = field(default_factory=dict)
+    bias_bound: np.ndarray | None = None
 
     def __post_init__(self):
         f = np.asarray(self.freq_hz, dtype=float)
@@ -87,6 +92,11 @@ class FRFData:
                 raise DataError(f"correlation {key} must be finite, inside the unit circle, one per frequency")
             corr[key] = r
         object.__setattr__(self, "correlation", corr)
+        if self.bias_bound is not None:
+            b = np.asarray(self.bias_bound, dtype=float)
+            if b.shape != f.shape or not np.all(np.isfinite(b)) or np.any(b < 0):
+                raise DataError(f"bias_bound must be finite, >= 0 and one per frequency (got shape {b.shape})")
+            object.__setattr__(self, "bias_bound", b)
 
     @property
     def names(self) -> tuple[str, ...]:
@@ -122,6 +132,10 @@ class FRFData:
         if keep.sum() == 0:
             raise DataError(f"band {lo}:{hi} Hz holds no data point (data span "
                             f"{self.freq_hz[0]:g}..{self.freq_hz[-1]:g} Hz)")
+        return self.take(keep)
+
+    def take(self, keep) -> "FRFData":
+        """Only the points ``keep`` (a boolean mask or indices), every per-point array alike."""
         return replace(
             self,
             freq_hz=self.freq_hz[keep],
@@ -129,6 +143,7 @@ class FRFData:
             std={c: s[keep] for c, s in self.std.items()},
             coherence={c: g[keep] for c, g in self.coherence.items()},
             correlation={k: r[keep] for k, r in self.correlation.items()},
+            bias_bound=None if self.bias_bound is None else self.bias_bound[keep],
         )
 
     def with_std(self, std: dict) -> "FRFData":

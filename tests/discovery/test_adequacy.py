@@ -213,6 +213,11 @@ def test_a_candidate_stretched_on_a_good_nominal_fit_is_dropped_not_held_against
     assert rep.model_adequate and rep.adequacy_reasons == []  # ... and it is not held against the model
     assert "structural_damping" not in rep.effect_names
     assert implausible_values(rep.final_fit) == {}  # what is reported is plausible
+    # ... and the report says what it set aside, and why, in its text and its JSON
+    assert list(rep.set_aside) == ["structural_damping"]
+    assert "set aside: structural_damping" in rep.report()
+    aside = rep.to_dict()["set_aside"]
+    assert aside[0]["name"] == "structural_damping" and aside[0]["reasons"][0]["kind"] == "implausible"
 
 
 def test_drop_stretched_needs_a_trusted_nominal_fit():

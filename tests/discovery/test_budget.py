@@ -1,0 +1,41 @@
+"""Practical significance: an effect within the estimator's own bias bound is a measurement matter."""
+import numpy as np
+import pytest
+
+from satmd import discover, effect
+from satmd.errors import DataError
+from satmd.io import FRFData
+from satmd.physics import Rig
+from satmd.simulation import simulate
+
+F = np.linspace(30.0, 160.0, 200)
+
+
+def _biased(bound):
+    """A null rig whose estimate reads 0.3 % low in both channels (a force-noise-like bias), tiny noise."""
+    d = simulate(F, Rig(), [effect("sensor_gain", gain_a1=0.997, gain_a2=0.997)], noise=(0.0005, 0.0001), seed=2)
+    return FRFData(d.freq_hz, d.channels, d.std, bias_bound=np.full(F.size, bound))
+
+
+def test_a_gain_inside_the_bias_bound_is_a_measurement_finding_not_physics():
+    rep = discover(_biased(0.005), candidates=["sensor_gain", "time_delay", "structural_damping"])
+    assert rep.significant_mismatch and rep.effects == []
+    notes = [m for m in rep.measurement if m["name"] == "within_estimator_bias"]
+    assert len(notes) == 1 and notes[0]["explanation"].startswith("sensor_gain")
+    assert rep.fit_after["chi2_reduced"] < 1.5  # the fit keeps it: nothing left for `unexplained`
+    assert "within_estimator_bias" in rep.report()
+
+
+def test_the_same_gain_beyond_the_bias_bound_is_named():
+    rep = discover(_biased(0.001), candidates=["sensor_gain", "time_delay", "structural_damping"])
+    assert rep.effect_names == ["sensor_gain"]
+    assert not [m for m in rep.measurement if m["name"] == "within_estimator_bias"]
+
+
+def test_bias_bound_is_checked_and_follows_the_band():
+    d = _biased(0.005)
+    assert d.band(50, 100).bias_bound.shape == d.band(50, 100).freq_hz.shape
+    with pytest.raises(DataError, match="bias_bound"):
+        FRFData(d.freq_hz, d.channels, d.std, bias_bound=np.ones(3))
+    with pytest.raises(DataError, match="bias_bound"):
+        FRFData(d.freq_hz, d.channels, d.std, bias_bound=-np.ones(F.size))
