@@ -27,8 +27,6 @@ import ast
 import itertools
 from pathlib import Path
 
-import pytest
-
 ROOT = Path(__file__).resolve().parent.parent / "satmd"
 MAX_LINES = 400
 # packages whose cycle and private-import checks are reported apart (none today: satmd/inverse was
