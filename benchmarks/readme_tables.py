@@ -371,7 +371,7 @@ def recordings() -> str:
     for sim, x in r.get("nulls_three_resonances", {}).items():
         cal, pts = x["std_calibration_rms"], x["points"]
         res = " / ".join(f"{cal[k]:.3f} ({pts[k]} points)" for k in sorted(cal) if k.startswith("resonance_"))
-        rows.append(f"| rigs with three resonances in band, {sim} simulator ({x['n']}, calibration only) | — | {res} "
+        rows.append(f"| rigs with three or more resonances in band, {sim} simulator ({x['n']}, calibration only) | — | {res} "
                     f"| {cal['elsewhere']:.3f} | — | — |")
     fams = r["nulls_by_family"]
     if fams and isinstance(next(iter(fams.values())), dict) and "satmd" not in fams:  # one table per family

@@ -17,7 +17,9 @@ one-recording nonlinear test (measured by benchmarks/nonlinear.py).
    `measurement` notes (the significant ones are counted apart).
 2. LPM std calibration: RMS of (estimate − truth)/std near each resonance
    (within 5 % of a peak of |a1| or |a2|, lowest first), near any, and
-   elsewhere, per simulator and per family of conditions (`FAMILIES`).
+   elsewhere, per simulator and per family of conditions (`FAMILIES`); and on a targeted
+   population (``--part resonant``, ``--resonant`` per simulator): null rigs drawn until they have
+   three or more resonances in band (a few % of random rigs), estimate and calibration only.
 3. Force-noise floor: estimated / true within a factor 1.5, or no correction.
 4. The nulls → identification: coverage of the 95 % intervals per parameter.
 5. Concealed single effects, per effect and simulator: found, no spurious
@@ -31,7 +33,7 @@ one-recording nonlinear test (measured by benchmarks/nonlinear.py).
 
 Writes benchmarks/results/recordings.json and prints one line of figures.
 Usage: python benchmarks/recordings.py [--nulls 160] [--per-effect 4] [--workers 2] [--quick]
-       [--part nulls|effects] [--seed-offset N] [--out PART.json]; then
+       [--part nulls|effects|resonant] [--resonant 150] [--seed-offset N] [--out PART.json]; then
        python benchmarks/recordings.py --merge PART1.json PART2.json ... (the statistics over all parts).
 Each worker runs one BLAS thread: on a shared 2-core machine multi-threaded BLAS made every small SVD of
 the least-squares fits 15-40x slower (measured: 2 ms single-threaded, 30-80 ms with 2 threads under load).
