@@ -69,12 +69,12 @@ TUNE_BAND = (20.0, 200.0)
 UP = 2
 
 
-def _strength(name, rig, rng):
-    """Element parameters moving the equivalent parameter by ~12 % (or ~3 N·s/m) at 10 N."""
+def _strength(name, rig, rng, scale=1.0):
+    """Element parameters moving the equivalent parameter by ~12 % (or ~3 N·s/m) at 10 N, times ``scale``."""
     from satmd.physics.nonlinear import response_rms
 
     rms = {k: float(v) for k, v in response_rms(rig, TUNE_BAND, LEVELS[-1]).items()}
-    f = rng.uniform(0.8, 1.25)
+    f = scale * rng.uniform(0.8, 1.25)
     if name == "cubic_absorber_spring":
         return {"k3": f * 0.12 * rig.kp / (3 * rms["d"] ** 2)}
     if name == "cubic_host_spring":
@@ -302,10 +302,10 @@ def _figures(result, folder) -> list:
 def _merge(paths, out):
     """One result from per-element runs: elements joined, settings checked equal, seconds summed."""
     parts = [json.loads(Path(p).read_text()) for p in paths]
-    keys = ("seeds", "seconds", "duration", "no_tune")
+    keys = ("seeds", "seconds", "duration", "no_tune", "strength")
     for p, part in zip(paths, parts):
-        if any(part["settings"][k] != parts[0]["settings"][k] for k in keys):
-            raise SystemExit(f"{p}: settings differ from {paths[0]} ({[part['settings'][k] for k in keys]})")
+        if any(part["settings"].get(k, 1.0) != parts[0]["settings"].get(k, 1.0) for k in keys):
+            raise SystemExit(f"{p}: settings differ from {paths[0]} ({[part['settings'].get(k) for k in keys]})")
     result = {"machine": parts[0]["machine"], "settings": dict(parts[0]["settings"]), "levels": parts[0]["levels"],
               "speed": parts[0]["speed"], "elements": {}, "merged_from": [str(p) for p in paths],
               "machine_per_part": [part["machine"] for part in parts]}
@@ -373,6 +373,15 @@ def readme_markdown(result) -> str:
                      f"({x['held_out_ratio_median']:.1f}× median), noise ceiling {x['held_out_ratio_ceiling_min']:.1f}× "
                      f"min, {x['held_out_ratio_vs_truth_min']:.1f}× against the noise-free truth: there the element "
                      "changes the response by about the sensor noise, and no model can show a 3× gain on that recording.")
+    weak_path = RESULT.parent / "nonlinear_model_weak.json"
+    if weak_path.exists():
+        weak = json.loads(weak_path.read_text())
+        w = weak["elements"]
+        lines.append(f"- Weaker elements (strength × {weak['settings']['strength']:g}: ~5 % on kp, k1 or L, ~1.4 N·s/m on "
+                     f"cp; `--strength {weak['settings']['strength']:g} --out benchmarks/results/nonlinear_model_weak.json`, "
+                     f"{len(next(iter(w.values()))['cases'])} rigs per element, headline hold-out): "
+                     + ", ".join(f"`{n}` {e['extrapolate']['held_out_ratio_min']:.1f}× min "
+                                 f"({100 * e['coverage']:.0f} % covered)" for n, e in w.items()) + ".")
     lines.append(f"- Integrator, 90 s at 2048 Hz with a cubic spring: {speed.get('numba_s_90s_2048Hz', float('nan')):.2f} s "
                  f"compiled (numba), {speed['numpy_s_90s_2048Hz']:.2f} s numpy; whole benchmark {result['seconds'] / 60:.0f} min "
                  f"({describe(result['machine'])}).")
@@ -396,6 +405,8 @@ def main(argv=None):
     ap.add_argument("--duration", type=float, default=40.0, help="recording length")
     ap.add_argument("--elements", default=",".join(indep.ELEMENTS))
     ap.add_argument("--no-tune", action="store_true")
+    ap.add_argument("--strength", type=float, default=1.0,
+                    help="scale of every element's strength (1: ~12 %% on kp, k1 or L, ~3 N·s/m on cp)")
     ap.add_argument("--designs", default=",".join(DESIGNS), help="hold-out designs, of " + ", ".join(DESIGNS))
     ap.add_argument("--out", default=str(RESULT), help="where the JSON goes (a partial run: somewhere in /tmp)")
     ap.add_argument("--merge", nargs="+", metavar="JSON", help="join per-element runs into --out and stop")
@@ -420,7 +431,7 @@ def main(argv=None):
         rng = np.random.default_rng(1000 + e_i)
         rigs = [Rig(m2=rng.uniform(0.4, 0.7), kp=rng.uniform(8e4, 1.5e5), R=rng.uniform(10, 60),
                     L=rng.uniform(0.04, 0.2)) for _ in range(args.seeds)]
-        params = [_strength(name, r, rng) for r in rigs]
+        params = [_strength(name, r, rng, args.strength) for r in rigs]
         t0 = time.perf_counter()
         recs, clean = _recordings(name, rigs, params, args.duration, 2000 + e_i)
         sim_s = time.perf_counter() - t0

@@ -34,6 +34,8 @@ def bias_share(with_effect, without_effect, bound) -> float:
         return float("inf")
     bound = np.asarray(bound, float)
     a, b = with_effect.prediction(), without_effect.prediction()
+    if bound.shape != a.freq_hz.shape:  # the fit saw another grid than the estimate's: no budget to compare
+        return float("inf")
     worst = 0.0
     for c in a.channels:
         change = np.abs(a[c] - b[c]) / np.maximum(np.abs(b[c]), TINY)
