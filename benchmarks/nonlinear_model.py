@@ -362,7 +362,8 @@ def readme_markdown(result) -> str:
              "where the measured response is excited (within 20 dB of its in-band peak), a1 and a2 together; "
              "the best linear model is the best of three linear fits (both training levels, each alone) chosen "
              "on the held-out recording itself. The noise ceiling: the linear model's error over that of the noise-free "
-             "truth itself, the best ratio any model could reach on that recording. Tuning: first rig per element, "
+             "truth itself, the best ratio any model could reach on that recording (a bound: every model is driven by the "
+             "measured force and carries its noise, which the noise-free truth does not). Tuning: first rig per element, "
              "R and L from the model of the headline hold-out, worst-case |U1| peak over the three levels simulated on the "
              "true rig, against a direct-simulation grid search on the true rig (9 × 9, refined once); cost: the "
              "low-level linear tuning's worst case minus the nonlinear tuning's, on the true rig.)", ""]
