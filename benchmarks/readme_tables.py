@@ -360,6 +360,8 @@ def recordings() -> str:
                  + (f" ({x['floor_ratio_range'][0]:.2f}–{x['floor_ratio_range'][1]:.2f})" if x["floor_ratio_range"] else "")
                  + f", {x['n'] - x['floor_corrected']} not corrected")
         sig = f" ({x['significant']} significant, noise-like)" if x.get("significant") else ""
+        if "called_inadequate" in x:
+            sig += f"; {x['called_inadequate']} called inadequate"
         return (f"| {label} | {x['false_alarms']}/{x['n']}{sig} | {res or '—'} | {cal['elsewhere']:.3f} | {floor} | "
                 f"{', '.join(x['measurement_findings']) or '—'} |")
 

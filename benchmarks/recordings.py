@@ -14,7 +14,8 @@ one-recording nonlinear test (measured by benchmarks/nonlinear.py).
 
 1. Null recordings (nothing missing from the physics): false alarms (any physics
    effect named); hum, drift and a noise-like significant residual may only be
-   `measurement` notes (the significant ones are counted apart).
+   `measurement` notes (the significant ones are counted apart); and how many are
+   wrongly called `model_adequate` false (an in-model rig).
 2. LPM std calibration: RMS of (estimate − truth)/std near each resonance
    (within 5 % of a peak of |a1| or |a2|, lowest first), near any, and
    elsewhere, per simulator and per family of conditions (`FAMILIES`); and on a targeted
@@ -250,6 +251,7 @@ def run_null(job):
     fit = rep.nominal_fit
     floor = excited_band(rec["force"], rec.fs_hz)[2]
     return {"sim": sim, "seed": seed, **cond, "alarm": bool(rep.effects), "significant": bool(rep.significant_mismatch),
+            "adequate": bool(rep.model_adequate),
             "effects": rep.effect_names, "measurement": [m["name"] for m in rep.measurement],
             "cover": {p: bool(abs(fit.values[p] - getattr(rig, p)) <= 1.96 * fit.std[p]) for p in PARAMS},
             "chi2_reduced": rep.fit_before["chi2_reduced"], "calibration": calibration(data, truth),
@@ -462,6 +464,7 @@ def summarise(nulls, cases, timing, a, seconds, parts=None, resonant=()):
         ratios = [r["floor_ratio"] for r in rows if r["floor_ratio"] is not None]
         return {"n": len(rows), "false_alarms": sum(r["alarm"] for r in rows),
                 "significant": sum(r.get("significant", r["alarm"]) for r in rows),
+                "called_inadequate": sum(not r.get("adequate", True) for r in rows),
                 "false_alarm_rate": float(np.mean([r["alarm"] for r in rows])) if rows else None,
                 "median_chi2_reduced": float(np.median([r["chi2_reduced"] for r in rows])) if rows else None,
                 "measurement_findings": sorted({m for r in rows for m in r["measurement"]}),

@@ -32,7 +32,7 @@ from ..conventions import TINY
 
 import math
 
-from ..identification.adequacy import Adequacy, Reason, implausible_values
+from ..identification.adequacy import Adequacy, Reason, implausible_values, rel_error_beyond_noise
 from ..identification.adequacy import assess_fit as assess_one
 from ..identification.statistics import POOR_REL_ERROR
 
@@ -110,7 +110,7 @@ def after_search(fit, effects, rig, discrepancy=None) -> list:
     if absurd:
         out.append(Reason("implausible", "the best augmented fit needs " + "; ".join(absurd.values()),
                           {"parameters": {n: float(fit.values[n]) for n in sorted(absurd)}}))
-    rel = float(fit.rel_error)
+    rel = rel_error_beyond_noise(fit)
     if rel >= POOR_REL_ERROR:
         out.append(Reason("poor_fit", f"the best augmented fit reproduces little of the data (relative FRF error "
                                       f"{rel:.3g})", {"rel_error": rel}))
@@ -123,9 +123,9 @@ def after_search(fit, effects, rig, discrepancy=None) -> list:
 
 
 def trusted(fit) -> bool:
-    """True when ``fit`` describes the data with plausible values: relative FRF error below
-    ``STRUCTURE_REL_ERROR`` (finite) and no parameter implausible (`implausible_values`)."""
-    rel = float(fit.rel_error)
+    """True when ``fit`` describes the data with plausible values: relative FRF error (beyond the noise,
+    `rel_error_beyond_noise`) below ``STRUCTURE_REL_ERROR`` and no parameter implausible (`implausible_values`)."""
+    rel = rel_error_beyond_noise(fit)
     return math.isfinite(rel) and rel < STRUCTURE_REL_ERROR and not implausible_values(fit)
 
 

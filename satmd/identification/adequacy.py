@@ -136,20 +136,50 @@ def assess_fit(fit, readings: bool = True, refit=None) -> Adequacy:
     if copied is not None:  # certain whatever the fit: two sensors cannot give the same numbers to 1e-9
         return Adequacy(False, (copied,))
     reasons = []
-    rel = float(fit.rel_error)
+    rel = rel_error_beyond_noise(fit)
     absurd = implausible_values(fit)
     if absurd:
         reasons.append(Reason("implausible", "the fit needs " + "; ".join(absurd.values()) + ": another structure, or "
                               "data in other units", {"parameters": {n: float(fit.values[n]) for n in sorted(absurd)}}))
     if rel >= POOR_REL_ERROR or not np.isfinite(rel):
         reasons.append(Reason("poor_fit", f"the best SATMD fit reproduces little of the data (relative FRF error "
-                              f"{rel:.3g}, χ²_red {fit.chi2_reduced:.3g}): not a SATMD rig as measured",
-                              {"rel_error": rel, "chi2_reduced": float(fit.chi2_reduced)}))
+                              f"{rel:.3g}{_beyond(fit, rel)}, χ²_red {fit.chi2_reduced:.3g}): not a SATMD rig as "
+                              "measured", {"rel_error": rel, "chi2_reduced": float(fit.chi2_reduced)}))
     if not reasons:
         return Adequacy(True)
     if readings and refit is not None:
-        reasons = _explain_failure(fit, rel, refit) + reasons
+        reasons = _explain_failure(fit, float(fit.rel_error), refit) + reasons  # readings compare plain errors
     return Adequacy(False, tuple(reasons))
+
+
+def rel_error_beyond_noise(fit) -> float:
+    """The relative FRF error of ``fit`` on what the data carry above their own noise.
+
+    A noisy measurement of a SATMD rig has a large plain relative error even for the true model. With the
+    std the data carry (a file's std columns, an estimate's), powers are counted in units of each point's
+    noise, so that a few points of huge scatter (a band edge the force hardly reaches) weigh no more than
+    their information, and the noise's expected share, 2 per point and channel, is taken out of the
+    residual's and the data's: sqrt(max(χ² − 2n, 0) / (Σ|d/σ|² − 2n)); the smaller of that and the plain
+    relative error counts (noise only ever excuses a misfit). Data without a std, or with less signal than
+    noise (Σ|d/σ|² < 4n: nothing measured above the noise), keep the plain relative error
+    (`FitResult.rel_error`).
+    """
+    rel = float(fit.rel_error)
+    if not getattr(fit, "weighted", False) or not np.isfinite(rel):  # no std: nothing to take out
+        return rel
+    sigma, res = fit.sigma, fit.residuals()
+    n = 2 * sum(np.size(res[c]) for c in fit.channels)
+    chi2 = sum(float(np.sum(np.abs(res[c] / sigma[c]) ** 2)) for c in fit.channels)
+    power = sum(float(np.sum(np.abs(fit.data[c] / sigma[c]) ** 2)) for c in fit.channels)
+    if not (np.isfinite(chi2) and np.isfinite(power) and power > 2 * n):
+        return rel
+    return min(rel, float(np.sqrt(max(chi2 - n, 0.0) / (power - n))))
+
+
+def _beyond(fit, rel) -> str:
+    """', X on the signal above the noise' when the plain relative error says otherwise."""
+    plain = float(fit.rel_error)
+    return "" if plain == rel else f" on what the data carry above their noise; {plain:.3g} with the noise"
 
 
 def implausible_values(fit) -> dict:

@@ -256,3 +256,22 @@ def test_another_structure_that_reaches_the_search_stays_inadequate(monkeypatch)
     assert len(seen) == 1 and seen[0]["dropped"] == {} and seen[0]["kept"] == seen[0]["selected"]
     assert not rep.model_adequate and rep.effects == []
     assert set(_kinds(rep)) & {"structure_left", "effect_at_bound", "implausible"}
+
+
+def test_a_noisy_measurement_of_a_satmd_rig_is_not_called_inadequate():
+    """Large noise (plain relative error > 0.5 even for the true model) is not another structure: the error
+    beyond the noise the std declares is what counts; data that are all noise stay inadequate."""
+    from satmd.identification.adequacy import assess_fit as assess_one, rel_error_beyond_noise
+
+    f = np.linspace(40, 130, 300)
+    d = simulate(f, Rig(), noise=(0.4, 0.0), seed=5)
+    fit = identify(d, warn=False)
+    assert fit.rel_error > 0.5 and fit.chi2_reduced < 1.3
+    assert rel_error_beyond_noise(fit) < 0.3
+    assert assess_one(fit, readings=False).adequate
+    rng = np.random.default_rng(1)
+    scale = np.abs(d["a1"]).mean()
+    noise = FRFData(f, {c: scale * (rng.standard_normal(f.size) + 1j * rng.standard_normal(f.size)) for c in d.names},
+                    {c: np.full(f.size, scale) for c in d.names})
+    nfit = identify(noise, warn=False)
+    assert not assess_one(nfit, readings=False).adequate
