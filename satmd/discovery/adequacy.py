@@ -32,7 +32,8 @@ from ..conventions import TINY
 
 import math
 
-from ..identification.adequacy import Adequacy, Reason, implausible_values, rel_error_beyond_noise
+from ..identification.adequacy import (Adequacy, Reason, implausible_reason, implausible_values,
+                                       rel_error_beyond_noise)
 from ..identification.adequacy import assess_fit as assess_one
 from ..identification.statistics import POOR_REL_ERROR
 
@@ -106,10 +107,9 @@ def after_search(fit, effects, rig, discrepancy=None) -> list:
         Empty when the augmented model describes the data.
     """
     out = effects_at_edge(effects, rig)
-    absurd = implausible_values(fit)
+    absurd = implausible_reason(fit, "the best augmented fit")
     if absurd:
-        out.append(Reason("implausible", "the best augmented fit needs " + "; ".join(absurd.values()),
-                          {"parameters": {n: float(fit.values[n]) for n in sorted(absurd)}}))
+        out.append(absurd)
     rel = rel_error_beyond_noise(fit)
     if rel >= POOR_REL_ERROR:
         out.append(Reason("poor_fit", f"the best augmented fit reproduces little of the data (relative FRF error "
@@ -133,10 +133,9 @@ def stretched(model, rig) -> list:
     """The evidence that ``model`` (a `select.Model`) is stretched: its effects at the edge of their own search
     ranges, and an ``implausible`` reason when its free parameters sit at absurd values (empty when neither)."""
     out = effects_at_edge(model.effects, rig)
-    absurd = implausible_values(model.fit)
+    absurd = implausible_reason(model.fit, "the augmented fit")
     if absurd:
-        out.append(Reason("implausible", "the augmented fit needs " + "; ".join(absurd.values()),
-                          {"parameters": {n: float(model.fit.values[n]) for n in sorted(absurd)}}))
+        out.append(absurd)
     return out
 
 

@@ -137,10 +137,9 @@ def assess_fit(fit, readings: bool = True, refit=None) -> Adequacy:
         return Adequacy(False, (copied,))
     reasons = []
     rel = rel_error_beyond_noise(fit)
-    absurd = implausible_values(fit)
+    absurd = implausible_reason(fit, "the fit", ": another structure, or data in other units")
     if absurd:
-        reasons.append(Reason("implausible", "the fit needs " + "; ".join(absurd.values()) + ": another structure, or "
-                              "data in other units", {"parameters": {n: float(fit.values[n]) for n in sorted(absurd)}}))
+        reasons.append(absurd)
     if rel >= POOR_REL_ERROR or not np.isfinite(rel):
         reasons.append(Reason("poor_fit", f"the best SATMD fit reproduces little of the data (relative FRF error "
                               f"{rel:.3g}{_beyond(fit, rel)}, χ²_red {fit.chi2_reduced:.3g}): not a SATMD rig as "
@@ -180,6 +179,16 @@ def _beyond(fit, rel) -> str:
     """', X on the signal above the noise' when the plain relative error says otherwise."""
     plain = float(fit.rel_error)
     return "" if plain == rel else f" on what the data carry above their noise; {plain:.3g} with the noise"
+
+
+def implausible_reason(fit, who: str, tail: str = "") -> Reason | None:
+    """An ``implausible`` `Reason` naming the parameters of ``fit`` at absurd values ("{who} needs ...{tail}"),
+    with their values as evidence; None when every value is plausible."""
+    absurd = implausible_values(fit)
+    if not absurd:
+        return None
+    return Reason("implausible", f"{who} needs " + "; ".join(absurd.values()) + tail,
+                  {"parameters": {n: float(fit.values[n]) for n in sorted(absurd)}})
 
 
 def implausible_values(fit) -> dict:
