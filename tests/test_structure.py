@@ -277,7 +277,7 @@ def test_no_private_import_across_packages_in_inverse():
 LAYERS = {
     "errors": 0, "conventions": 0, "validation": 0, "numerics": 0, "jsonsafe": 0, "version": 0,
     "_progress": 0, "_fleet": 0,
-    "physics": 1, "io": 2, "simulation": 3, "simulation_nonlinear": 3, "plots": 3,
+    "physics": 1, "io": 2, "simulation": 3, "simulation_nonlinear": 3, "plots": 3, "modal": 3,
     "identification": 4, "inverse": 5, "discovery": 5, "tuning": 6, "explain": 7, "report": 8, "cli": 9,
     "satmd": 10, "__main__": 10,
 }

@@ -300,6 +300,10 @@ def add_data_options(parser: argparse.ArgumentParser):
                         help="channel mapping for UFF files with more than two responses (or a1=#N: dataset N)")
     parser.add_argument("--freq-axis", default=None, metavar="START:STEP",
                         help="frequency axis in Hz for .txt files of complex values (one per line)")
+    add_recording_options(parser)
+
+
+from ._recording import add_recording_options, load_recording_args  # noqa: E402,F401 - shared by the commands
 
 
 from ._text import cli_text, one_line_warnings, safe_text, with_flags  # noqa: E402,F401 - shared by the commands
@@ -311,7 +315,7 @@ def load_data(args):
     A time recording is turned into FRFs with `satmd.io.estimate_frf`'s
     defaults (a note on stderr says so; `satmd estimate-frf` gives control).
     """
-    from ..io import estimate_frf, is_recording, load_frf, load_recording
+    from ..io import estimate_frf, is_recording, load_frf
 
     command = getattr(args, "command", None) or "satmd"
     if getattr(args, "plot", None):  # every output is checked before the first piece of work
@@ -319,7 +323,7 @@ def load_data(args):
     lo, hi = parse_band(getattr(args, "band", None))
     with one_line_warnings(command):
         if is_recording(args.data):
-            rec = load_recording(args.data, channel_map=getattr(args, "map", None))
+            rec = load_recording_args(args, args.data)
             data = estimate_frf(rec, band=(lo, hi))
             from ..io.estimate import describe_estimate
 

@@ -48,11 +48,11 @@ def run(args):
 
 def _load_one(args, path):
     """One of several DATA: a Recording as it is (the FRFs are estimated together), or FRFs in --band."""
-    from ..io import is_recording, load_frf, load_recording
-    from ._common import parse_band
+    from ..io import is_recording, load_frf
+    from ._common import load_recording_args, parse_band
 
     if is_recording(path):
-        return load_recording(path, channel_map=getattr(args, "map", None))
+        return load_recording_args(args, path)
     lo, hi = parse_band(getattr(args, "band", None))
     data = load_frf(path)
     return data.band(lo, hi) if (lo is not None or hi is not None) else data
@@ -61,8 +61,9 @@ def _load_one(args, path):
 def _check_linearity(args, rep, free):
     """A single time recording is also tested for nonlinear distortion (the FRF path estimated it already)."""
     from ..discovery.nonlinear_discover import check_one
-    from ..io import is_recording, load_recording
+    from ..io import is_recording
+    from ._common import load_recording_args
 
     if not is_recording(args.data):
         return rep
-    return check_one(rep, load_recording(args.data, channel_map=getattr(args, "map", None)), args.alpha, None, free)
+    return check_one(rep, load_recording_args(args, args.data), args.alpha, None, free)

@@ -8,7 +8,7 @@ import numpy as np
 
 from ..errors import SatmdError
 from ..io.atomic import all_or_none
-from ._common import (add_rig_options, check_outputs, integer, one_line_warnings, parse_band, parse_kv, plot_suffixes,
+from ._common import (add_recording_options, add_rig_options, check_outputs, integer, one_line_warnings, parse_band, parse_kv, plot_suffixes,
                       rig_from_args, safe_text)
 
 
@@ -17,7 +17,9 @@ def register(sub):
                        description="FRFs A1 = acc1/force, A2 = acc2/force with std columns and coherence. By "
                                    "default the local polynomial method on the full record (no window, full "
                                    "resolution, leakage and transient removed, independent points, std from the "
-                                   "local residual) over the band the force excites; Welch H1/H2 on request. A "
+                                   "local residual) over the band the force excites; for a periodic force the mean "
+                                   "over steady periods at the excited lines, for impacts H1 over hits (the "
+                                   "excitation is detected, or given by --excitation); Welch H1/H2 on request. A "
                                    "recording without force (output-only) gives the transmissibility A2/A1 (Welch).")
     p.add_argument("recording", metavar="REC", help="time recording (.csv time_s,force,acc1,acc2; .uff; .wav; "
                                                     ".npz; .mat)")
@@ -35,7 +37,9 @@ def register(sub):
     p.add_argument("--overlap", type=float, default=None, help="Welch: segment overlap fraction (default 0.5)")
     p.add_argument("--band", default=None, metavar="LO:HI", help="keep only LO <= f <= HI Hz")
     p.add_argument("--map", default=None, metavar="force=#1,a1=NODE:DIR,a2=#3",
-                   help="which UFF records / WAV channels are force, a1 and a2")
+                   help="which UFF records / WAV channels / .mat or .npz variables (Name or Name[row]) are force, "
+                        "a1 and a2")
+    add_recording_options(p)
     p.add_argument("--scale", default=None, metavar="force=K,acc1=K,...",
                    help="calibration of WAV channels: SI units per stored unit")
     p.add_argument("--plot", default=None, metavar="FIG.png", help="plot magnitude, phase and coherence")
@@ -68,10 +72,11 @@ def _run(args):
         raise SatmdError(f"{', '.join(given)}: Welch settings, they do not apply to --estimator lpm")
     out = Path(args.out)
     with one_line_warnings("estimate-frf"):
-        rec = load_recording(args.recording, channel_map=args.map, scale=scale)
+        rec = load_recording(args.recording, channel_map=args.map, scale=scale, fs_hz=args.fs)
         options = dict(nperseg=args.nperseg, window=args.window, overlap=args.overlap, band=band)
         if rec.has_force:
-            data = estimate_frf(rec, estimator=args.estimator, width_hz=args.width, **options)
+            data = estimate_frf(rec, estimator=args.estimator, width_hz=args.width, excitation=args.excitation,
+                                period_s=args.period_s, **options)
             save_frf(data, out)
             kind = f"FRFs {', '.join(data.channels)}"
             freq, coh = data.freq_hz, data.coherence

@@ -91,13 +91,17 @@ def discover(
 
         for j, part in enumerate(data):
             require_data(part, f"data[{j}]", FRFData, Recording)
+        data = [_with_excitation(part) for part in data]
         return discover_recordings(data, discover, rig=rig, free=free, alpha=alpha, candidates=candidates,
                                    channels=channels, max_effects=max_effects)
     require_data(data, "data", FRFData, Recording)
     recording = data if isinstance(data, Recording) else None
     if recording is not None:
         from ..io.estimate import estimate_frf
+        from ..io.excitation import detect_excitation, with_excitation
 
+        # the excitation is read once and travels with the recording: the FRF and the linearity test agree
+        recording = data = with_excitation(data, detect_excitation(data))
         data = estimate_frf(data)
     report = _discover_frf(data, rig, free, candidates, channels, alpha, max_effects)
     if not data.estimator:
@@ -109,6 +113,16 @@ def discover(
 
         report = check_one(report, recording, alpha, rig, free)
     return report
+
+
+def _with_excitation(part):
+    """A recording with its excitation read (FRFData as it is)."""
+    from ..io.excitation import detect_excitation, with_excitation
+    from ..io.recording import Recording
+
+    if isinstance(part, Recording) and "force" in part.channels:
+        return with_excitation(part, detect_excitation(part))
+    return part
 
 
 def _discover_one(data, kwargs):

@@ -50,7 +50,8 @@ class NonlinearReport:
     ----------
     detected : whether any test rejects linearity at its level
     tests : list of `NonlinearTest`
-    findings : list of dicts: name, parameters, ci95, equivalent, equivalent_linear, explanation
+    findings : list of dicts: name, parameters, ci95, equivalent, equivalent_linear, explanation (and
+        ``character`` or ``modes`` for a ``nonlinear_unexplained`` finding, SPEC §9)
     experiments : what to record next to settle what is open
     levels : one level figure per recording (force RMS), in the order given
     set_aside : linear effects a one-recording fit named while distortion is present (not physics)
@@ -65,10 +66,9 @@ class NonlinearReport:
 
     def to_dict(self) -> dict:
         """The SPEC §9 ``nonlinear`` block (plus ``experiments``)."""
-        keys = ("name", "parameters", "ci95", "equivalent", "equivalent_linear", "explanation")
+        keys = ("name", "parameters", "ci95", "equivalent", "equivalent_linear", "character", "modes", "explanation")
         out = {"detected": bool(self.detected), "tests": [t.to_dict() for t in self.tests],
-               "findings": [{k: f[k] for k in keys if k in f} | ({"character": f["character"]} if "character" in f
-                                                                    else {}) for f in self.findings],
+               "findings": [{k: f[k] for k in keys if k in f} for f in self.findings],
                "experiments": list(self.experiments)}
         if self.set_aside:
             out["set_aside"] = list(self.set_aside)
@@ -107,8 +107,14 @@ def distortion_test(recording, band=None, alpha: float = 1e-3) -> NonlinearTest:
     -------
     NonlinearTest
     """
+    from ..errors import DataError
+    from ..io.excitation import detect_excitation
     from ..io.lpm import excited_band
 
+    kind = detect_excitation(recording).kind
+    if kind == "impact":  # the regressors need a force that keeps the rig moving: hits leave it at rest
+        raise DataError("the distortion test needs a random or periodic force; an impact record cannot be "
+                        "tested for distortion (hit at two levels apart to see level dependence)")
     fs = recording.fs_hz
     x = recording["force"]
     if band is None:
@@ -153,8 +159,11 @@ def multisine_arrays(recording):
     skip = int(meta.get("transient_periods", 1 if per > 1 else 0))
     lines = np.array([int(k) for k in str(meta["lines"]).split(",") if k.strip()])
 
+    steady = [int(i) for i in str(meta.get("steady_periods", "")).split(",") if i.strip()]
+
     def shape(x):
-        return np.asarray(x, float)[: m * per * n].reshape(m, per, n)[:, skip:]
+        blocks = np.asarray(x, float)[: m * per * n].reshape(m, per, n)
+        return blocks[:, steady] if steady and m == 1 else blocks[:, skip:]
 
     outs = {ch: shape(recording[c]) for c, ch in zip(("acc1", "acc2"), ACCEL_CHANNELS) if c in recording.channels}
     if not outs:
@@ -197,7 +206,9 @@ def multisine_frf(recording):
     for c, y in outs.items():
         b = multisine_bla(u, y, lines, recording.fs_hz)
         chans[c], std[c] = b["bla"], b["std"]
-        info[f"var_nl/var_total {c}"] = float(np.nanmedian(b["var_nl"] / np.maximum(b["var_total"], TINY)))
+        share = b["var_nl"] / np.maximum(b["var_total"], TINY)
+        if np.isfinite(share).any():  # one realisation holds no estimate of the distortion's variance
+            info[f"var_nl/var_total {c}"] = float(np.nanmedian(share))
     meta = {"estimator": "multisine_bla", "realisations": str(u.shape[0]), "periods": str(u.shape[1])}
     meta.update({k: f"{v:.3g}" for k, v in info.items()})
     if "force_rms" in recording.meta:
@@ -255,7 +266,8 @@ def common_frfs(recordings) -> list:
     first = estimate_frf(recordings[0], band=band)
     width = first.estimator.get("window_hz") or first.estimator.get("settings", {}).get("window_hz")
     out = [estimate_frf(r, band=band, width_hz=width) for r in recordings]
-    return [_with_model_error(d, r, band, width) for d, r in zip(out, recordings)]
+    return [_with_model_error(d, r, band, width) if d.estimator.get("method") == "lpm" else d
+            for d, r in zip(out, recordings)]
 
 
 def _with_model_error(data, recording, band, width):

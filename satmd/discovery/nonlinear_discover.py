@@ -8,7 +8,10 @@ linear system; the linear vocabulary (`effects`) then runs
 - on the lowest level, with the parameter the nonlinear finding moves set free,
   when they are not: the nonlinearity is named once, in its own block, and a
   linear effect that only stands in for it (``parameter_offset`` of that
-  parameter, ``unexplained``) is dropped from ``effects``.
+  parameter, ``unexplained``) is dropped from ``effects``;
+- and when the SATMD model is not adequate for them (another structure), no
+  SATMD element is named at all: the finding is ``nonlinear_unexplained`` told
+  per resonance, from a modal fit of every level (`nonlinear_modes`).
 
 A single recording in which distortion is detected keeps the linear effects
 found in ``nonlinear.set_aside`` instead of ``effects``: one level cannot tell a
@@ -71,7 +74,11 @@ def discover_recordings(items, linear, rig=None, free=None, alpha: float = 1e-3,
 
     free = tuple(free or DEFAULT_FREE)
     items = list(items)
+    hits = repeated_hits(items)
+    if hits is not None:  # hits of one test are repeats, not levels: one FRF over all of them
+        return linear(hits, rig=rig, free=free, alpha=alpha, **kwargs)
     if all(_is_recording(x) for x in items):
+        unit: str | None = "N RMS"  # the levels are the recordings' force RMS
         datas = common_frfs(items)
         nl = analyse_recordings(items, rig, free, alpha, datas=datas)
         grid = on_common_grid(datas)
@@ -84,6 +91,7 @@ def discover_recordings(items, linear, rig=None, free=None, alpha: float = 1e-3,
 
             raise DataError("the FRFs share fewer than 4 frequencies: give them on one grid")
         datas = grid[1]
+        unit = "N RMS" if all("force_rms" in d.meta for d in datas) else None
         nl = analyse_frfs(datas, rig, free, alpha)
         levels = nl.levels
     finding = nl.findings[0] if nl.findings else {}
@@ -94,12 +102,47 @@ def discover_recordings(items, linear, rig=None, free=None, alpha: float = 1e-3,
     ref = datas[int(np.argmin(levels))] if levels else datas[0]
     free2 = free + ((moving,) if moving and moving not in free else ())
     rep = linear(ref, rig=rig, free=free2, alpha=alpha, **kwargs)
+    if not rep.model_adequate:  # another structure: its level dependence is told per resonance, no element named
+        from .nonlinear_modes import unexplained_by_modes
+
+        return replace(rep, nonlinear=unexplained_by_modes(nl, datas, unit))
     drop = {_UNEXPLAINED} | ({f"parameter_offset:{moving}"} if moving else set())
     if not moving:
         drop |= {e.name for e in rep.effects}
     kept = [e for e in rep.effects if e.name not in drop]
     aside = [e.name for e in rep.effects if e.name in drop]
     return replace(rep, effects=kept, nonlinear=replace(nl, set_aside=aside))
+
+
+#: Impact files whose median hit heights lie within this factor are repeats of one test, not levels.
+IMPACT_LEVEL_FACTOR = 3.0
+
+
+def repeated_hits(items):
+    """Impact recordings of one test joined end to end (one Recording), or None when they are not that.
+
+    Every item must be an impact recording at one sample rate with the same
+    channels, and their median hit heights within `IMPACT_LEVEL_FACTOR`
+    (farther apart they are levels, judged as such).
+    """
+    from ..io.excitation import detect_excitation, with_excitation
+    from ..io.recording import Recording
+
+    if len(items) < 2 or not all(_is_recording(x) for x in items):
+        return None
+    excs = [detect_excitation(x) for x in items]
+    if any(e.kind != "impact" for e in excs) or len({x.fs_hz for x in items}) > 1:
+        return None
+    if len({tuple(sorted(x.channels)) for x in items}) > 1:
+        return None
+    heights = [float(np.median([abs(x["force"][p] - np.median(x["force"])) for _, p in e.hits]))
+               for x, e in zip(items, excs)]
+    if max(heights) > IMPACT_LEVEL_FACTOR * min(heights):
+        return None
+    joined = {c: np.concatenate([x[c] for x in items]) for c in items[0].channels}
+    meta = {"source": " + ".join(str(x.meta.get("source", "recording")) for x in items)}
+    rec = Recording(items[0].fs_hz, joined, dict(items[0].units), meta)
+    return with_excitation(rec, detect_excitation(rec, "impact"))
 
 
 def check_one(report, recording, alpha: float = 1e-3, rig=None, free=None):

@@ -225,7 +225,8 @@ def analyse_generic(frfs: list, stds: list, freq, levels, tests=(), alpha: float
     -------
     NonlinearReport
         A finding ``nonlinear_unexplained`` with ``character`` hardening /
-        softening and the one-mode natural frequency and damping per record.
+        softening, the one-mode natural frequency and damping per record, and ``modes``: every
+        resonance that moves with level, from a multi-mode fit per record (SPEC §9).
     """
     from .nonlinear_periodic import one_mode_fit
 
@@ -245,9 +246,12 @@ def analyse_generic(frfs: list, stds: list, freq, levels, tests=(), alpha: float
         character = "hardening" if dz > 3 else "softening" if dz < -3 else "level-dependent damping"
         bands: list = next((t.bands_hz for t in tests if t.name == "level_dependence"), [])
         where = ", ".join(f"{a:.1f}–{b:.1f} Hz" for a, b in bands)
+        from .nonlinear_modes import level_modes
+
+        modes = [t.to_dict() for t in level_modes(freq, frfs, stds, levels) if t.moves]  # every resonance
         findings.append({
             "name": UNEXPLAINED_NL, "parameters": {}, "ci95": {}, "equivalent": [], "character": character,
-            "equivalent_linear": {"f_n_hz": fn, "zeta": [m["zeta"] for m in fits], "peak_hz": peaks},
+            "modes": modes, "equivalent_linear": {"f_n_hz": fn, "zeta": [m["zeta"] for m in fits], "peak_hz": peaks},
             "explanation": (f"{character} at the resonance: a one-mode fit per level puts the natural frequency at "
                             + ", ".join(f"{fn[i]:.2f}" for i in order) + " Hz (damping "
                             + ", ".join(f"{100 * fits[i]['zeta']:.1f}" for i in order) + " %) from the lowest to "

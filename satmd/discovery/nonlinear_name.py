@@ -24,6 +24,7 @@ from ..physics import frf
 from ..physics.nonlinear import NONLINEAR, response_rms
 
 MOVING = ("kp", "k1", "cp", "L")
+LOG_REACH = 50.0  # the farthest a joint fit moves a parameter from its start, in log units
 
 
 @dataclass(frozen=True)
@@ -91,18 +92,20 @@ def joint_fit(datas, rig, free, channels, moving, start: dict, moving_start=None
     y, w = _stack(datas, channels)
 
     def rigs_of(x):
-        vals = {n: base[n] * np.exp(x[i]) for i, n in enumerate(names)}
+        # a search on data the model cannot describe may run off: beyond e^±50 of its start a value is absurd
+        vals = {n: base[n] * np.exp(np.clip(x[i], -LOG_REACH, LOG_REACH)) for i, n in enumerate(names)}
         common = {p: vals[p] for p in shared}
         return [rig.replace(**common, **({moving: vals[f"{moving}#{r}"]} if moving else {})) for r in range(k)]
 
     def residual(x):
         out = []
-        for r, (d, rg) in enumerate(zip(datas, rigs_of(x))):
-            resp = frf(d.freq_hz, rg, outputs=tuple(channels), validate=False)
-            for c in channels:
-                m = resp.channel(c)
-                out.append(np.concatenate([m.real, m.imag]))
-        return (np.concatenate(out) - y) * w
+        with np.errstate(all="ignore"):  # absurd values give non-finite FRFs: least_squares steps back from them
+            for r, (d, rg) in enumerate(zip(datas, rigs_of(x))):
+                resp = frf(d.freq_hz, rg, outputs=tuple(channels), validate=False)
+                for c in channels:
+                    m = resp.channel(c)
+                    out.append(np.concatenate([m.real, m.imag]))
+            return (np.concatenate(out) - y) * w
 
     sol = least_squares(residual, x0, method="trf", x_scale="jac", xtol=1e-10, ftol=1e-10, max_nfev=200)
     chi2 = float(np.sum(sol.fun ** 2))
@@ -112,7 +115,7 @@ def joint_fit(datas, rig, free, channels, moving, start: dict, moving_start=None
         cov = np.linalg.inv(sol.jac.T @ sol.jac)
     except np.linalg.LinAlgError:
         cov = np.full((len(names), len(names)), np.nan)
-    vals = {nm: base[nm] * np.exp(sol.x[i]) for i, nm in enumerate(names)}
+    vals = {nm: base[nm] * np.exp(np.clip(sol.x[i], -LOG_REACH, LOG_REACH)) for i, nm in enumerate(names)}
     per, per_std = [], []
     if moving:
         for r in range(k):

@@ -26,6 +26,7 @@ from .estimate import (
     save_transmissibility,
     transmissibility,
 )
+from .excitation import Excitation, detect_excitation
 from .frfdata import CHANNELS, UNITS, FRFData
 from .matfile import read_frf_variables, write_frf_variables
 from .recording import Recording, clipped_channels, is_recording, load_recording, save_recording
@@ -120,5 +121,5 @@ __all__ = [
     "FRFData", "CHANNELS", "UNITS", "load_frf", "save_frf", "READERS", "WRITERS", "DataWarning",
     "Recording", "load_recording", "save_recording", "is_recording", "clipped_channels", "estimate_frf",
     "default_nperseg", "transmissibility", "Transmissibility", "model_transmissibility", "save_transmissibility",
-    "simulate_recording",
+    "simulate_recording", "Excitation", "detect_excitation",
 ]

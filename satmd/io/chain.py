@@ -187,6 +187,33 @@ def _unseen_floor(channels, std, settings, bias_bound) -> list[MeasurementFindin
         "measure the load cell's noise with the shaker off", corrected=False)]
 
 
+def sweep_findings(excitation, freq_hz, channels: dict) -> list[MeasurementFinding]:
+    """A single sweep faster than the sharpest resonance can follow (ISO 7626-2: rate < 0.9 f² ζ² Hz/s).
+
+    With half-power width B = 2ζf the limit is 0.225 B² Hz/s; a logarithmic
+    sweep's rate at f is f ln2 times its octaves per second.
+    """
+    if excitation.kind != "sweep" or not excitation.sweep:
+        return []
+    sharp = sharpest_resonance(freq_hz, channels)
+    if sharp is None:
+        return []
+    f_r, width = sharp
+    s = excitation.sweep
+    rate = (abs(s["rate_hz_per_s"]) if "rate_hz_per_s" in s
+            else abs(s.get("rate_octaves_per_s", 0.0)) * f_r * np.log(2.0))
+    limit = 0.225 * width ** 2
+    if rate <= limit:
+        return []
+    return [MeasurementFinding(
+        "fast_sweep",
+        f"the sweep passes the {f_r:.4g} Hz resonance (half-power width {width:.3g} Hz) at {rate:.3g} Hz/s, "
+        f"{rate / limit:.1f}x faster than it can follow (ISO 7626-2: {limit:.3g} Hz/s): the estimate is smeared "
+        f"and shifted there",
+        f"sweep slower than {limit:.3g} Hz/s through the resonances, or repeat the sweep periodically so that "
+        f"the steady periods are averaged")]
+
+
 def clipping_findings(recording) -> list[MeasurementFinding]:
     """A channel that sits on its extremes for several samples was clipped."""
     from .recording import clipped_channels

@@ -33,7 +33,8 @@ __all__ = ["estimate_frf", "describe_estimate", "default_nperseg", "get_window",
 
 
 def estimate_frf(recording: Recording, nperseg: int | None = None, window=None, overlap: float | None = None,
-                 estimator: str | None = None, band=None, width_hz: float | None = None) -> FRFData:
+                 estimator: str | None = None, band=None, width_hz: float | None = None,
+                 excitation: str = "auto", period_s: float | None = None) -> FRFData:
     """FRFs a1 = acc1/force and a2 = acc2/force with std, coherence and measurement-chain findings.
 
     Parameters
@@ -44,16 +45,25 @@ def estimate_frf(recording: Recording, nperseg: int | None = None, window=None, 
         Welch settings (samples per segment, any `scipy.signal.get_window`
         name, overlap fraction); giving any of them selects Welch H1.
     estimator : {"lpm", "H1", "H2"}, optional
-        ``lpm``: the local polynomial method on the full record (the default:
-        no window, full resolution, leakage and transient removed, std from the
-        local residual; `satmd.io.lpm`). ``H1`` / ``H2``: Welch averaging
-        (noise on the responses / on the force).
+        ``lpm``: the local polynomial method on the full record (no window,
+        full resolution, leakage and transient removed, std from the local
+        residual; `satmd.io.lpm`). ``H1`` / ``H2``: Welch averaging (noise on
+        the responses / on the force). Default: the estimator the excitation
+        calls for: the mean over steady periods at the excited lines for a
+        periodic force (`satmd.io.periodic`), H1 over hits for impacts
+        (`satmd.io.impact`), the LPM for random forces and sweeps.
     band : (lo, hi), optional
         Band to keep in Hz, either may be None. The LPM also keeps to the band
         the force excites, and says so.
     width_hz : float, optional
         LPM window width in Hz (default: 0.3 Hz, or a fifth of the sharpest
         resonance's half-power width when that is narrower).
+    excitation : {"auto", "random", "periodic", "impact", "sweep"}
+        What excited the rig; ``auto`` detects it from the force
+        (`satmd.io.excitation`). The estimate's ``estimator["excitation"]`` says
+        what was found or given.
+    period_s : float, optional
+        The period of a periodic force in seconds (default: detected).
 
     Returns
     -------
@@ -61,15 +71,31 @@ def estimate_frf(recording: Recording, nperseg: int | None = None, window=None, 
         With ``std``, ``coherence`` and ``estimator`` (method, settings,
         ``noise_dof``, and ``measurement`` findings, see `satmd.io.chain`).
     """
+    from .excitation import detect_excitation
+
     require_data(recording, "recording", Recording)
+    source, responses = _check_force(recording)
     welch_given = any(v is not None for v in (nperseg, window, overlap))
+    exc = detect_excitation(recording, excitation, period_s)
+    if estimator is None and not welch_given and width_hz is None and exc.kind in ("periodic", "impact"):
+        _check_constant(recording, source, responses)
+        return _estimate_designed(recording, exc, band)
     method = ("H1" if welch_given else "lpm") if estimator is None else str(estimator)
     if method.lower() == "lpm":
         if welch_given:
             raise DataError("nperseg, window and overlap are Welch settings: they do not apply to the lpm estimator")
-        return _estimate_lpm(recording, band, width_hz)
-    return _estimate_welch(recording, nperseg, "hann" if window is None else window,
-                           0.5 if overlap is None else overlap, method, band)
+        data = _estimate_lpm(recording, band, width_hz)
+    else:
+        data = _estimate_welch(recording, nperseg, "hann" if window is None else window,
+                               0.5 if overlap is None else overlap, method, band)
+    from dataclasses import replace
+
+    from .chain import sweep_findings
+
+    extra = [f.to_dict() for f in sweep_findings(exc, data.freq_hz, data.channels)]
+    info = dict(data.estimator, excitation=exc.to_dict(),
+                measurement=list(data.estimator.get("measurement", [])) + extra)
+    return replace(data, estimator=info)
 
 
 def describe_estimate(data) -> str:
@@ -77,6 +103,14 @@ def describe_estimate(data) -> str:
     e = data.estimator
     if not e:
         return ""
+    if e["method"] in ("periodic", "impact"):
+        lo, hi = e["band_hz"]
+        how = e.get("excitation", {})
+        what = (f"the mean over {how.get('periods_used')} steady periods of {how.get('period_s'):g} s "
+                f"({how.get('source')} periodic force), at the {e['points']} excited lines"
+                if e["method"] == "periodic" else
+                f"H1 over {how.get('hits')} hits ({how.get('source')} impacts), {e['points']} lines")
+        return f"{what} {lo:.4g}–{hi:.4g} Hz, noise from {e['noise_dof']:.0f} degrees of freedom"
     if e["method"] == "lpm":
         lo, hi = e["band_hz"]
         return (f"local polynomial method on the full {e['record_s']:g} s record, {e['points']} independent points "
@@ -136,6 +170,34 @@ def _estimate_lpm(recording: Recording, band, width_hz) -> FRFData:
                      f"{s['smooth_windows']} windows"}
     return FRFData(est.freq_hz, est.frf, std, meta, coherence=est.coherence, estimator=info,
                    correlation=est.correlation, bias_bound=est.force_noise_bias_bound)
+
+
+def _estimate_designed(recording: Recording, exc, band) -> FRFData:
+    """FRFs of a periodic or an impact excitation (`satmd.io.periodic`, `satmd.io.impact`)."""
+    from .chain import clipping_findings
+    from .impact import impact_frf
+    from .periodic import excitation_findings, periodic_frf
+
+    source, responses = _check_force(recording)
+    if exc.kind == "periodic":
+        f, frf, std, coh, dof = periodic_frf(recording, exc, responses, band)
+        extra = []
+        ref = "Pintelon & Schoukens 2012, periodic excitation: mean over steady periods"
+        noise = f"spread over {len(exc.steady)} steady periods"
+    else:
+        f, frf, std, coh, dof, extra = impact_frf(recording, exc, responses, band)
+        ref = "H1 over hits, force window (ISO 7626-5)"
+        noise = f"scatter over {len(exc.hits)} hits" if len(exc.hits) > 1 else "the quiet tail of the one hit"
+    findings = [x for x in clipping_findings(recording) if exc.kind != "impact"] + excitation_findings(exc) + extra
+    floor = 1e-10 * max(np.max(np.abs(h)) for h in frf.values())
+    std = {c: np.maximum(v, floor) for c, v in std.items()}
+    info = {"method": exc.kind, "reference": ref, "record_s": round(recording.duration_s, 6),
+            "band_hz": [round(float(f[0]), 6), round(float(f[-1]), 6)], "points": int(f.size),
+            "noise_dof": round(float(dof), 1), "excitation": exc.to_dict(),
+            "measurement": [x.to_dict() for x in findings]}
+    meta = {"source": str(source), "estimator": exc.kind, "band_hz": f"{f[0]:.6g}:{f[-1]:.6g}",
+            "noise_dof": f"{dof:.0f}", "noise": noise}
+    return FRFData(f, frf, std, meta, coherence=coh, estimator=info)
 
 
 def _estimate_welch(recording: Recording, nperseg, window, overlap, estimator, band) -> FRFData:

@@ -63,8 +63,12 @@ def _findings(value):
 
 
 MAX_HZ = 1e9
+METHODS = ("lpm", "welch-H1", "welch-H2", "periodic", "impact")
+EXCITATIONS = ("random", "periodic", "impact", "sweep")
 SCHEMA = {
-    "method": lambda v: None if v in ("lpm", "welch-H1", "welch-H2") else "must be lpm, welch-H1 or welch-H2",
+    "method": lambda v: None if v in METHODS else f"must be one of {', '.join(METHODS)}",
+    "excitation": lambda v: None if isinstance(v, dict) and v.get("kind") in EXCITATIONS else (
+        f"must be an object whose 'kind' is one of {', '.join(EXCITATIONS)}"),
     "reference": _text,
     "record_s": _number(0, lo_open=True),
     "band_hz": _band,

@@ -29,10 +29,9 @@ import numpy as np
 from ..errors import DataError, FormatError
 from ._common import read_bytes, short_error, warn
 from .atomic import atomic_write
-from .limits import MAX_BINARY_BYTES, MAX_SAMPLES, check_file, check_samples, size_text
+from .limits import MAX_BINARY_BYTES, MAX_SAMPLES, check_file, size_text
 from .frfdata import CHANNELS, FRFData
 
-RECORDING_NAMES = ("force", "acc1", "acc2")
 
 
 def load_variables(path) -> dict:
@@ -192,7 +191,8 @@ def _matrix(path, data, order, out):
     out[name] = arr.reshape(dims, order="F")
 
 
-def _vector(path, name, value, complex_ok=False) -> np.ndarray:
+def vector_variable(path, name, value, complex_ok=False) -> np.ndarray:
+    """Variable ``name`` as a finite 1-D float (or complex) array; a `FormatError` naming it otherwise."""
     v = np.asarray(value)
     if v.ndim > 1 and sum(s > 1 for s in v.shape) <= 1:
         v = v.reshape(-1)
@@ -208,7 +208,8 @@ def _vector(path, name, value, complex_ok=False) -> np.ndarray:
     return v
 
 
-def _scalar(path, name, value) -> float:
+def scalar_variable(path, name, value) -> float:
+    """Variable ``name`` as one finite number > 0; a `FormatError` naming it otherwise."""
     v = np.asarray(value)
     if v.size != 1 or v.dtype.kind not in "biuf":
         raise FormatError(path, f"variable {name!r} must be one real number")
@@ -231,22 +232,22 @@ def read_frf_variables(path) -> FRFData:
     """FRFData from a .mat / .npz file with the documented variable names."""
     path = Path(path)
     v = _variables_with(path, "freq_hz", "fs_hz", " (it looks like a recording: use satmd estimate-frf)")
-    freq = _vector(path, "freq_hz", v["freq_hz"])
+    freq = vector_variable(path, "freq_hz", v["freq_hz"])
     channels: dict[str, np.ndarray] = {}
     std: dict[str, np.ndarray] = {}
     coh: dict[str, np.ndarray] = {}
     used = {"freq_hz"}
     for ch in CHANNELS:
         if ch in v:
-            channels[ch] = _vector(path, ch, v[ch], complex_ok=True)
+            channels[ch] = vector_variable(path, ch, v[ch], complex_ok=True)
             used.add(ch)
         for suffix, into in (("_std", std), ("_coh", coh)):
             if ch + suffix in v:
-                into[ch] = _vector(path, ch + suffix, v[ch + suffix])
+                into[ch] = vector_variable(path, ch + suffix, v[ch + suffix])
                 used.add(ch + suffix)
     if not channels:
         raise FormatError(path, f"no FRF channel variable (any of {', '.join(CHANNELS)})")
-    _warn_unused(path, v, used | {"meta"})
+    warn_unused(path, v, used | {"meta"})
     meta = {"source": str(path), "format": path.suffix.lower().lstrip(".")}
     try:
         return FRFData(freq, channels, std, meta, coherence=coh)
@@ -254,31 +255,11 @@ def read_frf_variables(path) -> FRFData:
         raise FormatError(path, str(exc)) from None
 
 
-def read_recording_variables(path):
-    """(fs_hz, {name: series}) from a .mat / .npz recording."""
-    path = Path(path)
-    v = _variables_with(path, "fs_hz", "freq_hz", " (it looks like FRFs)")
-    fs = _scalar(path, "fs_hz", v["fs_hz"])
-    signals = {n: _vector(path, n, v[n]) for n in RECORDING_NAMES if n in v}
-    if not signals:
-        raise FormatError(path, f"no signal variable (any of {', '.join(RECORDING_NAMES)})")
-    lengths = {n: s.size for n, s in signals.items()}
-    check_samples(path, max(lengths.values()), len(signals), path=path)
-    if len(set(lengths.values())) > 1:
-        raise FormatError(path, "signals have different lengths: " + ", ".join(f"{n} {k}" for n, k in lengths.items()))
-    _warn_unused(path, v, set(signals) | {"fs_hz", "time_s", "meta"})
-    return fs, signals
-
-
-def _warn_unused(path, variables, used):
+def warn_unused(path, variables, used):
+    """Warn (`DataWarning`) about the file's variables that were not read."""
     extra = sorted(set(variables) - used)
     if extra:
         warn(path, f"ignored variable(s) {', '.join(extra)}")
-
-
-def is_recording_file(path) -> bool:
-    v = load_variables(path)
-    return "fs_hz" in v and "freq_hz" not in v
 
 
 def write_frf_variables(data: FRFData, path) -> Path:

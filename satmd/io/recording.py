@@ -18,7 +18,8 @@ Formats (`load_recording` chooses by suffix; each has its module: `csvrec`, `uff
 ``.wav``  one channel per column: 3 channels = force, acc1, acc2; 2 channels
           = acc1, acc2. WAV has no units: integer samples are read as
           fractions of full scale; pass ``scale={"force": N_per_unit, ...}``.
-``.npz`` / ``.mat``  variables ``fs_hz``, ``force``, ``acc1``, ``acc2``.
+``.npz`` / ``.mat``  variables ``force``, ``acc1``, ``acc2`` and a rate (``fs_hz``, ``Fs``, ...), or as a
+          channel map names them (``force=Force,a1=Acceleration[2]``; `matrec`).
 
 Loaders warn (`DataWarning`) about clipped channels and refuse NaN,
 mismatched lengths and non-uniform sampling with a one-line `FormatError`.
@@ -37,11 +38,11 @@ from .wavrec import read_recording_wav, write_recording_wav
 
 
 # --- .npz / .mat ----------------------------------------------------------------
-def read_recording_variables(path) -> Recording:
-    from .matfile import read_recording_variables as _read
+def read_recording_variables(path, channel_map=None, fs_hz=None) -> Recording:
+    from .matrec import read_recording_variables as _read
 
     path = Path(path)
-    fs, signals = _read(path)
+    fs, signals = _read(path, channel_map, fs_hz)
     try:
         rec = Recording(fs, signals, {n: SI_UNITS[n] for n in signals},
                         {"source": str(path), "format": path.suffix.lower().lstrip(".")})
@@ -65,7 +66,7 @@ RECORDING_WRITERS = {".csv": write_recording_csv, ".uff": write_recording_uff, "
                      ".mat": write_recording_variables}
 
 
-def load_recording(path, channel_map=None, scale=None) -> Recording:
+def load_recording(path, channel_map=None, scale=None, fs_hz=None) -> Recording:
     """Load a time recording; the reader is chosen by the suffix (see the module docstring).
 
     Parameters
@@ -75,11 +76,16 @@ def load_recording(path, channel_map=None, scale=None) -> Recording:
         file (suffix case does not matter).
     channel_map : str, optional
         Which record or column is which channel, e.g.
-        ``"force=#1,a1=1:+Z,a2=2:+Z"`` (UFF) or ``"force=#1,a1=#2"`` (WAV);
-        UFF and WAV only: the other formats name their channels.
+        ``"force=#1,a1=1:+Z,a2=2:+Z"`` (UFF), ``"force=#1,a1=#2"`` (WAV) or
+        ``"force=Force,a1=Acceleration[2],a2=Acceleration[3]"`` (.mat/.npz: a
+        variable, or a row of a matrix of signals counted from 1); CSV names
+        its columns.
     scale : dict, optional
         ``{channel: SI units per stored unit}`` (e.g. ``{"force": N_per_unit}``)
         for WAV files, which carry no units; WAV only.
+    fs_hz : float, optional
+        The sample rate, for .mat/.npz files that hold none (otherwise read
+        from a rate variable such as ``fs_hz`` or ``Fs``, or a time vector).
 
     Returns
     -------
@@ -104,9 +110,13 @@ def load_recording(path, channel_map=None, scale=None) -> Recording:
         raise FormatError(path, f"unknown recording type {path.suffix!r} (known: {known})")
     options = {}
     if channel_map:
-        if suffix not in (".uff", ".unv", ".wav"):
+        if suffix not in (".uff", ".unv", ".wav", ".mat", ".npz"):
             raise FormatError(path, f"channel_map does not apply to {suffix} recordings (their channels are named)")
         options["channel_map"] = channel_map
+    if fs_hz is not None:
+        if suffix not in (".mat", ".npz"):
+            raise FormatError(path, f"a sample rate applies to .mat/.npz recordings; {suffix} files state theirs")
+        options["fs_hz"] = fs_hz
     if scale:
         if suffix != ".wav":
             raise FormatError(path, "scale applies to WAV files only (the others carry units)")
@@ -181,7 +191,7 @@ def is_recording(path) -> bool:
         types = {r.func_type for r in records}
         return 1 in types and 4 not in types
     if suffix in (".npz", ".mat"):
-        from .matfile import is_recording_file
+        from .matrec import is_recording_file
 
         return is_recording_file(path)
     return False

@@ -1,0 +1,132 @@
+"""The level dependence of a structure the SATMD model cannot describe, told per resonance (SPEC §9).
+
+When several levels of one structure are judged and the SATMD model is not adequate for them, no
+SATMD element may be named: a joint SATMD fit would turn any change into one of its own parameters.
+The finding is ``nonlinear_unexplained`` with ``modes``: the modes of every level from a multi-mode
+fit (`satmd.modal.fit_modes`), followed over the levels (`satmd.modal.track_modes`); a resonance is
+listed when its frequency or damping moves beyond its uncertainty, and the level-dependence bands are
+put where those resonances move.
+"""
+from __future__ import annotations
+
+from dataclasses import replace
+
+from ..modal import fit_modes, track_modes
+from .nonlinear import UNEXPLAINED_NL
+
+NOT_SATMD = "the SATMD model does not describe these data, so no SATMD element is named"
+
+
+def level_modes(freq_hz, frfs, stds, levels, alpha: float = 0.05) -> list:
+    """The modes of every level followed over the levels (`satmd.modal.track_modes`).
+
+    Parameters
+    ----------
+    freq_hz : (M,) Hz, the grid of every level
+    frfs : per level {channel: (M,) complex}
+    stds : per level {channel: (M,) std} or None
+    levels : one level figure per FRF
+    alpha : family-wise level of the trend tests
+
+    Returns
+    -------
+    list of TrackedMode
+        Empty when a level has too few frequencies for a modal fit.
+    """
+    try:
+        fits = [fit_modes(freq_hz, h, s) for h, s in zip(frfs, stds)]
+    except ValueError:  # too few frequencies for a modal fit
+        return []
+    return track_modes(fits, levels, alpha)
+
+
+def modal_finding(datas, levels, unit: str | None = None, alpha: float = 0.05) -> tuple:
+    """The ``nonlinear_unexplained`` finding with ``modes``, and the bands where the resonances move.
+
+    Parameters
+    ----------
+    datas : list of FRFData on one grid, one per level
+    levels : one level figure per FRF (trends read from the lowest to the highest)
+    unit : the levels' unit in words (e.g. ``N RMS``); None when they are only an order
+    alpha : family-wise level of the trend tests
+
+    Returns
+    -------
+    (dict, list)
+        The finding and ``[[lo, hi], ...]`` Hz around each resonance that moves.
+    """
+    tracks = level_modes(datas[0].freq_hz, [d.channels for d in datas],
+                         [d.std if d.has_std else None for d in datas], levels, alpha)
+    moving = [t for t in tracks if t.moves]
+    stay = [t for t in tracks if not t.moves]
+    span = _span(levels, unit)
+    if len(moving) == 1:
+        text = f"{_describe(moving[0], levels)} {span}"
+    elif moving:
+        text = f"{span}: " + "; ".join(_describe(t, levels) for t in moving)
+    else:
+        text = (f"the levels differ, but no resonance's frequency or damping moves beyond its uncertainty "
+                f"({len(tracks)} followed over every level)")
+    if moving and stay:
+        text += "; the resonances at " + ", ".join(f"{t.f_hz[0]:.3g}" for t in stay) + " Hz stay within their " \
+                "uncertainty"
+    return _finding([t.to_dict() for t in moving], f"{text}; {NOT_SATMD}"), _bands(moving)
+
+
+def unexplained_by_modes(report, datas, unit: str | None = None):
+    """``report`` (a `NonlinearReport` that detected a level dependence) with its finding told per resonance.
+
+    Parameters
+    ----------
+    report : NonlinearReport of the levels
+    datas : their FRFData on one grid, in the order of ``report.levels``
+    unit : the levels' unit in words, or None
+
+    Returns
+    -------
+    NonlinearReport
+        One ``nonlinear_unexplained`` finding with ``modes``; the level-dependence tests' bands put
+        where resonances move (unchanged when none does).
+    """
+    finding, bands = modal_finding(datas, report.levels, unit)
+    # the SATMD-parameter test says nothing about a structure the SATMD model cannot describe: left out
+    tests = [replace(t, bands_hz=bands) if bands and t.name.startswith("level_dependence") else t
+             for t in report.tests if t.name != "level_dependence_parameters"]
+    return replace(report, tests=tests, findings=[finding],
+                   detected=any(t.significant for t in tests) or bool(finding.get("modes")))
+
+
+def _finding(modes, explanation) -> dict:
+    return {"name": UNEXPLAINED_NL, "parameters": {}, "ci95": {}, "equivalent": [], "equivalent_linear": {},
+            "modes": modes, "explanation": explanation}
+
+
+def _span(levels, unit) -> str:
+    lo, hi = min(levels), max(levels)
+    return f"from {lo:.3g} to {hi:.3g} {unit}" if unit else "from the lowest to the highest level"
+
+
+def _describe(track, levels) -> str:
+    """'the 7.32 Hz resonance softens by 2.2 % and its damping rises 4.2x' (lowest to highest level)."""
+    lo, hi = min(range(len(levels)), key=lambda i: levels[i]), max(range(len(levels)), key=lambda i: levels[i])
+    f0, f1, z0, z1 = track.f_hz[lo], track.f_hz[hi], track.zeta[lo], track.zeta[hi]
+    moves = {"softening": f"softens by {100 * (1 - f1 / f0):.2g} %",
+             "hardening": f"stiffens by {100 * (f1 / f0 - 1):.2g} %", "none": "keeps its frequency"}[track.trend]
+    ratio = z1 / z0
+    rises = f"rises {ratio:.2g}x" if ratio >= 1.5 else f"rises by {100 * (ratio - 1):.2g} %"
+    damping = {"rising": f"its damping {rises}", "falling": f"its damping falls by {100 * (1 - ratio):.2g} %",
+               "none": "its damping stays within its uncertainty"}[track.damping_trend]
+    return f"the {f0:.3g} Hz resonance {moves} and {damping}"
+
+
+def _bands(tracks) -> list:
+    """[lo, hi] over each track's frequencies widened by its half-power half-widths; overlaps merged."""
+    spans = sorted([min(f * (1 - z) for f, z in zip(t.f_hz, t.zeta)),
+                    max(f * (1 + z) for f, z in zip(t.f_hz, t.zeta))] for t in tracks)
+    out: list = []
+    for a, b in spans:
+        if out and a <= out[-1][1]:
+            out[-1][1] = max(out[-1][1], b)
+        else:
+            out.append([float(a), float(b)])
+    return out

@@ -1,0 +1,153 @@
+"""Time recordings in .mat / .npz files as labs write them: their own names, matrices of signals, any rate variable.
+
+Signals are the variables ``force``, ``acc1``, ``acc2`` (any case), or as a
+channel map says (``"force=Force,a1=Acceleration[2],a2=Acceleration[3]"``: a
+variable, or one row of a matrix of signals, counted from 1; the long axis of a
+matrix is time). The sample rate is given, or a variable (`FS_NAMES`, any
+case), or a uniform time vector (`TIME_NAMES`).
+"""
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from ..errors import FormatError
+from .limits import check_samples
+from .matfile import load_variables, scalar_variable, vector_variable, warn_unused
+
+RECORDING_NAMES = ("force", "acc1", "acc2")
+FS_NAMES = ("fs_hz", "fs", "sample_rate", "samplerate", "sampling_rate", "sampling_frequency", "srate", "sr")
+TIME_NAMES = ("time_s", "time", "t")
+ROLE_ALIASES = {"a1": "acc1", "a2": "acc2", "f": "force"}
+
+
+def _lookup(variables, name):
+    """The variable called ``name``, exactly or else ignoring case (None if absent)."""
+    if name in variables:
+        return name
+    folded = [k for k in variables if k.lower() == name.lower()]
+    return folded[0] if len(folded) == 1 else None
+
+
+def _sample_rate(path, v, fs_hz):
+    """The sample rate: given, from a rate variable, or from a time vector."""
+    if fs_hz is not None:
+        fs = float(fs_hz)
+        if not np.isfinite(fs) or fs <= 0:
+            raise FormatError(path, f"sample rate {fs_hz!r} Hz must be a finite number > 0")
+        return fs, None
+    for name in FS_NAMES:
+        key = _lookup(v, name)
+        if key is not None:
+            return scalar_variable(path, key, v[key]), key
+    for name in TIME_NAMES:
+        key = _lookup(v, name)
+        if key is not None:
+            t = vector_variable(path, key, v[key])
+            dt = np.diff(t)
+            if t.size < 2 or not np.all(dt > 0) or np.ptp(dt) > 1e-6 * np.mean(dt):
+                raise FormatError(path, f"variable {key!r} is not a uniform, increasing time axis")
+            return 1.0 / float(np.mean(dt)), key
+    raise FormatError(path, f"no sample rate: none of the variables {', '.join(FS_NAMES)} or a time vector "
+                            f"({', '.join(TIME_NAMES)}); found: {', '.join(sorted(v)) or 'nothing'}; "
+                            f"give the sample rate (fs_hz)")
+
+
+def _signal(path, v, spec, role):
+    """One signal from ``Name`` or ``Name[i]`` (row or column i, from 1, of a matrix: the long axis is time)."""
+    spec = spec.strip()
+    name, index = spec, None
+    for open_, close in (("[", "]"), ("(", ")")):
+        if spec.endswith(close) and open_ in spec:
+            name, _, rest = spec[:-1].partition(open_)
+            try:
+                index = int(rest)
+            except ValueError:
+                raise FormatError(path, f"map {role}={spec}: {rest!r} is not a row number") from None
+    key = _lookup(v, name.strip())
+    if key is None:
+        raise FormatError(path, f"map {role}={spec}: no variable {name.strip()!r}; found: "
+                                f"{', '.join(sorted(v)) or 'nothing'}")
+    a = np.asarray(v[key])
+    if index is None:
+        return vector_variable(path, key, a)
+    if a.ndim != 2:
+        raise FormatError(path, f"map {role}={spec}: {key!r} has shape {a.shape}, not a matrix of signals")
+    rows = a if a.shape[1] >= a.shape[0] else a.T  # signals along the long axis
+    if not 1 <= index <= rows.shape[0]:
+        raise FormatError(path, f"map {role}={spec}: {key!r} holds {rows.shape[0]} signal(s) "
+                                f"(rows 1..{rows.shape[0]})")
+    return vector_variable(path, f"{key}[{index}]", rows[index - 1])
+
+
+def _parse_variable_map(path, spec) -> dict:
+    """'force=Force,a1=Acceleration[2]' -> {'force': 'Force', 'acc1': 'Acceleration[2]'}."""
+    out = {}
+    for part in str(spec).split(","):
+        if not part.strip():
+            continue
+        role, eq, source = part.partition("=")
+        role = ROLE_ALIASES.get(role.strip().lower(), role.strip().lower())
+        if not eq or not source.strip():
+            raise FormatError(path, f"map {part.strip()!r}: write ROLE=VARIABLE or ROLE=VARIABLE[ROW]")
+        if role not in RECORDING_NAMES:
+            raise FormatError(path, f"map {part.strip()!r}: unknown channel {role!r} (use force, a1, a2)")
+        if role in out:
+            raise FormatError(path, f"map: {role} given twice")
+        out[role] = source.strip()
+    if not out:
+        raise FormatError(path, "map is empty")
+    return out
+
+
+def read_recording_variables(path, channel_map=None, fs_hz=None):
+    """(fs_hz, {name: series}) from a .mat / .npz recording.
+
+    Signals are the variables ``force``, ``acc1``, ``acc2`` (any case), or as
+    ``channel_map`` says (``"force=Force,a1=Acceleration[2],a2=Acceleration[3]"``:
+    a variable, or one row of a matrix of signals, counted from 1). The sample
+    rate is ``fs_hz``, or a variable (`FS_NAMES`, any case), or a time vector.
+    """
+    path = Path(path)
+    v = load_variables(path)
+    if _lookup(v, "freq_hz") is not None and _lookup(v, "fs_hz") is None and fs_hz is None:
+        raise FormatError(path, "it holds 'freq_hz' (it looks like FRFs), no sample rate")
+    fs, fs_key = _sample_rate(path, v, fs_hz)
+    if channel_map:
+        roles = _parse_variable_map(path, channel_map)
+        signals = {role: _signal(path, v, spec, role) for role, spec in roles.items()}
+        used = {_lookup(v, spec.partition("[")[0].partition("(")[0].strip()) for spec in roles.values()}
+    else:
+        signals, used = {}, set()
+        for n in RECORDING_NAMES:
+            key = _lookup(v, n)
+            if key is not None:
+                signals[n] = vector_variable(path, key, v[key])
+                used.add(key)
+        matrices = [f"{k} {np.asarray(a).shape}" for k, a in v.items()
+                    if np.asarray(a).ndim == 2 and min(np.asarray(a).shape) > 1]
+        if not signals or (matrices and not {"acc1", "acc2"} & set(signals)):
+            hint = (f"; it holds {', '.join(matrices)}: say which signal is which, e.g. "
+                    f"a channel map force=Force,a1=Acceleration[2],a2=Acceleration[3] (rows from 1)" if matrices else "")
+            raise FormatError(path, f"no {'response ' if signals else ''}signal variable (any of "
+                                    f"{', '.join(RECORDING_NAMES)}){hint}; found: {', '.join(sorted(v)) or 'nothing'}")
+    lengths = {n: s.size for n, s in signals.items()}
+    check_samples(path, max(lengths.values()), len(signals), path=path)
+    if len(set(lengths.values())) > 1:
+        raise FormatError(path, "signals have different lengths: " + ", ".join(f"{n} {k}" for n, k in lengths.items()))
+    warn_unused(path, v, used | {fs_key, "time_s", "meta"})
+    return fs, signals
+
+
+def is_recording_file(path) -> bool:
+    """A time recording: a sample rate, a time vector or a long signal, and no frequency axis."""
+    v = load_variables(path)
+    if _lookup(v, "freq_hz") is not None:
+        return False
+    if any(_lookup(v, n) is not None for n in FS_NAMES + TIME_NAMES):
+        return True
+    return any(np.asarray(a).dtype.kind in "biuf" and max(np.asarray(a).shape or (1,)) >= 256 for a in v.values())
+
+
+__all__ = ["FS_NAMES", "RECORDING_NAMES", "TIME_NAMES", "is_recording_file", "read_recording_variables"]

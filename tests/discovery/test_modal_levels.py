@@ -1,0 +1,78 @@
+"""Levels of a structure the SATMD model cannot describe (issue 35): the level dependence told per resonance,
+no SATMD element named; an adequate SATMD rig keeps its named element."""
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+
+import satmd
+from satmd import simulate
+from satmd.io.frfdata import FRFData
+from satmd.physics import Rig
+
+FREQ = np.linspace(15.0, 160.0, 400)
+
+
+def chain_modes():
+    """Natural frequencies (Hz) and mass-normalised mode shapes of a 4-mass chain, fixed at one end."""
+    from scipy.linalg import eigh
+
+    m, k = 0.5, 2.0e5
+    K = k * (2 * np.eye(4) - np.eye(4, k=1) - np.eye(4, k=-1))
+    K[3, 3] = k  # the free end
+    w2, phi = eigh(K, m * np.eye(4))
+    return np.sqrt(w2) / (2 * np.pi), phi
+
+
+def chain_frf(f_hz, zeta, rng, force_rms):
+    """Accelerances at masses 1 and 4 per unit force at mass 1, by modal superposition, with noise and std."""
+    _, phi = chain_modes()
+    w = 2 * np.pi * FREQ
+    chans = {}
+    for name, j in (("a1", 0), ("a2", 3)):
+        H = sum(phi[j, r] * phi[0, r] / ((2 * np.pi * f) ** 2 - w ** 2 + 2j * z * (2 * np.pi * f) * w)
+                for r, (f, z) in enumerate(zip(f_hz, zeta)))
+        chans[name] = -w ** 2 * H
+    std = {c: 0.003 * np.abs(h) + 0.002 * np.abs(h).max() for c, h in chans.items()}
+    noisy = {c: h + std[c] * (rng.standard_normal(h.size) + 1j * rng.standard_normal(h.size)) for c, h in chans.items()}
+    return FRFData(FREQ, noisy, std, {"force_rms": f"{force_rms:g}"})
+
+
+def test_a_chain_whose_second_mode_softens_gets_modes_not_an_element():
+    f0, _ = chain_modes()
+    rng = np.random.default_rng(3)
+    zeta = [0.01, 0.012, 0.008, 0.01]
+    # the second mode softens and its damping rises with level; the others stay
+    levels = [(10.0, 1.0, 0.012), (40.0, 0.99, 0.018), (80.0, 0.975, 0.03)]
+    datas = [chain_frf([f0[0], f0[1] * shift, f0[2], f0[3]], [zeta[0], z2, zeta[2], zeta[3]], rng, force)
+             for force, shift, z2 in levels]
+    rep = satmd.discover(datas)
+    doc = json.loads(json.dumps(rep.to_dict(), allow_nan=False))  # every number finite
+    assert doc["model_adequate"] is False and doc["effects"] == []
+    nl = doc["nonlinear"]
+    assert nl["detected"]
+    (finding,) = nl["findings"]
+    assert finding["name"] == "nonlinear_unexplained"
+    (mode,) = finding["modes"]
+    assert (mode["trend"], mode["damping_trend"]) == ("softening", "rising")
+    assert mode["f_hz"][0] == pytest.approx(f0[1], rel=2e-3)
+    assert mode["f_hz"][2] == pytest.approx(0.975 * f0[1], rel=2e-3)
+    assert mode["zeta"][0] == pytest.approx(0.012, rel=0.15) and mode["zeta"][2] == pytest.approx(0.03, rel=0.15)
+    assert all(lo <= f <= hi for f, (lo, hi) in zip(mode["f_hz"], mode["f_ci95"]))
+    assert f"{f0[1]:.3g} Hz resonance softens" in finding["explanation"]
+    assert "from 10 to 80 N RMS" in finding["explanation"]
+    level_test = next(t for t in nl["tests"] if t["name"] == "level_dependence")
+    assert level_test["bands_hz"] and all(lo <= f0[1] <= hi or lo <= 0.975 * f0[1] <= hi
+                                          for lo, hi in level_test["bands_hz"])
+
+
+def test_an_adequate_satmd_rig_keeps_its_named_element():
+    freq = np.linspace(40, 130, 120)
+    low = simulate(freq_hz=freq, rig=Rig(), noise=(0.002, 0.0002), seed=4)
+    high = simulate(freq_hz=freq, rig=Rig().replace(kp=111e3 * 1.08), noise=(0.002, 0.0002), seed=5)
+    rep = satmd.discover([low, high])
+    assert rep.model_adequate
+    (finding,) = rep.nonlinear.to_dict()["findings"]
+    assert finding["name"] == "cubic_absorber_spring" and "modes" not in finding

@@ -1,0 +1,238 @@
+"""The lab's other excitations: periodic forces, impacts and sweeps, detected from the force and estimated."""
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from satmd.errors import DataError, FormatError
+from satmd.io import Recording, estimate_frf, load_recording
+from satmd.io.excitation import detect_excitation, find_period
+from satmd.io.timesim import _convolve
+from satmd.physics import Rig, frf
+
+FS = 1000.0
+F16 = Path(__file__).resolve().parents[3] / "shared" / "data" / "real" / "f16"
+
+
+def _record(force, noise=0.01, seed=0, fs=FS):
+    """Responses of the paper's rig from rest, white noise on every channel (a share of each one's RMS)."""
+    rng = np.random.default_rng(seed)
+    out = _convolve(force, fs, Rig(), ())
+    chans = {}
+    for name in ("force", "acc1", "acc2"):
+        x = out[name]
+        chans[name] = x + noise * np.std(x) * rng.standard_normal(x.size)
+    return Recording(fs, chans, meta={"source": "test"})
+
+
+def _multisine(period, periods, lo=20.0, hi=200.0, seed=1, fs=FS):
+    rng = np.random.default_rng(seed)
+    k = np.arange(period // 2 + 1)
+    f = k * fs / period
+    spec = np.where((f >= lo) & (f <= hi), np.exp(2j * np.pi * rng.random(k.size)), 0)
+    one = np.fft.irfft(spec, period)
+    return np.tile(one / np.std(one), periods)
+
+
+def _hits(times, n, width_s=0.006, fs=FS, heights=None, clip=None):
+    x = np.zeros(n)
+    w = int(width_s * fs)
+    pulse = np.sin(np.pi * np.arange(w) / w)
+    for j, t in enumerate(times):
+        i = int(t * fs)
+        x[i:i + w] += (1.0 if heights is None else heights[j]) * 50.0 * pulse[: max(0, min(w, n - i))]
+    if clip is not None:
+        x = np.minimum(x, clip)
+    return x
+
+
+def _calibration(data, fs=FS):
+    """RMS of (estimate − truth)/std over every point and part (1 for a calibrated std)."""
+    truth = frf(data.freq_hz, Rig())
+    z = [((data[c] - getattr(truth, c)) / data.std[c]) for c in data.channels]
+    z = np.concatenate([np.concatenate([v.real, v.imag]) for v in z])
+    return float(np.sqrt(np.mean(z ** 2)))
+
+
+# --- periodic -------------------------------------------------------------------------------------------
+def test_multisine_from_rest_is_detected_and_estimated_at_its_lines():
+    rec = _record(_multisine(2000, 8), noise=0.02)
+    exc = detect_excitation(rec)
+    assert exc.kind == "periodic" and exc.period_samples == 2000 and exc.periods == 8
+    assert exc.transient_periods >= 1  # the rig starts at rest
+    data = estimate_frf(rec)
+    assert data.estimator["method"] == "periodic"
+    assert data.estimator["excitation"]["kind"] == "periodic"
+    assert data.freq_hz[0] >= 20.0 and data.freq_hz[-1] <= 200.0
+    assert np.allclose(np.diff(data.freq_hz), 0.5)  # every line of the design, nothing between them
+    assert 0.75 < _calibration(data) < 1.35
+
+
+def test_pseudo_random_and_a_given_period_agree():
+    rng = np.random.default_rng(4)
+    one = rng.standard_normal(1000)
+    spec = np.fft.rfft(one)
+    f = np.fft.rfftfreq(1000, 1 / FS)
+    spec[(f < 15) | (f > 250)] = 0
+    force = np.tile(np.fft.irfft(spec, 1000), 10)
+    rec = _record(force, noise=0.01, seed=3)
+    auto = estimate_frf(rec)
+    given = estimate_frf(rec, excitation="periodic", period_s=1.0)
+    assert auto.estimator["excitation"]["source"] == "detected"
+    assert given.estimator["excitation"]["source"] == "given"
+    assert np.allclose(auto["a1"], given["a1"])
+    assert 0.75 < _calibration(auto) < 1.35
+
+
+def test_a_glitch_is_left_out_and_said():
+    force = _multisine(1000, 10, seed=2)
+    force[5300:5340] += 8.0  # a burst in period 6
+    rec = _record(force, noise=0.01)
+    exc = detect_excitation(rec)
+    assert exc.kind == "periodic" and 5 not in exc.steady
+    data = estimate_frf(rec)
+    assert "glitch" in [m["name"] for m in data.estimator["measurement"]]
+    assert 0.7 < _calibration(data) < 1.4
+
+
+def test_a_partial_last_period_and_a_drifting_period():
+    force = _multisine(1000, 6, seed=5)
+    exc = detect_excitation(_record(force[:5600]))
+    assert exc.kind == "periodic" and exc.periods == 5
+    t = np.arange(12000) / FS
+    drift = np.sin(2 * np.pi * 37.0 * t * (1 + 0.02 * t))  # a tone whose period drifts: not periodic
+    assert detect_excitation(_record(drift + np.random.default_rng(1).standard_normal(t.size))).kind != "periodic"
+
+
+def test_random_force_is_not_periodic():
+    rng = np.random.default_rng(0)
+    rec = _record(rng.standard_normal(20000))
+    assert detect_excitation(rec).kind == "random"
+    assert find_period(rng.standard_normal(20000))[0] == 0
+
+
+def test_a_given_period_that_does_not_fit_is_refused():
+    rec = _record(_multisine(1000, 4))
+    with pytest.raises(DataError, match="whole number of samples"):
+        detect_excitation(rec, period_s=1.0005)
+    with pytest.raises(DataError, match="does not repeat"):
+        detect_excitation(rec, period_s=0.7)
+    with pytest.raises(DataError, match="not one of"):
+        detect_excitation(rec, kind="chirpy")
+
+
+def test_linear_rig_under_a_multisine_is_linear_with_no_physics():
+    from satmd import discover
+
+    rep = discover(_record(_multisine(2000, 8), noise=0.02, seed=7))
+    assert rep.model_adequate
+    assert rep.effect_names == []
+    assert rep.nonlinear is not None and not rep.nonlinear.detected
+    assert rep.to_dict()["estimator"]["excitation"]["kind"] == "periodic"
+
+
+# --- impacts --------------------------------------------------------------------------------------------
+def test_hits_are_segmented_and_h1_is_calibrated():
+    n = int(20 * FS)
+    times = [0.5, 3.6, 6.8, 10.1, 13.2, 16.4]
+    rec = _record(_hits(times, n, heights=[1, 0.8, 1.2, 0.9, 1.1, 1.0]), noise=0.01, seed=2)
+    exc = detect_excitation(rec)
+    assert exc.kind == "impact" and len(exc.hits) == 6 and not exc.dropped
+    data = estimate_frf(rec)
+    assert data.estimator["method"] == "impact"
+    assert data.freq_hz[0] < 25 and data.freq_hz[-1] > 200
+    assert 0.7 < _calibration(data) < 1.4
+
+
+def test_double_clipped_and_late_hits_are_dropped_with_their_reason():
+    n = int(20 * FS)
+    rec = _record(_hits([0.5, 3.6, 3.62, 6.8, 10.1, 13.2, 19.5], n), noise=0.005)
+    force = rec["force"].copy()
+    hit = slice(int(10.0 * FS), int(10.3 * FS))
+    force[hit] = np.minimum(force[hit], 0.3 * force[hit].max())  # the ADC clips this hit's top
+    rec = Recording(FS, dict(rec.channels, force=force), meta=rec.meta)
+    exc = detect_excitation(rec)
+    reasons = " ".join(r for _, r in exc.dropped)
+    assert exc.kind == "impact" and len(exc.hits) == 3
+    assert "double hit" in reasons and "clipped" in reasons and "record's end" in reasons
+    data = estimate_frf(rec)
+    names = {m["name"] for m in data.estimator["measurement"]}
+    assert {"double_hit", "clipped_hit", "truncated_hit"} <= names
+
+
+def test_linear_rig_under_hits_is_not_called_nonlinear():
+    from satmd import discover
+
+    n = int(24 * FS)
+    rec = _record(_hits([0.5 + 3.9 * j for j in range(6)], n), noise=0.01, seed=9)
+    rep = discover(rec)
+    assert rep.model_adequate
+    assert rep.effect_names == []
+    assert rep.nonlinear is None or not rep.nonlinear.detected
+
+
+# --- sweeps ---------------------------------------------------------------------------------------------
+def test_a_log_sweep_is_recognised_with_its_law():
+    from satmd.io.timesim import log_sweep
+
+    rec = _record(log_sweep(int(40 * FS), FS, 15.0, 250.0), noise=0.01)
+    exc = detect_excitation(rec)
+    assert exc.kind == "sweep"
+    assert exc.sweep["law"] == "logarithmic" and exc.sweep["direction"] == "up"
+    assert 12 < exc.sweep["f_start_hz"] < 25 and 200 < exc.sweep["f_end_hz"] < 300
+    data = estimate_frf(rec)
+    assert data.estimator["method"] == "lpm" and data.estimator["excitation"]["kind"] == "sweep"
+
+
+# --- files as labs write them -----------------------------------------------------------------------------
+def test_mat_with_lab_names_and_rows(tmp_path):
+    from scipy.io import savemat
+
+    rec = _record(_multisine(1000, 4))
+    path = tmp_path / "lab.mat"
+    savemat(path, {"Force": rec["force"][None], "Acc": np.stack([rec["acc2"], rec["acc1"]]), "Fs": FS})
+    got = load_recording(path, channel_map="force=Force,a1=Acc[2],a2=Acc[1]")
+    assert np.allclose(got["acc1"], rec["acc1"]) and got.fs_hz == FS
+    with pytest.raises(FormatError, match="channel map"):
+        load_recording(path)
+    with pytest.raises(FormatError, match="rows 1..2"):
+        load_recording(path, channel_map="force=Force,a1=Acc[3]")
+    with pytest.raises(FormatError, match="no variable 'Missing'"):
+        load_recording(path, channel_map="force=Missing,a1=Acc[1]")
+    savemat(tmp_path / "nofs.mat", {"force": rec["force"], "acc1": rec["acc1"]})
+    with pytest.raises(FormatError, match="sample rate"):
+        load_recording(tmp_path / "nofs.mat")
+    assert load_recording(tmp_path / "nofs.mat", fs_hz=FS).fs_hz == FS
+
+
+@pytest.mark.skipif(not F16.is_dir(), reason="the F-16 files are not in ../shared")
+def test_f16_reads_as_it_is_and_equals_the_periodic_estimate():
+    path = F16 / "F16Data_FullMSine_Level1.mat"
+    rec = load_recording(path, channel_map="force=Force,a1=Acceleration[2],a2=Acceleration[3]")
+    data = estimate_frf(rec)
+    ex = data.estimator["excitation"]
+    assert ex["kind"] == "periodic" and abs(ex["period_s"] - 20.48) < 1e-9 and ex["periods"] == 9
+    # the textbook estimate: periods 2-9 averaged, the FFT at the excited lines
+    u = rec["force"].reshape(9, 8192)[1:].mean(axis=0)
+    y = rec["acc1"].reshape(9, 8192)[1:].mean(axis=0)
+    lines = np.round(data.freq_hz * 8192 / 400.0).astype(int)
+    textbook = np.fft.rfft(y)[lines] / np.fft.rfft(u)[lines]
+    z = (data["a1"] - textbook) / data.std["a1"]
+    assert np.sqrt(np.mean(np.abs(z) ** 2) / 2) < 1.5
+    mag = np.abs(data["a1"])
+    assert abs(data.freq_hz[np.argmax(mag * (data.freq_hz > 6) * (data.freq_hz < 8))] - 7.32) < 0.1
+    assert np.corrcoef(mag[1:], mag[:-1])[0, 1] > 0.8  # smooth, not noise-like
+
+
+def test_one_hit_per_file_is_one_test_of_repeats():
+    from satmd import discover
+
+    n = int(6 * FS)
+    recs = [_record(_hits([0.6], n, heights=[h]), noise=0.01, seed=s) for s, h in enumerate((1.0, 0.7, 1.3, 0.9))]
+    rep = discover(recs)
+    ex = rep.to_dict()["estimator"]["excitation"]
+    assert ex["kind"] == "impact" and ex["hits"] == 4
+    assert rep.model_adequate and rep.effect_names == []
+    assert rep.nonlinear is None or not rep.nonlinear.detected
