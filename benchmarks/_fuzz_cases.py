@@ -69,6 +69,11 @@ def make_base(folder):
         assert main(["inverse", "train", "--kind", "supervised", "--epochs", "2", "--samples-per-pair", "1",
                      "--members", "1", "--quiet", "--out", f"{folder}/net"]) == 0
         assert main(["inverse", "train", "--kind", "optimization", "--quiet", "--out", f"{folder}/opt"]) == 0
+        # issue 38: one-member ensembles of every net kind, and a two-member one, each trained for two epochs
+        for name, kind, members in (("phys1", "physics", "1"), ("hyb1", "hybrid", "1"), ("net2", "supervised", "2")):
+            warm = ["--warm-start", "1"] if kind != "supervised" else []
+            assert main(["inverse", "train", "--kind", kind, "--epochs", "2", *warm, "--samples-per-pair", "1",
+                         "--members", members, "--quiet", "--out", f"{folder}/{name}"]) == 0
 
 
 def _csv_with_comment(base_text: str, comment: str) -> bytes:
@@ -446,8 +451,147 @@ def generate(base) -> list[dict]:
         blob = mutations((base / name).read_bytes()[:8000], rng, 1)[0]
         add(case("random damage", "api", "either", [name], op="load_frf" if name == "frf.csv" else "load_recording",
                  files={name: blob}, args=["{work}/" + name]))
+    cases += issue38_cases(base)
+    from _fuzz_excitation import cases as excitation_cases
+
+    cases += excitation_cases(case)
     for i, c in enumerate(cases):
         c["id"] = i
+    return cases
+
+
+# --- issue 38: Ctrl-C at any moment, one-member models, out-of-range options, reversed bands -------------------
+CTRL_C_COMMANDS = [  # (argv, files made first, outputs that must stay whole)
+    (["simulate", "--freq", "1:1000:1000000", "--noise", "0.01", "-o", "{work}/big.csv"], {"big.csv": b"old\n"},
+     ["big.csv"]),
+    (["identify", "{base}/paper.csv", "--json"], {}, []),
+    (["discover", "{base}/frf.csv", "--plot", "{work}/d.png"], {"d.png": b"old png\n"}, ["d.png"]),
+    (["inverse", "predict", "{base}/net", "{base}/paper.csv", "--json"], {}, []),
+    (["inverse", "evaluate", "{base}/net2"], {}, []),
+    (["inverse", "train", "--kind", "supervised", "--epochs", "4", "--samples-per-pair", "2", "--members", "2",
+      "--quiet", "--out", "{work}/m"], {}, []),
+    (["explain", "{base}/net2", "--quick", "--no-distill", "--quiet", "--out", "{work}/ex"], {}, []),
+    (["info", "{base}/rec.csv"], {}, []),
+    (["estimate-frf", "{base}/rec.csv", "-o", "{work}/e.csv"], {"e.csv": b"old\n"}, ["e.csv"]),
+    (["tune", "{base}/frf.csv", "--json"], {}, []),
+    (["reproduce", "--only", "forward", "--quick", "--out", "{work}/rep"],
+     {"rep/index.md": b"old report\n", "rep/figures/old.png": b"old\n"}, ["rep"]),
+    (["--help"], {}, []),
+]
+CTRL_C_DELAYS = (0.15, 0.4, 0.8, 1.5, 3.0)  # from the interpreter's start (imports take a second or more) to the work
+
+# option -> out-of-range values (all refused, naming the option); {b}: base, {w}: work
+OUT_OF_RANGE = [
+    (["simulate", "-o", "{w}/s.csv"], {"--m2": ["1e300", "1e-300"], "--kp": ["1e308", "1e-300"], "--R": ["1e300"],
+                                         "--L": ["1e300", "1e-300"], "--seed": ["-1", "1e20", "4294967296"]}),
+    (["simulate", "--time", "--duration", "2", "-o", "{w}/r.csv"],
+     {"--burn-in": ["1e9", "-1", "1e300"], "--fs": ["1e300", "1e-300", "0"], "--force-rms": ["1e300", "0"],
+      "--level": ["1e300", "-1"], "--force-noise": ["1e300", "-1"], "--duration": ["1e300", "-1"]}),
+    (["simulate", "--time", "--excitation", "multisine", "--duration", "8", "-o", "{w}/r.csv"],
+     {"--periods": ["0", "-1", "1000000000"], "--realisations": ["0", "1000000000"]}),
+    (["simulate", "--time", "--duration", "2", "-o", "{w}/r.csv", "--nonlinear"],
+     {"cubic_absorber_spring:k3": ["1e300", "-1e300"], "absorber_friction:Fc": ["1e300", "-1"],
+      "quadratic_damping:c2": ["1e300"]}),
+    (["identify", "{b}/paper.csv"], {"--reg": ["1e300", "-1"], "--init": ["m2=1e300", "R=-5"]}),
+    (["discover", "{b}/paper.csv"], {"--alpha": ["0", "1", "1e300", "-1"]}),
+    (["inverse", "train", "--out", "{w}/m"],
+     {"--epochs": ["0", "1000000000"], "--warm-start": ["1000000000", "90"], "--samples-per-pair": ["0", "1000000000"],
+      "--members": ["0", "257", "1000000"], "--threads": ["0", "1000000"], "--noise": ["1", "-1", "1e300"],
+      "--seed": ["-1", "1e30"]}),
+    (["inverse", "train", "--preset", "box", "--out", "{w}/m"], {"--samples": ["1", "1000000000"]}),
+    (["inverse", "evaluate", "{b}/net2"], {"--noise": ["1", "1e300", "-1"], "--seed": ["-1"]}),
+    (["explain", "{b}/net2", "--out", "{w}/ex"], {"--threads": ["0", "1000000"]}),
+    (["tune", "--rig", "--nonlinear", "cubic_absorber_spring:k3=2e11"], {"--levels": ["1e300", "0", "-1"]}),
+    (["tune", "--rig", "--levels", "1", "--nonlinear"], {"cubic_absorber_spring:k3": ["1e300"]}),
+    (["tune", "--rig", "--robust", "--uncertainty", "kp=5e3"], {"--draws": ["1000000000", "0"]}),
+    (["tune", "--rig"], {"--current": ["R=1e300", "L=-1"], "--robust": ["2", "0.1"]}),
+    (["estimate-frf", "{b}/rec.csv", "-o", "{w}/o.csv"], {"--width": ["0", "-1", "1e300"]}),
+    (["estimate-frf", "{b}/rec.csv", "--estimator", "H1", "-o", "{w}/o.csv"],
+     {"--nperseg": ["0", "1000000000000"], "--overlap": ["-1", "1", "1e300"]}),
+]
+# every option that takes a band (LO:HI), reversed; the refusal must name the option as typed
+REVERSED_BANDS = [
+    (["identify", "{b}/paper.csv"], "--band"), (["discover", "{b}/paper.csv"], "--band"),
+    (["inverse", "predict", "{b}/net2", "{b}/paper.csv"], "--band"), (["tune", "{b}/paper.csv"], "--data-band"),
+    (["tune", "--rig"], "--band"), (["estimate-frf", "{b}/rec.csv", "-o", "{w}/o.csv"], "--band"),
+    (["simulate", "--time", "--duration", "2", "-o", "{w}/r.csv"], "--force-band"),
+]
+
+
+def _oom_files(base) -> dict:
+    """FRF files no SATMD rig gives (a 1-DOF accelerance, white noise, the rig in g): tune must name the file."""
+    f = np.linspace(40.0, 130.0, 60)
+    w = 2 * np.pi * f
+    rng = np.random.default_rng(38)
+    one_dof = -w ** 2 / (4e6 - 1.0 * w ** 2 + 1j * 30.0 * w)
+    noise = rng.standard_normal(60) + 1j * rng.standard_normal(60)
+    from satmd.io import load_frf
+
+    paper = load_frf(base / "paper.csv")
+    out = {}
+    for name, a1, a2 in (("one_dof.csv", one_dof, None), ("noise.csv", noise, noise[::-1]),
+                         ("in_g.csv", paper["a1"] / 9.80665, paper["a2"] / 9.80665)):
+        x = paper.freq_hz if name == "in_g.csv" else f
+        head = "freq_hz,a1_re,a1_im" + (",a2_re,a2_im" if a2 is not None else "")
+        rows = [",".join(repr(float(v)) for v in (x[i], a1[i].real, a1[i].imag) + (() if a2 is None else
+                                                                                   (a2[i].real, a2[i].imag)))
+                for i in range(len(x))]
+        out[name] = ("# satmd-frf v1\n" + head + "\n" + "\n".join(rows) + "\n").encode()
+    return out
+
+
+def issue38_cases(base) -> list[dict]:
+    """The classes of issue 38, each for every command it concerns."""
+    cases = []
+    add = cases.append
+    # 19. Ctrl-C at several moments, from the interpreter's start (imports) to the work, once and twice
+    for argv, files, keep in CTRL_C_COMMANDS:
+        for delay in CTRL_C_DELAYS:
+            add(case("Ctrl-C", "proc", "either", argv=argv, signal="SIGINT", delay=delay, files=files, keep=keep))
+        add(case("Ctrl-C", "proc", "either", argv=argv, signal="SIGINT", delay=0.6, repeat=1, gap=0.05, files=files,
+                 keep=keep))
+        add(case("Ctrl-C", "proc", "either", argv=argv, signal="SIGINT", delay=1.0, repeat=2, gap=0.4, files=files,
+                 keep=keep))
+    # 20. one-member and two-epoch models: no std of 0 or 1e10 (a std, or none with its reason)
+    for model, one in (("net", True), ("phys1", True), ("hyb1", True), ("net2", False)):
+        unexplained = one and model != "hyb1"  # the hybrid's std is its least-squares one
+        add(case("one-member models", "api", "answer", op="predict_model", args=["{base}/" + model, "{base}/paper.csv"],
+                 check_std=True, unexplained=unexplained))
+        add(case("one-member models", "cli", "answer", argv=["inverse", "predict", "{base}/" + model,
+                                                                "{base}/paper.csv", "--json"],
+                 check_std=True, unexplained=unexplained))
+        add(case("one-member models", "cli", "answer", argv=["inverse", "predict", "{base}/" + model,
+                                                                "{base}/paper.csv"], text_std=True))
+        add(case("one-member models", "cli", "answer", argv=["inverse", "evaluate", "{base}/" + model, "--json"],
+                 check_std=True))
+        add(case("one-member models", "cli", "answer", argv=["inverse", "evaluate", "{base}/" + model, "--noise",
+                                                                "0.01", "--json"], check_std=True))
+    # 21. out-of-range values of every command's options, and the refusal names the option as typed
+    for prefix, options in OUT_OF_RANGE:
+        for opt, values in options.items():
+            for v in values:
+                argv = [a.replace("{b}", "{base}").replace("{w}", "{work}") for a in prefix]
+                if opt.startswith("--"):
+                    argv, names = argv + [opt, v], [opt]
+                else:  # an element's parameter: --nonlinear NAME:key=VALUE
+                    argv, names = argv + [f"{opt}={v}"], ["--nonlinear"]
+                add(case("out-of-range options", "cli", "refuse", names, argv=argv))
+    for window in ("boxcar", "bogus"):  # a window without a second-order kernel (boxcar) or none at all
+        add(case("out-of-range options", "cli", "either", ["--window"],
+                 argv=["estimate-frf", "{base}/rec.csv", "--estimator", "H1", "--window", window, "-o", "{work}/o.csv"]))
+    # 22. reversed bands under every option name that takes one
+    for prefix, opt in REVERSED_BANDS:
+        argv = [a.replace("{b}", "{base}").replace("{w}", "{work}") for a in prefix]
+        for band in ("120:40", "40:40", "200:-5"):
+            add(case("reversed bands", "cli", "refuse", [opt], argv=argv + [opt, band]))
+    add(case("reversed bands", "cli", "refuse", ["--freq"],
+             argv=["simulate", "--freq", "130:40:60", "-o", "{work}/s.csv"]))
+    # 23. refusals of data the model cannot describe name the file (satmd tune)
+    for name, content in _oom_files(base).items():
+        add(case("out-of-model files", "cli", "refuse", [name], argv=["tune", "{work}/" + name, "--json"],
+                 files={name: content}))
+        add(case("out-of-model files", "cli", "refuse", [name], argv=["tune", "{work}/" + name, "--no-discover"],
+                 files={name: content}))
     return cases
 
 

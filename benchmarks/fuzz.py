@@ -9,17 +9,19 @@ run inside the worker, ``python -m satmd`` subprocesses are used for the cases
 that send SIGINT / SIGTERM. Every case is classified:
 
 refused          a clean refusal naming the file or option (and what is wrong)
-answered         a correct answer (with the warning the case requires, finite std >= 0)
+answered         a correct answer (with the warning the case requires, finite std >= 0, not absurd and not
+                 far below the error beside it, or no std with its reason said)
 unclear          a refusal that does not name the file or option, shows an array repr or raw control characters
 accepted         hostile input taken silently (should have been refused)
 silent           an answer without the warning the case requires (a glitch, unrelated channels)
 false_refusal    a valid input refused
-traceback        any other exception
+traceback        any other exception (after Ctrl-C: anything but one line "satmd: interrupted" and exit 130)
 hang             past the time limit
 memory           MemoryError or the worker killed (the address-space limit)
 leftover         a temporary file left behind
 damaged          an interruption left an old output destroyed or a new one incomplete
-bad_std          a negative or non-finite std, or ``explained`` for a prediction that says nothing
+bad_std          a std that is negative, infinite or absurd, 0 beside an error, missing without a reason,
+                 or ``explained`` for a prediction that says nothing
 
 Writes ``benchmarks/results/fuzz.json`` and prints one line of counts.
 """
@@ -145,8 +147,20 @@ def _clean_message(message):
     return "array(" not in message and "Traceback" not in message and not CONTROL.search(message)
 
 
-def _std_problem(obj):
-    """A negative or non-finite ``*_std`` anywhere in a result (dict / JSON), else None."""
+# a std beyond ten widths of the inverse model's training box (R 0..103 Ω, L 0..0.5 H) is absurd (issue 38: 6.9e10 Ω)
+ABSURD_STD = {"R_std": 1030.0, "L_std": 5.0}
+
+
+MAX_Z = 1e3  # an error this many std off: the std claims a certainty the answer does not have (issue 38: 4e301 σ)
+
+
+def _std_problem(obj, excused=False):
+    """A std that is negative, infinite or absurd (`ABSURD_STD`) anywhere in a result (dict / JSON), or one
+    that an error beside it (``abs_err_X``) exceeds `MAX_Z` times (a std of 0 with an error), else None.
+
+    A missing std (null / NaN) passes only when ``excused``: the output says why it gives none ("no std: ...",
+    e.g. a one-member ensemble); without a reason it is a std gone missing.
+    """
     import math
 
     import numpy as np
@@ -155,21 +169,30 @@ def _std_problem(obj):
         for k, v in obj.items():
             if k.endswith("_std") and not isinstance(v, dict):
                 try:
-                    values = np.ravel(np.asarray(v, dtype=float))
+                    values = np.ravel(np.asarray(v, dtype=float))  # null -> NaN
                 except (TypeError, ValueError):
                     values = []
-                bad = [x for x in values if not math.isfinite(x) or x < 0]
-                if bad:
-                    return f"{k} = {bad[0]}"
-            p = _std_problem(v)
+                for x in values:
+                    if math.isnan(x) and not excused:
+                        return f"{k} = {x} without a reason (no 'no std: ...' said)"
+                    if math.isinf(x) or x < 0 or x > ABSURD_STD.get(k, math.inf):
+                        return f"{k} = {x}"
+                err = obj.get("abs_err_" + k[:-4])
+                if isinstance(err, (int, float)) and values.size == 1 and math.isfinite(values[0]) and \
+                        err > MAX_Z * values[0]:
+                    return f"{k} = {values[0]:.3g} beside an error of {err:.3g}"
+            p = _std_problem(v, excused)
             if p:
                 return p
     elif isinstance(obj, list):
         for v in obj:
-            p = _std_problem(v)
+            p = _std_problem(v, excused)
             if p:
                 return p
     return None
+
+
+TEXT_STD = re.compile(r"± ?(0(\.0*)?(?![\d.e])|[\d.]+e\+\d+)")  # "± 0" or "± 3.5e+10" in a text report
 
 
 def _explained(obj):
@@ -206,7 +229,7 @@ def run_api_case(c, base, work):
     if c["expect"] == "warn" and not _names_ok(c, texts):
         return "silent", "no warning naming " + "/".join(c["names"])
     if c.get("check_std"):
-        problem = _std_problem(result if isinstance(result, dict) else {})
+        problem = _std_problem(result if isinstance(result, dict) else {}, excused="no std" in texts)
         if problem:
             return "bad_std", problem
         if c.get("unexplained") and _explained(result):
@@ -252,12 +275,14 @@ def _judge_cli(c, rc, out, err):
         return "silent", "no warning naming " + "/".join(c["names"])
     if c.get("no_control") and CONTROL.search(err + out):
         return "unclear", "raw control characters echoed"
+    if c.get("text_std") and TEXT_STD.search(out):
+        return "bad_std", f"text report shows {TEXT_STD.search(out).group(0)!r}"
     if c.get("check_std"):
         try:
             doc = json.loads(out, parse_constant=lambda x: float("nan"))
         except ValueError:
             return "traceback", "invalid JSON"
-        problem = _std_problem(doc)
+        problem = _std_problem(doc, excused="no std" in err)
         if problem:
             return "bad_std", problem
         if c.get("unexplained") and _explained(doc):
@@ -279,8 +304,11 @@ def run_proc_case(c, base, work, limit, timeout):
     p = subprocess.Popen(argv, cwd=work, stdout=subprocess.PIPE, stderr=subprocess.PIPE, env=env, preexec_fn=limits)
     if c.get("signal"):
         time.sleep(c["delay"])
-        if p.poll() is None:
-            p.send_signal(getattr(signal, c["signal"]))
+        for k in range(1 + int(c.get("repeat", 0))):  # "repeat": further presses, "gap" s apart (a double Ctrl-C)
+            if k:
+                time.sleep(c.get("gap", 0.05))
+            if p.poll() is None:
+                p.send_signal(getattr(signal, c["signal"]))
     try:
         out, err = p.communicate(timeout=timeout)
     except subprocess.TimeoutExpired:
@@ -296,6 +324,10 @@ def run_proc_case(c, base, work, limit, timeout):
             if cls == "refused" and _snapshot(work / name) != before:
                 return "damaged", f"{name} changed by a refused command"
         return cls, detail
+    if c["signal"] == "SIGINT" and p.returncode not in (0, 2):  # Ctrl-C: one line and 130, at any moment (issue 38)
+        lines = [ln for ln in err.splitlines() if ln.strip()]
+        if p.returncode != 130 or lines[-1:] != ["satmd: interrupted"] or lines.count("satmd: interrupted") != 1:
+            return "traceback", f"exit {p.returncode} after Ctrl-C: {err.strip()[-200:]!r}"
     for name, before in old.items():
         now = _snapshot(work / name)
         if now != before and not _complete(work / name):
@@ -436,7 +468,8 @@ def describe(c) -> str:
         args = ", ".join(str(a)[:40] for a in c.get("args", []))
         return f"{c['op']}({args})" + (f" {c['kwargs']}" if c.get("kwargs") else "")
     text = "satmd " + " ".join(str(a)[:40] for a in c["argv"])
-    return text + (f" + {c['signal']} after {c['delay']} s" if c.get("signal") else "")
+    again = f" (x{1 + c['repeat']}, {c.get('gap', 0.05)} s apart)" if c.get("repeat") else ""
+    return text + (f" + {c['signal']} after {c['delay']} s{again}" if c.get("signal") else "")
 
 
 def main():

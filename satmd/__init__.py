@@ -2,42 +2,68 @@
 
 Forward model, grey-box identification, amortized inversion, explainability
 and missing-physics discovery from measured or simulated FRFs.
-"""
-from .errors import (DataError, DataWarning, FormatError, IdentifiabilityWarning, PinnedParameterWarning, PoorFitWarning,
-                     SatmdError)
-from .io import FRFData, load_frf, save_frf
-from .physics import (
-    PAPER_GRID_HZ,
-    DielectricLoss,
-    Effect,
-    ExtraMode,
-    ParameterOffset,
-    Rig,
-    SensorGain,
-    ShuntCapacitance,
-    StructuralDamping,
-    TimeDelay,
-    effect,
-    frf,
-    NonlinearElement,
-    integrate,
-    nonlinear_element,
-)
-from .simulation import simulate
-from .identification import FitResult, identify, identify_many  # noqa: E402  (binds the functions over the subpackages)
-from .discovery import DiscoveryReport, discover, discover_many  # noqa: E402
-from .tuning import TuneResult, retune, tune  # noqa: E402  (light: scipy.optimize loads on first use)
 
-from .version import __version__  # noqa: E402, F401  (re-exported: satmd.__version__)
+The names below load on first use (PEP 562): ``import satmd`` itself imports
+nothing heavy, so the ``satmd`` command can take charge of Ctrl-C before
+numpy and scipy load, and ``satmd.identify`` costs what identification needs.
+"""
+from __future__ import annotations
+
+import importlib
+
+TYPE_CHECKING = False  # typing.TYPE_CHECKING without importing typing (type checkers take the name as true)
+from .version import __version__  # noqa: F401  (re-exported: satmd.__version__)
+
+# public name -> the module that defines it (imported when the name is first used)
+_EXPORTS = {
+    **dict.fromkeys(("DataError", "DataWarning", "FormatError", "IdentifiabilityWarning", "PinnedParameterWarning",
+                     "PoorFitWarning", "SatmdError"), ".errors"),
+    **dict.fromkeys(("FRFData", "load_frf", "save_frf"), ".io"),
+    **dict.fromkeys(("PAPER_GRID_HZ", "DielectricLoss", "Effect", "ExtraMode", "ParameterOffset", "Rig", "SensorGain",
+                     "ShuntCapacitance", "StructuralDamping", "TimeDelay", "effect", "frf", "NonlinearElement",
+                     "integrate", "nonlinear_element"), ".physics"),
+    "simulate": ".simulation",
+    **dict.fromkeys(("FitResult", "identify", "identify_many"), ".identification"),
+    **dict.fromkeys(("DiscoveryReport", "discover", "discover_many"), ".discovery"),
+    **dict.fromkeys(("TuneResult", "retune", "tune"), ".tuning"),
+    "InverseModel": ".inverse",  # torch is optional: it loads only when the model is used
+}
+
+if TYPE_CHECKING:  # what type checkers and editors see; at run time `__getattr__` imports on first use
+    from .discovery import DiscoveryReport, discover, discover_many
+    from .errors import (DataError, DataWarning, FormatError, IdentifiabilityWarning, PinnedParameterWarning,
+                         PoorFitWarning, SatmdError)
+    from .identification import FitResult, identify, identify_many
+    from .inverse import InverseModel
+    from .io import FRFData, load_frf, save_frf
+    from .physics import (PAPER_GRID_HZ, DielectricLoss, Effect, ExtraMode, NonlinearElement, ParameterOffset, Rig,
+                          SensorGain, ShuntCapacitance, StructuralDamping, TimeDelay, effect, frf, integrate,
+                          nonlinear_element)
+    from .simulation import simulate
+    from .tuning import TuneResult, retune, tune
 
 
 def __getattr__(name):
-    # torch is optional: the inverse model loads on first use, so `import satmd` works without it
-    if name == "InverseModel":
-        from .inverse import InverseModel
+    """A public name (or a subpackage, ``satmd.io``) imported on first use and kept."""
+    source = _EXPORTS.get(name)
+    if source is not None:
+        value = getattr(importlib.import_module(source, __name__), name)
+    elif not name.startswith("_"):
+        try:
+            value = importlib.import_module(f".{name}", __name__)
+        except ModuleNotFoundError as exc:
+            if exc.name != f"{__name__}.{name}":  # the submodule exists; something it imports is missing
+                raise
+            raise AttributeError(f"module {__name__!r} has no attribute {name!r}") from None
+    else:
+        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+    globals()[name] = value
+    return value
 
-        return InverseModel
-    raise AttributeError(f"module 'satmd' has no attribute {name!r}")
+
+def __dir__():
+    return sorted(set(globals()) | set(__all__))
+
 
 __all__ = [
     "Rig", "frf", "effect", "Effect", "FRFData", "load_frf", "save_frf", "simulate", "PAPER_GRID_HZ",

@@ -1,6 +1,13 @@
 """`python -m satmd` runs the satmd command."""
 import sys
 
-from .cli import main
+try:
+    from .cli import main
+except KeyboardInterrupt:  # Ctrl-C before the command could take charge of it: still one line, no traceback
+    import signal
+
+    signal.signal(signal.SIGINT, signal.SIG_IGN)  # the process ends now: a second press changes nothing
+    sys.stderr.write("satmd: interrupted\n")
+    sys.exit(130)
 
 sys.exit(main())

@@ -7,18 +7,17 @@ with exit status 2; nothing is written when the input is bad.
 from __future__ import annotations
 
 import argparse
-import importlib
-import pkgutil
 import sys
-from pathlib import Path
 
-from ..errors import SatmdError
+from ._interrupt import INTERRUPTED, catching_interrupts, interrupted
 
 # commands listed first in `satmd --help`; any other module follows
 _ORDER = ("simulate", "identify", "discover", "inverse", "explain", "info", "estimate_frf", "reproduce")
 
 
 def _command_modules():
+    import pkgutil
+
     found = [m.name for m in pkgutil.iter_modules(__path__) if not m.name.startswith("_")]
     return [n for n in _ORDER if n in found] + sorted(n for n in found if n not in _ORDER)
 
@@ -40,6 +39,8 @@ def build_parser() -> argparse.ArgumentParser:
 
     parser.add_argument("--version", action="version", version=f"satmd {__version__}")
     sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
+    import importlib
+
     for name in _command_modules():
         importlib.import_module(f"{__name__}.{name}").register(sub)
     return parser
@@ -54,8 +55,21 @@ def main(argv=None) -> int:
 
     Only user errors are caught: `SatmdError`, `OSError` (said in words) and a
     missing optional dependency. Anything else is a bug and keeps its traceback.
+    Ctrl-C, wherever it lands (while the command's modules are still being
+    imported too), ends with one line, ``satmd: interrupted``, and status 130.
     """
-    parser = build_parser()
+    with catching_interrupts(exiting=argv is None):  # no argv: run as the program, which ends next
+        try:
+            return _main(argv)
+        except KeyboardInterrupt:
+            return interrupted()
+    return INTERRUPTED  # pragma: no cover - a Ctrl-C after the command's own `except` (see catching_interrupts)
+
+
+def _main(argv) -> int:
+    from ..errors import SatmdError
+
+    parser = build_parser()  # imports every command, and with them numpy and scipy: under the Ctrl-C handling
     try:
         args = parser.parse_args(argv)
     except SystemExit as exc:  # --help, --version or a usage error, already printed by argparse
@@ -79,13 +93,12 @@ def main(argv=None) -> int:
         if not (isinstance(missing, ModuleNotFoundError) and (missing.name or "").split(".")[0] in _EXTRAS):
             raise
         return _refuse(args.command, str(exc))
-    except KeyboardInterrupt:
-        print("satmd: interrupted", file=sys.stderr)
-        return 130
 
 
 def _blame(args, message: str) -> str:
     """A refusal that names neither an input file nor an option is about the input: name it in front."""
+    from pathlib import Path
+
     inputs = []
     for key in ("data", "recording", "model"):
         value = getattr(args, key, None)

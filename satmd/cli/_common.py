@@ -16,6 +16,7 @@ from ..validation import Interval
 from ..conventions import DEFAULT_FREE
 from ..errors import FormatError, SatmdError
 from ..physics import Rig, effect
+from ._ranges import check_element_range, check_rig_scale  # noqa: F401 - the commands take them from here
 
 # Upper bounds that keep memory bounded (one place: satmd.io.limits); refused up front with the number asked for.
 from ..io.limits import MAX_FREQ_POINTS, MAX_SAMPLES  # noqa: E402,F401 - the commands import them from here
@@ -283,6 +284,8 @@ def add_rig_options(parser: argparse.ArgumentParser, names=DEFAULT_FREE):
 
 def rig_from_args(args, names=DEFAULT_FREE) -> Rig:
     changes = {n: getattr(args, n) for n in names if getattr(args, n, None) is not None}
+    for n, x in changes.items():
+        check_rig_scale(f"--{n} {x:g}", n, x)
     try:
         return Rig().replace(**changes).validate()
     except ValueError as exc:  # name the option: "--m2 -1: rig parameter m2 must be > 0"
@@ -304,13 +307,14 @@ def add_data_options(parser: argparse.ArgumentParser):
 
 
 from ._recording import add_recording_options, load_recording_args  # noqa: E402,F401 - shared by the commands
-
-
 from ._text import cli_text, one_line_warnings, safe_text, with_flags  # noqa: E402,F401 - shared by the commands
 
 
 def load_data(args):
     """Load DATA with the --band, --map and --freq-axis options applied.
+
+    ``args.band_flag``, when set, is what the command calls its --band option
+    (``tune``: ``--data-band``), so that refusals name the option as typed.
 
     A time recording is turned into FRFs with `satmd.io.estimate_frf`'s
     defaults (a note on stderr says so; `satmd estimate-frf` gives control).
@@ -320,7 +324,8 @@ def load_data(args):
     command = getattr(args, "command", None) or "satmd"
     if getattr(args, "plot", None):  # every output is checked before the first piece of work
         check_outputs([("--plot", args.plot, plot_suffixes())], inputs=[args.data])
-    lo, hi = parse_band(getattr(args, "band", None))
+    flag = getattr(args, "band_flag", None) or "--band"  # the option as the command calls it (tune: --data-band)
+    lo, hi = parse_band(getattr(args, "band", None), flag)
     with one_line_warnings(command):
         if is_recording(args.data):
             rec = load_recording_args(args, args.data)
@@ -351,9 +356,9 @@ def load_data(args):
     try:
         banded = data.band(lo, hi)
     except SatmdError as exc:
-        raise SatmdError(f"--band {args.band}: {exc} in {safe_text(args.data)}") from None
+        raise SatmdError(f"{flag} {args.band}: {exc} in {safe_text(args.data)}") from None
     if len(banded) < MIN_POINTS:
-        raise SatmdError(f"--band {args.band}: leaves {len(banded)} frequency point(s) of {safe_text(args.data)}; "
+        raise SatmdError(f"{flag} {args.band}: leaves {len(banded)} frequency point(s) of {safe_text(args.data)}; "
                          f"the fitting commands need at least {MIN_POINTS}")
     return banded
 

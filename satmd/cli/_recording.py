@@ -19,11 +19,32 @@ def load_recording_args(args, path):
     from ..io import load_recording
     from ..io.excitation import detect_excitation, with_excitation
 
-    rec = load_recording(path, channel_map=getattr(args, "map", None), fs_hz=getattr(args, "fs", None))
-    if "force" not in rec.channels:
-        return rec
-    exc = detect_excitation(rec, getattr(args, "excitation", "auto") or "auto", getattr(args, "period_s", None))
+    from ..errors import SatmdError
+
+    try:
+        rec = load_recording(path, channel_map=getattr(args, "map", None), fs_hz=getattr(args, "fs", None))
+        if "force" not in rec.channels:
+            return rec
+        exc = detect_excitation(rec, getattr(args, "excitation", "auto") or "auto", getattr(args, "period_s", None))
+    except SatmdError as err:
+        text = as_typed(str(err))
+        raise SatmdError(text if str(path) in text else f"{path}: {text}") from None
     return with_excitation(rec, exc)
+
+
+#: the library's names for what the command line calls its options
+TYPED = {"(period_s)": "(--period-s)", "(fs_hz)": "(--fs)", "a channel map ": "--map ",
+         "period_s / ": "--period-s / ", "period_s = ": "--period-s ", "a sample rate applies to": "--fs applies to"}
+
+
+def as_typed(message: str) -> str:
+    """A library message with the options named as the user types them."""
+    import re
+
+    for name, flag in TYPED.items():
+        message = message.replace(name, flag)
+    message = re.sub(r"(^|: )map\b", r"\1--map", message)
+    return re.sub(r"(^|: )excitation '(\w+)' given", r"\1--excitation \2 given", message)
 
 
 def _positive(text):

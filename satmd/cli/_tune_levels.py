@@ -12,10 +12,13 @@ every level and reports what the low-level linear tuning costs.
 """
 from __future__ import annotations
 
+import math
+
 from ..errors import DataError
-from ._common import dumps_json, one_line_warnings, parse_kv, parse_list, parse_number
+from ._common import check_element_range, dumps_json, one_line_warnings, parse_kv, parse_list, parse_number
 
 MAX_LEVELS = 12  # each level is one batched direct simulation per candidate grid (~1 s each)
+MAX_LEVEL_N = 1e12  # the most force RMS a level may ask for (as `satmd simulate --level`)
 
 
 def parse_levels(text: str) -> list[float]:
@@ -33,9 +36,10 @@ def parse_levels(text: str) -> list[float]:
     if not items:
         raise DataError("--levels: give drive levels (force RMS in N), e.g. --levels 1,4,10")
     levels = [parse_number(x, "--levels") for x in items]
-    bad = [x for x in levels if not x > 0 or x != x or x == float("inf")]
+    bad = [x for x in levels if not 0 < x <= MAX_LEVEL_N]
     if bad:
-        raise DataError(f"--levels {text}: every level must be a finite force RMS > 0 N, got {bad[0]:g}")
+        raise DataError(f"--levels {text}: every level must be a force RMS > 0 N, at most {MAX_LEVEL_N:g} N; "
+                        f"got {bad[0]:g}")
     if len(levels) > MAX_LEVELS:
         raise DataError(f"--levels {text}: at most {MAX_LEVELS} levels")
     return sorted(set(levels))
@@ -57,9 +61,11 @@ def _element(text: str, fitted: bool):
         raise DataError(f"--nonlinear {text!r}: with --rig give the element's parameters, e.g. "
                         "cubic_absorber_spring:k3=2e11")
     try:
-        return nonlinear_element(name, **parse_kv(kv, f"--nonlinear {name}"))
+        element = nonlinear_element(name, **parse_kv(kv, f"--nonlinear {name}"))
+        check_element_range(f"--nonlinear {text}", element)
     except (TypeError, ValueError) as exc:
-        raise DataError(f"--nonlinear {text!r}: {exc}") from None
+        raise DataError(str(exc) if str(exc).startswith("--nonlinear") else f"--nonlinear {text!r}: {exc}") from None
+    return element
 
 
 def run_levels(args, band, model_rig, files) -> int:
@@ -111,6 +117,10 @@ def run_levels(args, band, model_rig, files) -> int:
         rig = model_rig(args)
         elements = [_element(t, fitted=False) for t in args.nonlinear]
     result = tune_nonlinear(rig, elements, levels, band, output=args.output)
+    if not all(math.isfinite(x) for x in (result.worst_db, *result.peaks_db)):  # the integrator overflowed
+        raise DataError(f"--levels {args.levels} with --nonlinear {args.nonlinear[0]}: the direct simulation is not "
+                        "finite (the element is too strong at these drive levels); lower --levels or weaken the "
+                        "element")
     if args.json:
         doc = {"schema": "satmd-tune-levels/1", **result.to_dict()}
         if fit is not None:

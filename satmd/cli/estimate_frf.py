@@ -1,14 +1,16 @@
 """satmd estimate-frf: FRFs (or transmissibilities) with coherence and std from a time recording."""
 from __future__ import annotations
 
+import re
 import sys
 from pathlib import Path
 
 import numpy as np
 
+from ..conventions import DEFAULT_FREE
 from ..errors import SatmdError
 from ..io.atomic import all_or_none
-from ._common import (add_recording_options, add_rig_options, check_outputs, integer, one_line_warnings, parse_band, parse_kv, plot_suffixes,
+from ._common import (add_recording_options, add_rig_options, check_outputs, integer, real, one_line_warnings, parse_band, parse_kv, plot_suffixes,
                       rig_from_args, safe_text)
 
 
@@ -29,12 +31,12 @@ def register(sub):
     p.add_argument("--estimator", default=None, choices=("lpm", "H1", "H2"),
                    help="lpm: local polynomial method (default); Welch H1: noise on the responses; Welch H2: "
                         "noise on the force")
-    p.add_argument("--width", type=float, default=None, metavar="HZ",
+    p.add_argument("--width", type=real(0, 1e6, lo_open=True), default=None, metavar="HZ",
                    help="lpm: width of each local window in Hz (default 0.3, narrower for sharper resonances)")
     p.add_argument("--nperseg", type=integer(8), default=None, metavar="N",
                    help="Welch: samples per segment (default: ≈0.5 Hz resolution, at least 16 averages)")
     p.add_argument("--window", default=None, help="Welch: window (any scipy.signal.get_window name; default hann)")
-    p.add_argument("--overlap", type=float, default=None, help="Welch: segment overlap fraction (default 0.5)")
+    p.add_argument("--overlap", type=real(0, 1, hi_open=True), default=None, help="Welch: segment overlap fraction (default 0.5)")
     p.add_argument("--band", default=None, metavar="LO:HI", help="keep only LO <= f <= HI Hz")
     p.add_argument("--map", default=None, metavar="force=#1,a1=NODE:DIR,a2=#3",
                    help="which UFF records / WAV channels / .mat or .npz variables (Name or Name[row]) are force, "
@@ -72,11 +74,23 @@ def _run(args):
         raise SatmdError(f"{', '.join(given)}: Welch settings, they do not apply to --estimator lpm")
     out = Path(args.out)
     with one_line_warnings("estimate-frf"):
-        rec = load_recording(args.recording, channel_map=args.map, scale=scale, fs_hz=args.fs)
+        try:
+            rec = load_recording(args.recording, channel_map=args.map, scale=scale, fs_hz=args.fs)
+        except SatmdError as exc:
+            raise SatmdError(_as_typed(str(exc))) from None
         options = dict(nperseg=args.nperseg, window=args.window, overlap=args.overlap, band=band)
         if rec.has_force:
-            data = estimate_frf(rec, estimator=args.estimator, width_hz=args.width, excitation=args.excitation,
-                                period_s=args.period_s, **options)
+            overlay = [f"--{n}" for n in DEFAULT_FREE if getattr(args, n, None) is not None]
+            if overlay:
+                raise SatmdError(f"{', '.join(overlay)}: the model overlay applies to the transmissibility of an "
+                                 f"output-only recording; {safe_text(args.recording)} has a force")
+            try:
+                data = estimate_frf(rec, estimator=args.estimator, width_hz=args.width, excitation=args.excitation,
+                                    period_s=args.period_s, **options)
+            except SatmdError as exc:
+                text = _as_typed(str(exc))
+                where = safe_text(args.recording)
+                raise SatmdError(text if text.startswith(where) else f"{where}: {text}") from None
             save_frf(data, out)
             kind = f"FRFs {', '.join(data.channels)}"
             freq, coh = data.freq_hz, data.coherence
@@ -122,6 +136,15 @@ def _run(args):
         plot_estimate(freq, curves, coh, args.plot, title=f"{Path(args.recording).name}: {kind}")
         print(f"plot: {args.plot}")
     return 0
+
+
+def _as_typed(message: str) -> str:
+    """A library message about a Welch setting, naming the option as typed (``nperseg`` -> ``--nperseg``)."""
+    from ._recording import as_typed
+
+    for name in ("nperseg", "window", "overlap"):
+        message = re.sub(rf"(^|: ){name}\b", rf"\1--{name}", message, count=1)
+    return as_typed(message)
 
 
 LOW_COHERENCE = 0.5  # a median ordinary coherence below this: mostly noise, or the wrong channels

@@ -9,6 +9,9 @@ from ._common import Progress, check_outputs, dumps_json, integer
 BACKENDS = ("hybrid", "operon", "skeleton", "pysr", "sindy")
 
 
+MAX_THREADS = 256  # more threads than any machine's cores only wait on each other (and 1e6 aborts)
+
+
 def register(sub):
     p = sub.add_parser("explain", help="explain a trained inverse net: attribution, latent, symbolic distillation",
                        description="Use case III for a model saved by `satmd inverse train`: neural attribution on "
@@ -21,8 +24,8 @@ def register(sub):
     p.add_argument("--backend", default="hybrid", choices=BACKENDS,
                    help="symbolic-regression backend (default hybrid: operon pooled with the skeleton pass; "
                         "pysr needs a Julia runtime)")
-    p.add_argument("--threads", type=integer(1), default=1, metavar="N",
-                   help="threads for the symbolic search (default 1)")
+    p.add_argument("--threads", type=integer(1, MAX_THREADS), default=1, metavar="N",
+                   help=f"threads for the symbolic search, 1..{MAX_THREADS} (default 1)")
     p.add_argument("--quick", action="store_true", help="smaller latent set and shorter symbolic searches")
     p.add_argument("--no-distill", action="store_true", help="skip the symbolic distillation")
     p.add_argument("--quiet", action="store_true", help="no progress lines on stderr")

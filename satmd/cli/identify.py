@@ -2,8 +2,12 @@
 from __future__ import annotations
 
 from ..conventions import DEFAULT_FREE
+from ..errors import SatmdError
 from ._common import (add_data_options, add_model_options, dumps_json, load_data, one_line_warnings, parse_effect,
                       parse_kv, parse_list, real)
+
+
+MAX_REG = 1e6  # the prior then outweighs the data a million times: the fit is the start (beyond, it overflows)
 
 
 def register(sub):
@@ -15,7 +19,8 @@ def register(sub):
     p.add_argument("--init", default=None, metavar="m2=0.3,...", help="start values (also the nominal values)")
     p.add_argument("--effect", action="append", default=[], metavar="NAME:key=value,...",
                    help="include a known effect in the model (repeatable)")
-    p.add_argument("--reg", type=real(0), default=0.0, help="λ_reg of paper eq. 13 (default 0: unbiased)")
+    p.add_argument("--reg", type=real(0, MAX_REG), default=0.0,
+                   help=f"λ_reg of paper eq. 13, 0..{MAX_REG:g} (default 0: unbiased)")
     p.add_argument("--local", action="store_true", help="skip the global search (start from --init only)")
     p.add_argument("--ci", action="store_true", help="also compute 95 %% profile-likelihood intervals")
     p.add_argument("--json", action="store_true", help="print the result as JSON only")
@@ -33,8 +38,14 @@ def run(args):
     effects = [parse_effect(e) for e in args.effect]
     start = parse_kv(args.init, "--init") if args.init else None
     with one_line_warnings("identify"):  # poor fit / pinned: on stderr with --json (the report lists them)
-        fit = identify(data, free=free, channels=channels, effects=effects, start=start, reg=args.reg,
-                       global_search=not args.local, warn=bool(args.json))
+        try:
+            fit = identify(data, free=free, channels=channels, effects=effects, start=start, reg=args.reg,
+                           global_search=not args.local, warn=bool(args.json))
+        except SatmdError as exc:  # the library's start values are the command line's --init
+            text = str(exc)
+            if not (start and "start " in text and "outside the bounds" in text):
+                raise
+            raise SatmdError("--init " + text[text.index("start ") + len("start "):]) from None
     if args.plot:
         from ..plots import fit_figure, save
 

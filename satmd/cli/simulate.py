@@ -11,6 +11,7 @@ from ._common import (
     MAX_SAMPLES,
     SEED,
     add_rig_options,
+    check_element_range,
     check_outputs,
     OptionGroup,
     option_defaults,
@@ -136,15 +137,25 @@ def run_time(args, rig, effects):
     lo, hi = parse_band(args.force_band, "--force-band")
     if lo is None or hi is None:
         raise SatmdError(f"--force-band {args.force_band!r}: expected LO:HI in Hz")
+    if not 0 < lo < hi < args.fs / 2:  # the simulator's condition, in the options' names
+        raise SatmdError(f"--force-band {args.force_band} must lie inside (0, --fs/2 = {args.fs / 2:g}) Hz: "
+                         "raise --fs or narrow --force-band")
     n = args.duration * args.fs
     if n > MAX_SAMPLES:
         raise SatmdError(f"--duration {args.duration:g} s at --fs {args.fs:g} Hz is {n:.3g} samples per channel; "
                          f"at most {MAX_SAMPLES} (e.g. --duration {MAX_SAMPLES // args.fs:g})")
-    from ..io.limits import check_memory
+    from ..io.limits import check_memory, memory_budget
     from ..io.timesim import recording_memory
 
     check_memory(f"--fs {args.fs:g} Hz for --duration {args.duration:g} s",
-                 recording_memory(args.duration, args.fs, args.burn_in), "lower --fs or --duration")
+                 recording_memory(args.duration, args.fs), "lower --fs or --duration")
+    if args.burn_in:  # simulated ahead of the record, as many samples a second: its own limit, under its own name
+        # samples left beside the record's: the simulator's limit, and memory at 400 bytes a sample (recording_memory)
+        room = min(MAX_SAMPLES - n, (memory_budget() - recording_memory(args.duration, args.fs)) / 400.0)
+        if args.burn_in * args.fs > room:
+            raise SatmdError(f"--burn-in {args.burn_in:g} s: {args.burn_in * args.fs:.3g} samples ahead of the "
+                             f"record at --fs {args.fs:g} Hz; at most {max(room, 0) / args.fs:.3g} s beside "
+                             f"--duration {args.duration:g} s (a few seconds let the rig's response settle)")
     check_outputs([("-o", args.out, tuple(sorted(RECORDING_WRITERS)))])
     if args.nonlinear or args.excitation == "multisine" or args.level is not None:
         return run_nonlinear(args, rig, effects, noise, (lo, hi))
@@ -174,10 +185,27 @@ def run_nonlinear(args, rig, effects, noise, band):
             elements.append(nonlinear_element(name, **(parse_kv(kv, f"--nonlinear {name}") if kv else {})))
         except (TypeError, ValueError) as exc:
             raise SatmdError(f"--nonlinear {text!r}: {exc}") from None
-    rec = simulate_nonlinear_recording(rig, elements, level, args.duration, args.fs, band,
-                                       noise=noise[0] if noise else 0.0, force_noise=args.force_noise, seed=args.seed,
-                                       excitation=args.excitation, periods=args.periods or 3,
-                                       realisations=args.realisations or 4, effects=effects)
+        check_element_range(f"--nonlinear {text}", elements[-1])
+    for flag, value in (("--periods", args.periods), ("--realisations", args.realisations)):
+        if value is not None and value < 1:
+            raise SatmdError(f"{flag} {value}: must be >= 1")
+    if args.excitation == "multisine":  # a period of at least 16 samples (satmd.simulation_nonlinear)
+        periods, realisations = args.periods or 3, args.realisations or 4
+        if args.duration * args.fs / (periods * realisations) < 16:
+            raise SatmdError(f"--realisations {realisations} x --periods {periods} do not fit in --duration "
+                             f"{args.duration:g} s at --fs {args.fs:g} Hz (each period needs 16 samples or more); "
+                             f"at most {int(args.duration * args.fs // 16)} periods in all")
+    try:
+        rec = simulate_nonlinear_recording(rig, elements, level, args.duration, args.fs, band,
+                                           noise=noise[0] if noise else 0.0, force_noise=args.force_noise,
+                                           seed=args.seed, excitation=args.excitation, periods=args.periods or 3,
+                                           realisations=args.realisations or 4, effects=effects)
+    except SatmdError as exc:  # the integrator overflowed: name what the user can change
+        if not elements or "NaN or infinite" not in str(exc):
+            raise
+        raise SatmdError(f"--nonlinear {' --nonlinear '.join(args.nonlinear)} at --level {level:g} N: the simulated "
+                         "response is not finite (the element is too strong at this drive level); lower --level "
+                         "or weaken the element") from None
     save_recording(rec, args.out)
     print(f"wrote {args.out} ({rec.n_samples} samples at {rec.fs_hz:g} Hz = {rec.duration_s:g} s, level "
           f"{level:g} N RMS, {', '.join(e.name for e in elements) or 'linear'}, {args.excitation} force)")

@@ -7,9 +7,9 @@ import warnings
 from pathlib import Path
 
 from ..conventions import DEFAULT_FREE
-from ..errors import DataError
-from ._common import (check_outputs, name_list, dumps_json, load_data, one_line_warnings, parse_effect, parse_kv, parse_list,
-                      parse_number, plot_suffixes)
+from ..errors import DataError, SatmdError
+from ._common import (check_outputs, check_rig_scale, name_list, dumps_json, load_data, one_line_warnings, parse_effect,
+                      parse_kv, parse_list, parse_number, plot_suffixes, safe_text)
 
 _DATA_TYPES = (".csv", ".uff", ".unv", ".mat", ".npz", ".txt", ".wav")
 
@@ -93,9 +93,14 @@ def run(args):
             return _finish(args, result)
         try:
             result = tune(_identified(args, series[0]), force=args.force, **options)
-        except DataError as exc:  # the library names its keyword; the command line names its option
-            raise DataError(str(exc).replace("force=True", "--force")) from None
+        except SatmdError as exc:  # the library names its keyword; the command line names its option and the file
+            raise DataError(_naming(files[0], str(exc).replace("force=True", "--force"))) from None
     return _finish(args, result)
+
+
+def _naming(path, message: str) -> str:
+    """``message`` about the data of ``path``, with the file named in front unless it already is."""
+    return message if str(path) in message or path.name in message else f"{safe_text(path)}: {message}"
 
 
 def _finish(args, result):
@@ -153,18 +158,16 @@ def _tune_options(args) -> dict:
 
 
 MAX_DRAWS = 4096  # about 4 minutes of robust tuning (55 s per 1000 draws, measured)
-SCALE = 1e6  # rig values within a factor 1e6 of the paper's rig: beyond, the optimiser's numbers overflow
 GRID_BYTES = 1.5e5  # memory per frequency of the tuning grid (measured: --band 1e-6:200, 4779 points, 670 MB)
 
 
 def _check_scale(where, name, x):
-    """A rig value (or bound, current setting, std) within a factor `SCALE` of the paper's rig."""
-    from ..physics import Rig
-
-    ref = Rig().as_dict().get(name)
-    if ref and x != 0 and not (abs(ref) / SCALE <= abs(x) <= abs(ref) * SCALE):
-        raise DataError(f"{where}: {x:g} is more than a factor {SCALE:g} from the paper's {name} = {ref:g}; "
-                        "check the unit (SI)")
+    """A rig value (or bound, current setting, std) within a factor `RIG_SCALE` of the paper's rig (the
+    optimiser's numbers overflow beyond): `satmd.cli._ranges.check_rig_scale`, one rule for every command."""
+    try:
+        check_rig_scale(where, name, x)
+    except SatmdError as exc:
+        raise DataError(str(exc)) from None
 
 
 def _check_work(args, band):
@@ -212,8 +215,8 @@ def data_files(items) -> list[Path]:
 
 
 def _load(args, path):
-    ns = argparse.Namespace(data=str(path), band=args.data_band, map=args.map, freq_axis=args.freq_axis,
-                            command="tune")
+    ns = argparse.Namespace(data=str(path), band=args.data_band, band_flag="--data-band", map=args.map,
+                            freq_axis=args.freq_axis, command="tune")
     return load_data(ns)
 
 

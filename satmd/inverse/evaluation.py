@@ -26,7 +26,8 @@ def evaluate(model, test: InverseDataset | None = None, noise: float = 0.0, seed
     Returns
     -------
     dict : predictions, MAE / relative / max error and 2σ coverage per output,
-        mean relative FRF error, inference seconds per FRF.
+        mean relative FRF error, inference seconds per FRF. A model that gives
+        no std (``R_std`` NaN, see `InverseModel.predict`) has coverage NaN.
     """
     test = pairs_dataset(BLIND_PAIRS, freq_hz=model.freq_hz, rig=model.rig) if test is None else test
     datas = noisy_inputs(test, noise, seed)
@@ -44,8 +45,10 @@ def evaluate(model, test: InverseDataset | None = None, noise: float = 0.0, seed
         out[f"mae_{k}"] = float(np.mean(np.abs(err)))
         out[f"rel_{k}"] = float(np.mean(np.abs(err) / np.abs(truth[k])))
         out[f"max_{k}"] = float(np.max(np.abs(err)))
+        # no std (NaN: a one-member ensemble), no coverage: never an error divided by a std of 0
         out[f"coverage_{k}"] = float(np.mean(np.abs(err) <= 2 * sd)) if np.all(np.isfinite(sd)) else float("nan")
-    out["coverage"] = float(np.nanmean([out["coverage_R"], out["coverage_L"]]))
+    known = [c for c in (out["coverage_R"], out["coverage_L"]) if np.isfinite(c)]
+    out["coverage"] = float(np.mean(known)) if known else float("nan")
     clean = np.stack([test.a1, test.a2], axis=1)
     out["frf_error"] = float(np.mean(model.reconstruction_error(clean, pred)))
     return out

@@ -250,7 +250,7 @@ def check_message(check: dict, R, L, rig: Rig | None) -> str | None:
 MAX_STD_SCALE = 1e3  # a calibration factor beyond this: the ensemble had no spread of its own to calibrate
 
 
-def trust_check(out: dict, bounds: dict, std_scale) -> str | None:
+def trust_check(out: dict, bounds: dict, no_std: str | None = None) -> str | None:
     """Keep every std finite and >= 0 and withdraw ``explained`` where the std says nothing; returns a note or None.
 
     Parameters
@@ -260,19 +260,26 @@ def trust_check(out: dict, bounds: dict, std_scale) -> str | None:
         ``explained``; updated in place.
     bounds : dict
         ``{"R": (lo, hi), "L": (lo, hi)}`` of the training box.
-    std_scale : array (2,)
-        The model's std calibration factors for R and L.
+    no_std : str or None
+        Why the model gives no std at all (`NetStrategy.no_std`: a one-member
+        ensemble, or a calibration factor beyond `MAX_STD_SCALE`, both a
+        spread the ensemble does not have), or None. When given, ``R_std`` and
+        ``L_std`` are NaN (no std, rather than 0 or 1e10, numbers that mean
+        nothing) and ``explained`` is false: nothing says how far to trust R, L.
 
     Returns
     -------
     str or None
-        Why some predictions are not to be trusted: a std that is not finite
-        (set to the box width), one as wide as the whole box, or a model whose
-        calibration factor exceeds `MAX_STD_SCALE` (badly trained: too few
-        members or epochs).
+        Why some predictions are not to be trusted: no std (``no_std``), a std
+        that is not finite (set to the box width), or one as wide as the whole box.
     """
     notes, distrust = [], None
-    for k, name in enumerate(("R", "L")):
+    if no_std:
+        for name in ("R", "L"):
+            out[f"{name}_std"] = np.full(np.shape(out[name]), np.nan)
+        notes.append(f"no std: {no_std}")
+        distrust = np.ones(np.shape(out["R"]), dtype=bool)
+    for name in () if no_std else ("R", "L"):
         span = float(bounds[name][1] - bounds[name][0])
         s = np.asarray(out[f"{name}_std"], dtype=float)
         bad = ~np.isfinite(s) | (s < 0)
@@ -285,11 +292,6 @@ def trust_check(out: dict, bounds: dict, std_scale) -> str | None:
             notes.append(f"{name}_std {float(np.max(s)):.3g} spans the whole training box ({span:g})")
         distrust = wide if distrust is None else distrust | wide
     assert distrust is not None  # set for R and L
-    scale = float(np.max(np.asarray(std_scale, dtype=float)))
-    if scale > MAX_STD_SCALE:
-        notes.append(f"the model's std calibration factor is {scale:.3g}: its ensemble has no spread of its own "
-                     "(too few members or epochs), so its std means nothing; retrain it")
-        distrust = np.ones_like(distrust)
     residual = np.asarray(out.get("residual", 0.0), dtype=float)
     if not np.all(np.isfinite(residual)):
         notes.append("the forward check is not finite (the model's rig cannot be computed)")

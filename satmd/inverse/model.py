@@ -296,7 +296,7 @@ class InverseModel:
 
         Returns
         -------
-        dict of arrays
+        dict of arrays (std NaN where it would mean nothing, one member: a `DataWarning` says why)
         """
         import warnings
 
@@ -312,8 +312,8 @@ class InverseModel:
             message = check_message(out, out["R"], out["L"], self.rig_or_default)
             if message:
                 warnings.warn(message, DataWarning, stacklevel=2)
-        # std finite, >= 0 and saying something (the optimization kind has no calibration: factors 1)
-        message = trust_check(out, self.bounds, getattr(self, "std_scale_", np.ones(2)))
+        # std finite, >= 0 and saying something, or none (NaN) with the reason (a one-member ensemble)
+        message = trust_check(out, self.bounds, self._strategy().no_std(self))
         if message:
             warnings.warn(message, DataWarning, stacklevel=2)
         return out

@@ -187,6 +187,24 @@ class NetStrategy:
         mean, sd = net_predict(model, inputs.a, inputs.std)
         return {"R": mean[:, 0], "L": mean[:, 1], "R_std": sd[:, 0], "L_std": sd[:, 1]}
 
+    def no_std(self, model) -> str | None:
+        """Why this model's predictions come without a std (None: they have one).
+
+        The std is the calibrated spread of the members: one member has no
+        spread, and a calibration factor beyond `satmd.inverse.inputs.MAX_STD_SCALE`
+        scales up a spread the ensemble does not have (0 or 1e10, both meaningless).
+        """
+        from .inputs import MAX_STD_SCALE
+
+        if len(model.networks_) < 2:
+            return ("a one-member ensemble has no spread between members to measure the uncertainty by "
+                    "(train two or more members)")
+        scale = float(np.max(np.asarray(model.std_scale_, dtype=float)))
+        if scale > MAX_STD_SCALE:
+            return (f"the model's std calibration factor is {scale:.3g}: its ensemble has no spread of its own "
+                    "(too few members or epochs); retrain it")
+        return None
+
 
 def member_outputs(model, a, member) -> np.ndarray:
     """Normalised outputs (n, 2) of complex inputs ``a`` (n, 2, F), sample ``i`` from ensemble member ``member[i]``."""
@@ -246,6 +264,10 @@ class OptimizationStrategy:
     def predict(self, model, inputs) -> dict:
         return least_squares(model, inputs.a, inputs.std, None)
 
+    def no_std(self, model) -> str | None:
+        """None: the least-squares standard errors are the std."""
+        return None
+
 
 class HybridStrategy(NetStrategy):
     """The physics net's prediction refined by a few least-squares steps (no global search)."""
@@ -261,6 +283,10 @@ class HybridStrategy(NetStrategy):
     def predict(self, model, inputs) -> dict:
         mean, _ = net_predict(model, inputs.a, inputs.std)
         return least_squares(model, inputs.a, inputs.std, mean)
+
+    def no_std(self, model) -> str | None:
+        """None: the refinement's least-squares standard errors are the std, whatever the ensemble."""
+        return None
 
 
 STRATEGIES: dict[str, NetStrategy | OptimizationStrategy] = {

@@ -82,7 +82,7 @@ SCHEMA = {
     "measurement": _findings,
     "window": _text,
     "nperseg": _number(1, 1e12, integer=True),
-    "kernel_rms_hz": _number(0, MAX_HZ),
+    "kernel_rms_hz": lambda v: None if v is None else _number(0, MAX_HZ)(v),  # None: an untapered window
     "overlap": _number(0, 1),
     "segments": _number(1, 1e12, integer=True),
     "resolution_hz": _number(0, MAX_HZ, lo_open=True),

@@ -172,7 +172,10 @@ def detect_excitation(recording, kind: str = "auto", period_s: float | None = No
     if kind == "random":
         return Excitation("random", False, fs)
     if kind == "impact":
-        hits = find_hits(x, fs, detected=False)
+        try:
+            hits = find_hits(x, fs, detected=False)
+        except DataError as why:
+            raise DataError(f"excitation 'impact' given, but {why}") from None
         if hits is None:
             raise DataError("excitation 'impact' given, but the force holds no pulse that stands out "
                             "(no sample above a tenth of the peak is separated from the rest)")
@@ -269,14 +272,14 @@ def _periodic(x, fs, outs, detected: bool):
 def _periodic_given(x, fs, outs, period_s):
     period = int(round(period_s * fs))
     if not np.isfinite(period_s) or period_s <= 0 or abs(period - period_s * fs) > 1e-6 * max(period, 1) + 1e-9:
-        raise DataError(f"period {period_s:g} s is not a whole number of samples at {fs:g} Hz "
+        raise DataError(f"period_s = {period_s:g} s is not a whole number of samples at {fs:g} Hz "
                         f"({period_s * fs:g}); give it to the sample")
     if period < 8 or 2 * period > x.size:
-        raise DataError(f"period {period_s:g} s ({period} samples) does not fit twice in the "
+        raise DataError(f"period_s = {period_s:g} s ({period} samples) does not fit twice in the "
                         f"{x.size / fs:g} s record")
     exc = _layout(x, fs, outs, period, False, evidence=f"period {period_s:g} s as given")
     if exc is None:
-        raise DataError(f"the force does not repeat every {period_s:g} s: its periods differ by more than "
+        raise DataError(f"period_s = {period_s:g} s: the force does not repeat with it; its periods differ by more than "
                         f"{100 * PERIODIC_SPREAD:.0f} % of their power (a wrong period?)")
     return exc
 

@@ -48,6 +48,8 @@ def find_hits(x, fs, detected: bool):
     energy = float(np.sum(a[near] ** 2) / max(np.sum(a ** 2), TINY))
     if detected and (duty >= IMPACT_DUTY or energy < IMPACT_ENERGY or not runs):
         return None
+    if duty >= IMPACT_DUTY:
+        raise DataError(f"the force is above a tenth of its peak {100 * duty:.0f} % of the time: not separate hits")
     if not runs:
         return None
     # group pulses: within one ring-down gap they are one hit (several pulses: a double hit)

@@ -250,8 +250,10 @@ def test_std_is_finite_and_a_model_without_spread_is_not_trusted():
 
     out = {"R_std": np.array([np.nan, 1.0]), "L_std": np.array([0.01, 0.01]), "explained": np.array([True, True])}
     with warnings.catch_warnings():
-        note = trust_check(out, {"R": (0.0, 103.0), "L": (0.0, 0.5)}, [1.0, 1.0])
+        note = trust_check(out, {"R": (0.0, 103.0), "L": (0.0, 0.5)})
     assert np.all(np.isfinite(out["R_std"])) and list(out["explained"]) == [False, True] and "R_std" in note
-    out = {"R_std": np.array([1.0]), "L_std": np.array([0.01]), "explained": np.array([True])}
-    assert "calibration" in trust_check(out, {"R": (0.0, 103.0), "L": (0.0, 0.5)}, [1.8e11, 1.0])
-    assert not out["explained"][0]
+    # a model without spread (one member, or a calibration factor of 1.8e11) gives no std, never 0 or 1e10
+    out = {"R": np.array([40.0]), "L": np.array([0.1]), "R_std": np.array([1.0]), "L_std": np.array([0.01]),
+           "explained": np.array([True])}
+    assert "calibration" in trust_check(out, {"R": (0.0, 103.0), "L": (0.0, 0.5)}, "calibration factor 1.8e+11")
+    assert not out["explained"][0] and np.isnan(out["R_std"][0])
