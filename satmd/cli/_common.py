@@ -300,7 +300,8 @@ def add_data_options(parser: argparse.ArgumentParser):
                              "(.csv, .uff, .wav, .npz, .mat; FRFs are then estimated with default settings)")
     parser.add_argument("--band", default=None, metavar="LO:HI", help="use only LO <= f <= HI Hz")
     parser.add_argument("--map", default=None, metavar="a1=NODE:DIR,a2=NODE:DIR",
-                        help="channel mapping for UFF files with more than two responses (or a1=#N: dataset N)")
+                        help="which record/column is which channel: UFF (a1=NODE:DIR or a1=#N), WAV (#N), .mat/.npz "
+                             "(force=Force,a1=Acceleration[2]: a variable or a row), a lab's CSV (a1=Acc wing)")
     parser.add_argument("--freq-axis", default=None, metavar="START:STEP",
                         help="frequency axis in Hz for .txt files of complex values (one per line)")
     add_recording_options(parser)

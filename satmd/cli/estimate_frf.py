@@ -39,8 +39,8 @@ def register(sub):
     p.add_argument("--overlap", type=real(0, 1, hi_open=True), default=None, help="Welch: segment overlap fraction (default 0.5)")
     p.add_argument("--band", default=None, metavar="LO:HI", help="keep only LO <= f <= HI Hz")
     p.add_argument("--map", default=None, metavar="force=#1,a1=NODE:DIR,a2=#3",
-                   help="which UFF records / WAV channels / .mat or .npz variables (Name or Name[row]) are force, "
-                        "a1 and a2")
+                   help="which UFF records / WAV channels / .mat or .npz variables (Name or Name[row]) / CSV columns "
+                        "are force, a1 and a2")
     add_recording_options(p)
     p.add_argument("--scale", default=None, metavar="force=K,acc1=K,...",
                    help="calibration of WAV channels: SI units per stored unit")

@@ -259,8 +259,10 @@ def common_frfs(recordings) -> list:
     from ..io.estimate import estimate_frf
     from ..io.lpm import excited_band
 
-    if all(is_multisine(r) for r in recordings):
-        return [multisine_frf(r) for r in recordings]
+    if all(is_multisine(r) and int(r.meta.get("realisations", 1)) > 1 for r in recordings):
+        return [multisine_frf(r) for r in recordings]  # files that hold several realisations each
+    if all(is_multisine(r) for r in recordings):  # periodic: the estimator of the excitation, at its lines
+        return [estimate_frf(r) for r in recordings]
     bands = [excited_band(r["force"], r.fs_hz)[:2] for r in recordings]
     band = (max(b[0] for b in bands), min(b[1] for b in bands))
     first = estimate_frf(recordings[0], band=band)

@@ -39,18 +39,34 @@ def _is_recording(x) -> bool:
 
 
 def pooled(datas):
-    """Inverse-variance mean of FRFData on one grid (std of the mean)."""
+    """Inverse-variance mean of FRFData on one grid (std of the mean).
+
+    Periodic realisations (``estimator.method`` periodic, three or more) give
+    the best linear approximation: its std is the larger of the noise's and the
+    spread over realisations (noise and the stochastic nonlinear distortion,
+    Pintelon & Schoukens ch. 3), and ``estimator.nonlinear_variance_share``
+    says how much of that spread the noise does not explain.
+    """
     first = datas[0]
-    chans, std = {}, {}
+    k = len(datas)
+    realisations = k >= 3 and all(d.estimator.get("method") == "periodic" for d in datas)
+    chans, std, share = {}, {}, []
     for c in first.channels:
         w = np.stack([1.0 / np.maximum(d.std[c], TINY) ** 2 for d in datas])
         H = np.stack([d.channels[c] for d in datas])
         chans[c] = np.sum(w * H, axis=0) / w.sum(axis=0)
         std[c] = 1.0 / np.sqrt(w.sum(axis=0))
+        if realisations:  # the spread over realisations: per part, of the mean
+            spread = np.sqrt(np.sum(np.abs(H - H.mean(axis=0)) ** 2, axis=0) / (k - 1) / k / 2.0)
+            share.append(float(np.median(np.maximum(spread ** 2 - std[c] ** 2, 0.0) / np.maximum(spread ** 2, TINY))))
+            std[c] = np.maximum(std[c], spread)
     est = dict(first.estimator)
     if "noise_dof" in est and est["noise_dof"]:
-        est["noise_dof"] = float(est["noise_dof"]) * len(datas)
-    est["pooled_records"] = len(datas)
+        est["noise_dof"] = 2.0 * (k - 1) if realisations else float(est["noise_dof"]) * k
+    est["pooled_records"] = k
+    if realisations:
+        est["realisations"] = k
+        est["nonlinear_variance_share"] = round(max(share), 4)
     return replace(first, channels=chans, std=std, correlation={}, estimator=est)
 
 

@@ -48,6 +48,13 @@ def _distortion_tests(recordings, alpha):
     return tests
 
 
+def _few_dof(datas):
+    """The noise dof of periodic or impact estimates (few periods or hits: F, not χ², tests); None otherwise."""
+    if all(d.estimator.get("method") in ("periodic", "impact") and d.estimator.get("noise_dof") for d in datas):
+        return float(min(d.estimator["noise_dof"] for d in datas))
+    return None
+
+
 def _inner(freq, share: float = 0.05):
     """Points of ``freq`` away from its two ends by ``share`` of the span."""
     lo, hi = freq[0], freq[-1]
@@ -62,6 +69,10 @@ def _hint(test: NonlinearTest) -> str:
         parts = ", ".join(f"{c}: odd {d['odd_ratio']:.3g}x, even {d['even_ratio']:.3g}x the noise" for c, d in ratios)
         return f"distortion at {where}; at the detection lines {parts} (odd: a symmetric nonlinearity)"
     expl = test.details.get("explained", {})
+    if test.name.startswith("level_dependence"):
+        return f"the FRFs of the recordings differ beyond their noise at {where}"
+    if not expl:
+        return f"distortion at {where}"
     chans = ", ".join(f"{c} {100 * v:.0f} %" for c, v in expl.items())
     text = f"distortion at {where}; nonlinear functions of the responses explain {chans} of the local residual"
     regs = test.details.get("regressors") or []
@@ -102,6 +113,7 @@ def analyse_recordings(recordings, rig=None, free=DEFAULT_FREE, alpha: float = 1
             inner = _inner(freq)  # the band edges, where the force falls off, carry the estimator's own errors
             lt = level_dependence(freq[inner], [{c: v[inner] for c, v in d.channels.items()} for d in datas],
                                   [{c: v[inner] for c, v in d.std.items()} for d in datas], alpha / 4,
+                                  dof_noise=_few_dof(datas),
                                   model_errors=[{c: np.asarray(v)[inner] for c, v in (d.meta.get("model_error")
                                                                                       or {}).items()}
                                                 for d in datas])

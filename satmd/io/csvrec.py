@@ -1,6 +1,13 @@
 """Recordings as CSV: ``# satmd-recording v1`` (optional), then ``time_s,force,acc1,acc2`` in SI units.
 
 ``force`` may be left out (output-only); sampling must be uniform.
+
+Lab files as their software writes them are read too: a first column that is
+time (``time``, ``t``, ``Time [s]``, ``t (ms)``), channels under the lab's own
+names, any case, with a unit in brackets (``Force [N]``, ``Acc wing (g)``:
+converted to SI). Columns named ``force``/``acc1``/``acc2`` (any case, unit
+aside) are taken by name; otherwise ``channel_map="force=Force,a1=Acc wing"``
+says which column is which.
 """
 from __future__ import annotations
 
@@ -16,13 +23,17 @@ from .recdata import ROLES, SI_UNITS, Recording, uniform_rate, warn_clipping
 CSV_MAGIC = "# satmd-recording v1"
 
 
-def read_recording_csv(path) -> Recording:
-    """A ``time_s,force,acc1,acc2`` CSV (SI units); malformed input names file, line and column."""
+def read_recording_csv(path, channel_map=None) -> Recording:
+    """A ``time_s,force,acc1,acc2`` CSV (SI units) or a lab's CSV; malformed input names file, line and column."""
     path = Path(path)
     text = read_text(path)
     header, header_line, rows, meta = split_csv(path, text, "satmd-recording")
     if header is None:
         raise FormatError(path, "no column header (expected time_s,force,acc1,acc2)")
+    if channel_map or header[0] != "time_s":
+        from .labcsv import read_lab_csv
+
+        return read_lab_csv(path, header, header_line, rows, meta, channel_map)
     _check_header(path, header, header_line)
     if len(rows) < 2:
         raise FormatError(path, f"{len(rows)} data row(s): a recording needs at least 2 samples", line=header_line)
@@ -56,7 +67,8 @@ def write_recording_csv(rec: Recording, path) -> Path:
     if len(names) != len(rec.channels):
         raise DataError(f"CSV recordings hold {', '.join(ROLES)}; rename the other channels first")
     lines = [CSV_MAGIC]
-    lines += [f"# {k}: {v}" for k, v in rec.meta.items() if k != "source" and "\n" not in f"{k}{v}"]
+    lines += [f"# {k}: {v}" for k, v in rec.meta.items()
+              if k not in ("source", "excitation_layout", "steady_periods") and "\n" not in f"{k}{v}"]
     lines.append(",".join(["time_s"] + names))
     table = np.column_stack([rec.time_s] + [rec.channels[n] for n in names])
     lines += [",".join(f"{x:.17g}" for x in row) for row in table]

@@ -78,8 +78,8 @@ def load_recording(path, channel_map=None, scale=None, fs_hz=None) -> Recording:
         Which record or column is which channel, e.g.
         ``"force=#1,a1=1:+Z,a2=2:+Z"`` (UFF), ``"force=#1,a1=#2"`` (WAV) or
         ``"force=Force,a1=Acceleration[2],a2=Acceleration[3]"`` (.mat/.npz: a
-        variable, or a row of a matrix of signals counted from 1); CSV names
-        its columns.
+        variable, or a row of a matrix of signals counted from 1) or
+        ``"force=Force,a1=Acc wing"`` (a lab's CSV columns).
     scale : dict, optional
         ``{channel: SI units per stored unit}`` (e.g. ``{"force": N_per_unit}``)
         for WAV files, which carry no units; WAV only.
@@ -110,7 +110,7 @@ def load_recording(path, channel_map=None, scale=None, fs_hz=None) -> Recording:
         raise FormatError(path, f"unknown recording type {path.suffix!r} (known: {known})")
     options = {}
     if channel_map:
-        if suffix not in (".uff", ".unv", ".wav", ".mat", ".npz"):
+        if suffix not in (".uff", ".unv", ".wav", ".mat", ".npz", ".csv"):
             raise FormatError(path, f"channel_map does not apply to {suffix} recordings (their channels are named)")
         options["channel_map"] = channel_map
     if fs_hz is not None:
@@ -179,10 +179,12 @@ def is_recording(path) -> bool:
         return True
     if suffix == ".csv":
         text = read_text(path)
+        from .labcsv import TIME_NAMES, split_unit
+
         for line in text_lines(text):
             s = line.strip()
             if s and not s.startswith("#"):
-                return s.split(",")[0].strip() == "time_s"
+                return split_unit(s.split(",")[0])[0].lower() in TIME_NAMES
         return False
     if suffix in (".uff", ".unv"):
         from .uff58 import read_records

@@ -236,3 +236,35 @@ def test_one_hit_per_file_is_one_test_of_repeats():
     assert ex["kind"] == "impact" and ex["hits"] == 4
     assert rep.model_adequate and rep.effect_names == []
     assert rep.nonlinear is None or not rep.nonlinear.detected
+
+
+def test_csv_as_a_lab_writes_it(tmp_path):
+    rec = _record(_multisine(1000, 4))
+    t = np.arange(rec.n_samples) / FS * 1e3
+    rows = np.column_stack([t, rec["force"] / 1e3, rec["acc2"] / 9.80665, rec["acc1"] / 9.80665])
+    path = tmp_path / "lab.csv"
+    np.savetxt(path, rows, delimiter=",", header="Time (ms),Force [kN],Acc payload [g],Acc wing [g]", comments="")
+    from satmd.io import is_recording
+
+    assert is_recording(path)
+    with pytest.raises(FormatError, match="channel map"):
+        load_recording(path)
+    got = load_recording(path, channel_map="force=Force,a1=Acc wing,a2=Acc payload")
+    assert got.fs_hz == FS and np.allclose(got["acc1"], rec["acc1"], rtol=1e-6, atol=1e-9)
+    assert np.allclose(got["force"], rec["force"], rtol=1e-6, atol=1e-9)
+    with pytest.raises(FormatError, match="no column 'Acc tail'"):
+        load_recording(path, channel_map="force=Force,a1=Acc tail")
+    named = tmp_path / "named.csv"
+    np.savetxt(named, rows[:, :3], delimiter=",", header="t (ms),FORCE (N),acc1", comments="")
+    assert set(load_recording(named).channels) == {"force", "acc1"}
+
+
+def test_periodic_realisations_give_the_best_linear_approximation():
+    from satmd import discover
+
+    recs = [_record(_multisine(1000, 6, seed=20 + j), noise=0.02, seed=j) for j in range(4)]
+    rep = discover(recs)
+    est = rep.to_dict()["estimator"]
+    assert est["method"] == "periodic" and est["realisations"] == 4
+    assert rep.model_adequate and rep.effect_names == []
+    assert not rep.nonlinear.detected
