@@ -259,8 +259,9 @@ def common_frfs(recordings) -> list:
     from ..io.estimate import estimate_frf
     from ..io.lpm import excited_band
 
-    if all(is_multisine(r) and int(r.meta.get("realisations", 1)) > 1 for r in recordings):
-        return [multisine_frf(r) for r in recordings]  # files that hold several realisations each
+    if all(is_multisine(r) and (int(r.meta.get("realisations", 1)) > 1
+                                or not {"acc1", "acc2"} & set(r.channels)) for r in recordings):
+        return [multisine_frf(r) for r in recordings]  # several realisations in each file, or a generic output
     if all(is_multisine(r) for r in recordings):  # periodic: the estimator of the excitation, at its lines
         return [estimate_frf(r) for r in recordings]
     bands = [excited_band(r["force"], r.fs_hz)[:2] for r in recordings]
