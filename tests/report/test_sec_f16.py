@@ -1,0 +1,17 @@
+"""The report's F-16 section: four real levels, each resonance's trend, no SATMD element (issue 35)."""
+from __future__ import annotations
+
+import pytest
+
+from satmd.report import reproduce
+from satmd.report.sec_f16 import data_dir
+
+
+@pytest.mark.skipif(data_dir() is None, reason="the F-16 files are not in ../shared")
+def test_f16_section_reads_the_levels_and_names_no_element(tmp_path):
+    index = reproduce(tmp_path / "r", only=["f16"], log=lambda *_: None)
+    text = index.read_text()
+    assert "no SATMD element is named" in text and "model adequate: False" in text
+    row = next(line for line in text.splitlines() if line.startswith("| 7.32 Hz"))
+    assert row.rstrip().endswith("| softening | rising |")
+    assert (tmp_path / "r" / "figures" / "f16_levels.png").is_file()
