@@ -181,8 +181,42 @@ def _name_from_levels(datas, rig, free, levels, recordings, cmp=None) -> dict:
     except Exception as exc:  # noqa: BLE001 - the name stands even when the strength cannot be fitted
         params, ci = {}, {}
         text = f"{cls.description}; measured: {moved} (strength not fitted: {exc})"
+    strength = _time_domain_strength(recordings, cls.name, rig)
+    if strength is not None:  # the time-domain fit's coefficient and interval: they cover (issue 36 item 7)
+        params, ci, fitted = strength
+        text = f"{fitted.explain(rig.replace(**{p: nominal}))}; measured: {moved}" if params else text
+    elif params:
+        text += " (strength from the equivalent linearisation, whose own error the interval does not carry)"
     return {"name": cls.name, "parameters": params, "ci95": ci, "equivalent": others,
             "equivalent_linear": eq_lin, "explanation": text, "moving": p, "direction": direction}
+
+
+def _time_domain_strength(recordings, name, rig):
+    """(parameters, ci95, element) from `fit_nonlinear` on the recordings, or None when it cannot run.
+
+    The equivalent linearisation's strength comes with an interval from that fit's noise alone, which
+    misses the linearisation's own error; the time-domain output-error fit does not linearise.
+    """
+    from ..errors import SatmdError
+    from ..identification.nonlinear import fit_nonlinear
+    from ..physics.nonlinear import kernel
+
+    if not kernel.available:  # the numpy integrator is ~100x slower: not inside discover
+        return None
+    import warnings
+
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")  # its internal linear start's notes are not the user's findings
+            fit = fit_nonlinear(recordings, name, rig=rig)
+    except (SatmdError, ArithmeticError, ValueError, np.linalg.LinAlgError):
+        return None
+    names = [k for k in fit.element.params]
+    values = {k: float(fit.values[k]) for k in names if k in fit.values}
+    ci = {k: [float(a) for a in fit.ci95[k]] for k in names if k in fit.ci95}
+    if not values or not all(np.isfinite(v) for v in values.values()):
+        return None
+    return values, ci, fit.element
 
 
 def analyse_frfs(datas, rig=None, free=DEFAULT_FREE, alpha: float = 1e-3, levels=None) -> NonlinearReport:
