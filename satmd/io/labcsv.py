@@ -50,11 +50,11 @@ def read_lab_csv(path, header, header_line, rows, meta, channel_map=None) -> Rec
     if names[0][0].lower() not in TIME_NAMES:
         raise FormatError(path, f"first column must be time_s (or time, t; in s or ms), got {header[0]!r}",
                           line=header_line, column=1)
-    lookup = {}
+    lookup: dict[str, int] = {}
     for j, (name, _) in enumerate(names[1:], start=1):
         lookup.setdefault(name.lower(), j)
         lookup.setdefault(header[j].strip().lower(), j)
-    roles = {}
+    roles: dict[str, int] = {}
     if channel_map:
         for part in str(channel_map).split(","):
             if not part.strip():
@@ -63,13 +63,13 @@ def read_lab_csv(path, header, header_line, rows, meta, channel_map=None) -> Rec
             role = ALIASES.get(role.strip().lower(), role.strip().lower())
             if not eq or role not in ROLES:
                 raise FormatError(path, f"map {part.strip()!r}: write force=COLUMN, a1=COLUMN, a2=COLUMN")
-            j = lookup.get(column.strip().lower())
-            if j is None:
+            found = lookup.get(column.strip().lower())
+            if found is None:
                 raise FormatError(path, f"map {part.strip()}: no column {column.strip()!r}; columns: "
                                         f"{', '.join(header[1:])}")
-            if role in roles or j in roles.values():
+            if role in roles or found in roles.values():
                 raise FormatError(path, f"map: {role} or column {column.strip()!r} given twice")
-            roles[role] = j
+            roles[role] = found
     else:
         for role in ROLES:
             if role in lookup:

@@ -55,7 +55,7 @@ def build(ctx) -> str:
     rep = discover(recs)
     datas = [estimate_frf(r) for r in recs]
     levels = list(rep.nonlinear.levels) if rep.nonlinear is not None else [0.0] * len(recs)
-    finding = next((f for f in (rep.nonlinear.findings if rep.nonlinear is not None else [])), {})
+    finding: dict = next((f for f in (rep.nonlinear.findings if rep.nonlinear is not None else [])), {})
     modes = finding.get("modes", [])
     rows = []
     for m in modes:

@@ -22,9 +22,12 @@ def build(ctx) -> str:
     truth = Rig(m2=0.55, kp=1.2e5, R=30.0, L=0.07)
     element = nonlinear_element("cubic_absorber_spring", k3=K3)
     duration = 12.0 if ctx.quick else 16.0
-    kw = dict(rig=truth, time=True, nonlinear=[element], duration_s=duration, fs_hz=1024.0, noise=0.01)
-    train = [simulate(level=lv, seed=i, **kw) for i, lv in enumerate((1.0, 10.0))]
-    held = simulate(level=4.0, seed=7, **kw)
+    def record(level, seed):
+        return simulate(rig=truth, time=True, nonlinear=[element], duration_s=duration, fs_hz=1024.0, noise=0.01,
+                        level=level, seed=seed)
+
+    train = [record(lv, i) for i, lv in enumerate((1.0, 10.0))]
+    held = record(4.0, 7)
     rep = discover(train)
     nl = rep.nonlinear
     named = [f["name"] for f in nl.findings] if nl is not None else []
