@@ -173,6 +173,7 @@ def _name_from_levels(datas, rig, free, levels, recordings, cmp=None) -> dict:
         return {"name": cls.name, "parameters": {}, "ci95": {}, "equivalent": others, "equivalent_linear": eq_lin,
                 "explanation": f"{cls.description}; measured: {moved} (FRFs only: no force level, no strength)",
                 "moving": p, "direction": direction}
+    nominal = float(fit.per_record[cmp["order"][0]])  # the lowest level's value, until the strength fit says
     try:
         el, ci, nominal, rms = fit_strength(cls, fit.per_record, fit.per_record_std, fit.rigs,
                                             [r["force"] for r in recordings], [r.fs_hz for r in recordings])

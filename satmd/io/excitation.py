@@ -377,9 +377,12 @@ def excited_lines(periods) -> np.ndarray:
     if lines.size < 5:
         return lines
     # a lone line far from the rest (mains pick-up in the force channel) is not part of the design
-    gaps = np.diff(lines) / lines[1:]
-    rel = np.minimum(np.append(gaps, np.inf), np.insert(gaps, 0, np.inf))
-    return lines[rel <= 10.0 * np.median(gaps)]
+    # (far in both senses: a linear grid's low lines are far in relative terms, a log grid's high lines in absolute)
+    steps = np.diff(lines).astype(float)
+    nearest = np.minimum(np.append(steps, np.inf), np.insert(steps, 0, np.inf))
+    relative = nearest / lines
+    lone = (nearest > 10.0 * np.median(steps)) & (relative > 10.0 * np.median(steps / lines[1:]))
+    return lines[~lone]
 
 
 def _random_evidence(x) -> str:

@@ -1,9 +1,11 @@
 """`track_modes`: the modes of fits at several levels followed over the levels, and whether they move.
 
-A mode is matched to the nearest one at the next level up (within a half-power width plus the
-uncertainty of their difference); its frequency and damping move when the change from the lowest
-to the highest level exceeds its combined std, two-sided, at ``alpha`` for all modes and both
-quantities together (Bonferroni).
+A mode is matched to the nearest one at the next level up: within a half-power width plus the
+uncertainty of their difference, or, farther, within `MOVE_SHARE` of the distance to the nearest
+other mode of either fit (and `MAX_MOVE` of its frequency): a lightly damped mode that moves by more
+than its own bandwidth is still the same mode while no other lies near. Its frequency and damping
+move when the change from the lowest to the highest level exceeds its combined std, two-sided, at
+``alpha`` for all modes and both quantities together (Bonferroni).
 """
 from __future__ import annotations
 
@@ -12,6 +14,11 @@ from dataclasses import dataclass
 import numpy as np
 
 from .fit import Z95, Mode
+
+#: A mode may move between levels by this share of the distance to the nearest other mode of either fit ...
+MOVE_SHARE = 0.3
+#: ... and by no more than this share of its frequency.
+MAX_MOVE = 0.1
 
 
 @dataclass(frozen=True)
@@ -76,8 +83,10 @@ def track_modes(fits, levels=None, alpha: float = 0.05) -> list:
     known = [[m for m in fit.modes if np.isfinite(m.f_std) and np.isfinite(m.zeta_std)] for fit in fits]
     tracks = [[m] for m in known[order[0]]]
     for i in order[1:]:
+        last = [t[-1] for t in tracks]
         pairs = sorted((abs(m.f_hz - t[-1].f_hz), a, b) for a, t in enumerate(tracks)
-                       for b, m in enumerate(known[i]) if abs(m.f_hz - t[-1].f_hz) <= _match_tol(t[-1], m))
+                       for b, m in enumerate(known[i])
+                       if abs(m.f_hz - t[-1].f_hz) <= _match_tol(t[-1], m, last, known[i]))
         taken_t, taken_m = set(), set()
         for _, a, b in pairs:
             if a not in taken_t and b not in taken_m:
@@ -98,9 +107,13 @@ def track_modes(fits, levels=None, alpha: float = 0.05) -> list:
     return out
 
 
-def _match_tol(a: Mode, b: Mode) -> float:
+def _match_tol(a: Mode, b: Mode, before=(), after=()) -> float:
+    """How far apart a mode ``a`` of one fit (modes ``before``) and ``b`` of the next (``after``) may be."""
     spread = np.hypot(a.f_std, b.f_std)
-    return max(a.half_power_hz, b.half_power_hz) + (Z95 * spread if np.isfinite(spread) else 0.0)
+    width = max(a.half_power_hz, b.half_power_hz) + (Z95 * spread if np.isfinite(spread) else 0.0)
+    gaps = [abs(m.f_hz - a.f_hz) for m in before if m is not a] + [abs(m.f_hz - b.f_hz) for m in after if m is not b]
+    room = min([MOVE_SHARE * g for g in gaps] + [MAX_MOVE * a.f_hz])
+    return max(width, room)
 
 
 def _direction(change, sd_a, sd_b, threshold, up: str, down: str) -> str:

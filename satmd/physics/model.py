@@ -247,6 +247,12 @@ def frf(
     unknown = [o for o in outputs if o not in CHANNELS]
     if unknown:
         raise DataError(f"unknown output channel(s) {unknown}; known: {', '.join(CHANNELS)}")
+    for i, eff in enumerate(effects):  # a nonlinear element has no frequency-domain form: never ignored silently
+        if not isinstance(eff, Effect) or eff.acts_on == "nonlinear":
+            hint = (": a nonlinear element acts in the time domain (simulate(time=True, nonlinear=[...])); at one "
+                    "level its equivalent linear rig is satmd.physics.nonlinear.equivalent_rig(rig, [element], ...)"
+                    if isinstance(eff, Effect) else "")
+            raise DataError(f"effects[{i}] is {type(eff).__name__}, not a missing-physics effect (SPEC §8){hint}")
     wrt = tuple(wrt or ())
     targets = [resolve_parameter(n, effects) for n in wrt]
 

@@ -135,4 +135,12 @@ def _from_report(model, notes: list):
         source = "nominal model (discovery found no significant mismatch)"
     if UNEXPLAINED in model.effect_names:
         notes.append("part of the mismatch is unexplained by the vocabulary: the tuning cannot account for it")
+    nl = getattr(model, "nonlinear", None)
+    if nl is not None and nl.detected:  # a linear design at one level; the levels call for tune_nonlinear
+        named = [f["name"] for f in nl.findings if f.get("parameters")]
+        how = (f"tune across the drive levels with the named element: satmd.tuning.nonlinear.tune_nonlinear "
+               f"(satmd tune ... --nonlinear {named[0]} --levels ...)" if named else
+               "record the rig at the drive levels it will see and name the element before tuning across them")
+        notes.append(f"discovery detected nonlinearity: this linear design holds at the level of the data it was "
+                     f"fitted to only; {how}")
     return fit, source
