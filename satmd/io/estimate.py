@@ -77,9 +77,18 @@ def estimate_frf(recording: Recording, nperseg: int | None = None, window=None, 
     source, responses = _check_force(recording)
     welch_given = any(v is not None for v in (nperseg, window, overlap))
     exc = detect_excitation(recording, excitation, period_s)
-    if estimator is None and not welch_given and width_hz is None and exc.kind in ("periodic", "impact"):
+    designed = exc.kind in ("periodic", "impact")
+    if exc.kind == "sweep":  # whole transients in the record: no leakage term, however fast the sweep
+        from .sweepfrf import at_rest_at_the_end
+
+        designed = at_rest_at_the_end(recording, responses)
+    if estimator is None and not welch_given and width_hz is None and designed:
         _check_constant(recording, source, responses)
         return _estimate_designed(recording, exc, band)
+    if exc.kind == "sweep" and exc.sweep and not designed:  # cut off mid-sweep: its ends carry the cut's transient
+        lo_s, hi_s = sorted((exc.sweep["f_start_hz"], exc.sweep["f_end_hz"]))
+        band = (max(1.05 * lo_s, band[0] if band and band[0] is not None else 0.0),
+                min(0.95 * hi_s, band[1] if band and band[1] is not None else np.inf))
     method = ("H1" if welch_given else "lpm") if estimator is None else str(estimator)
     if method.lower() == "lpm":
         if welch_given:
@@ -103,6 +112,10 @@ def describe_estimate(data) -> str:
     e = data.estimator
     if not e:
         return ""
+    if e["method"] == "sweep":
+        lo, hi = e["band_hz"]
+        return (f"the whole record's spectra of a sweep at rest at both ends, G fitted locally, {e['points']} "
+                f"independent points {lo:.4g}–{hi:.4g} Hz, noise from {e['noise_dof']:.0f} degrees of freedom")
     if e["method"] in ("periodic", "impact"):
         lo, hi = e["band_hz"]
         how = e.get("excitation", {})
@@ -184,10 +197,23 @@ def _estimate_designed(recording: Recording, exc, band) -> FRFData:
         extra = []
         ref = "Pintelon & Schoukens 2012, periodic excitation: mean over steady periods"
         noise = f"spread over {len(exc.steady)} steady periods"
-    else:
+    elif exc.kind == "impact":
         f, frf, std, coh, dof, extra = impact_frf(recording, exc, responses, band)
         ref = "H1 over hits, force window (ISO 7626-5)"
         noise = f"scatter over {len(exc.hits)} hits" if len(exc.hits) > 1 else "the quiet tail of the one hit"
+    else:
+        from .lpm import excited_band
+        from .sweepfrf import sweep_frf
+
+        lo, hi, _ = excited_band(recording["force"], recording.fs_hz)
+        lo = lo if not band or band[0] is None else max(lo, band[0])
+        hi = hi if not band or band[1] is None else min(hi, band[1])
+        if hi <= lo:
+            raise DataError(f"band {band[0]}:{band[1]} Hz holds nothing of the sweep's {lo:.4g}–{hi:.4g} Hz")
+        f, frf, std, coh, dof = sweep_frf(recording, responses, (lo, hi))
+        extra = []
+        ref = "whole-record spectra of a sweep at rest at both ends, G fitted locally (no leakage term)"
+        noise = "local residual, smoothed over neighbouring windows"
     findings = [x for x in clipping_findings(recording) if exc.kind != "impact"] + excitation_findings(exc) + extra
     floor = 1e-10 * max(np.max(np.abs(h)) for h in frf.values())
     std = {c: np.maximum(v, floor) for c, v in std.items()}

@@ -23,6 +23,7 @@ from .chain import MeasurementFinding
 
 DECAYED = 1e-3  # the response's RMS over a segment's last tenth, as a share of its first tenth: rung down
 FORCE_BAND_DB = 20.0
+SMOOTH = 5  # lines the hit-to-hit noise variance is averaged over
 
 
 def _force_window(x, fs, start, peak, length):
@@ -74,7 +75,10 @@ def impact_frf(recording, excitation, responses, band=None):
     quiet = max((float(np.std(np.asarray(recording[r][:lead], float)))
                  / max(np.sqrt(np.mean(segs[r][:, :tenth] ** 2)), TINY) for r in responses), default=0.0) \
         if lead >= max(16, int(0.05 * fs)) else 0.0
-    if ring > max(DECAYED, 3.0 * quiet):
+    # or its tail has stopped falling: the last tenth no quieter than the one before it, the noise floor
+    flat = min(float(np.sqrt(np.mean(v[:, -tenth:] ** 2)) / max(np.sqrt(np.mean(v[:, -2 * tenth:-tenth] ** 2)), TINY))
+               for v in segs.values()) > 0.8
+    if ring > max(DECAYED, 3.0 * quiet) and not flat:
         tau = L / fs / np.log(1.0 / DECAYED)  # the window falls to DECAYED at the segment's end
         w = np.exp(-np.arange(L) / fs / tau)
         X = np.array([np.fft.rfft(np.fft.irfft(x, L) * w) for x in X])
@@ -113,8 +117,8 @@ def impact_frf(recording, excitation, responses, band=None):
         Y = np.fft.rfft(v, axis=1)
         Sxy = np.sum(Y * np.conj(X), axis=0)
         H = Sxy / np.maximum(Sxx, TINY)
-        if n >= 2:
-            var_y = np.sum(np.abs(Y - H * X) ** 2, axis=0) / (n - 1)
+        if n >= 2:  # smoothed over 5 lines: the sensor noise is smooth in frequency, and few hits give few dof
+            var_y = np.convolve(np.sum(np.abs(Y - H * X) ** 2, axis=0) / (n - 1), np.ones(SMOOTH) / SMOOTH, "same")
         else:  # one hit: the noise of its quiet tail (last quarter), white
             tail = v[0, -max(8, L // 4):]
             var_y = np.full(f.size, L * np.var(tail))
@@ -123,7 +127,7 @@ def impact_frf(recording, excitation, responses, band=None):
         std[ch] = np.sqrt(var_y / np.maximum(Sxx, TINY) / 2.0)[keep]
         Syy = np.sum(np.abs(Y) ** 2, axis=0)
         coh[ch] = np.clip(np.abs(Sxy) ** 2 / np.maximum(Sxx * Syy, TINY), 0.0, 1.0)[keep]
-    dof = 2.0 * (n - 1) if n >= 2 else 2.0 * max(L // 4, 8)
+    dof = 2.0 * (n - 1) * SMOOTH if n >= 2 else 2.0 * max(L // 4, 8)
     return f[keep], frf, std, coh, dof, findings
 
 

@@ -32,7 +32,7 @@ def find_sweep(x, fs, detected: bool):
     z = hilbert(x)
     env = np.abs(z)
     active = env > 0.3 * np.percentile(env, 95)
-    if active.mean() < 0.5:
+    if active.mean() < 0.2:  # a sweep and its ring-down: the sweep may fill only part of the record
         return None
     idx = np.flatnonzero(active)
     i0, i1 = int(idx[0]), int(idx[-1])

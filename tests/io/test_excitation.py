@@ -174,6 +174,21 @@ def test_linear_rig_under_hits_is_not_called_nonlinear():
 
 
 # --- sweeps ---------------------------------------------------------------------------------------------
+def test_a_fast_sweep_at_rest_at_both_ends_is_estimated_without_leakage():
+    from scipy.signal import chirp
+
+    from satmd import discover
+
+    t = np.arange(int(4 * FS)) / FS
+    force = np.where(t < 2.0, chirp(t, 15.0, 2.0, 250.0), 0.0) * np.sin(np.pi * np.clip(t / 2.0, 0, 1)) ** 0.1
+    rec = _record(np.concatenate([force, np.zeros(int(4 * FS))]), noise=0.01, seed=5)
+    data = estimate_frf(rec)
+    assert data.estimator["method"] == "sweep" and data.estimator["excitation"]["kind"] == "sweep"
+    assert 0.8 < _calibration(data) < 1.25  # ~90 Hz/s through resonances a few Hz wide: no smearing
+    rep = discover(rec)
+    assert rep.effect_names == [] and rep.nonlinear is None  # no distortion test for a sweep
+
+
 def test_a_log_sweep_is_recognised_with_its_law():
     from satmd.io.timesim import log_sweep
 

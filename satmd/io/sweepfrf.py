@@ -1,0 +1,82 @@
+"""FRFs of a single swept sine that starts and ends at rest: the whole record's spectra, fitted locally.
+
+When the force and the responses are both whole transients in the record (the rig at rest before the
+sweep and rung down after it), ``Y(k) = G(k) X(k) + N(k)`` holds at every DFT bin with no leakage
+term, however fast the sweep: the transient is the signal. ``G`` is then fitted as a local polynomial
+(degree 2) in non-overlapping windows of 7 bins, ``Y ≈ (g0 + g1 δ + g2 δ²) X``; the residual gives the
+response noise, smoothed over neighbouring windows (it is smooth in frequency), and
+``var(g0) = σ² [(AᴴA)⁻¹]₀₀``. A sweep that has not rung down by the record's end keeps the local
+polynomial method (`satmd.io.lpm`), whose transient term takes the leakage.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from ..conventions import RECORDING_CHANNELS, TINY
+
+RUNG_DOWN = 1e-2  # the responses' RMS over the record's last 2 %, as a share of their loudest 2 %: at rest
+HALF = 3  # window: 2·HALF + 1 bins
+DEGREE = 2
+SMOOTH = 9  # windows the noise variance is averaged over
+
+
+def at_rest_at_the_end(recording, responses) -> bool:
+    """Whether every response has rung down by the record's end (so the record holds whole transients)."""
+    n = recording.n_samples
+    m = max(8, n // 50)
+    for r in responses:
+        y = np.asarray(recording[r], float)
+        blocks = y[: n // m * m].reshape(-1, m)
+        rms = np.sqrt(np.mean((blocks - blocks.mean()) ** 2, axis=1))
+        if rms[-1] > RUNG_DOWN * rms.max():
+            return False
+    return True
+
+
+def sweep_frf(recording, responses, band):
+    """(freq_hz, frf, std, coherence, noise_dof) of a sweep at rest at both ends, over ``band`` (lo, hi) Hz.
+
+    Parameters
+    ----------
+    recording : Recording
+    responses : recording channels (``acc1``, ``acc2``)
+    band : (lo, hi) Hz: the band the force excites
+
+    Returns
+    -------
+    tuple
+        One point per window (independent points): frequencies; per FRF channel the FRF, the std of each
+        of its parts and a local coherence (1 − residual share); the noise degrees of freedom.
+    """
+    fs, n = recording.fs_hz, recording.n_samples
+    x = np.asarray(recording["force"], float)
+    X = np.fft.rfft(x - np.median(x))
+    f = np.fft.rfftfreq(n, 1.0 / fs)
+    width = 2 * HALF + 1
+    lo_k = max(HALF + 1, int(np.ceil(band[0] * n / fs)))
+    hi_k = min(f.size - HALF - 1, int(np.floor(band[1] * n / fs)))
+    centres = np.arange(lo_k, hi_k - HALF, width)
+    idx = centres[:, None] + np.arange(-HALF, HALF + 1)[None, :]  # (W, width)
+    delta = np.arange(-HALF, HALF + 1) / HALF
+    powers = delta[None, :, None] ** np.arange(DEGREE + 1)[None, None, :]  # (1, width, p)
+    A = X[idx][:, :, None] * powers  # (W, width, p)
+    AhA = np.einsum("wkp,wkq->wpq", A.conj(), A)
+    inv = np.linalg.inv(AhA + TINY * np.eye(DEGREE + 1))
+    dof_window = width - DEGREE - 1
+    frf, std, coh = {}, {}, {}
+    for r in responses:
+        y = np.asarray(recording[r], float)
+        Y = np.fft.rfft(y - np.median(y))[idx]  # (W, width)
+        coef = np.einsum("wpq,wkq,wk->wp", inv, A.conj(), Y)
+        resid = Y - np.einsum("wkp,wp->wk", A, coef)
+        s2 = np.sum(np.abs(resid) ** 2, axis=1) / dof_window
+        s2 = np.convolve(s2, np.ones(SMOOTH) / SMOOTH, "same")  # the noise spectrum is smooth
+        ch = RECORDING_CHANNELS[r]
+        frf[ch] = coef[:, 0]
+        std[ch] = np.sqrt(np.maximum(s2 * inv[:, 0, 0].real, 0.0) / 2.0)
+        coh[ch] = np.clip(1.0 - np.sum(np.abs(resid) ** 2, axis=1) / np.maximum(np.sum(np.abs(Y) ** 2, axis=1), TINY),
+                          0.0, 1.0)
+    return f[centres], frf, std, coh, 2.0 * dof_window * SMOOTH
+
+
+__all__ = ["at_rest_at_the_end", "sweep_frf"]
