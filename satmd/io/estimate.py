@@ -188,8 +188,9 @@ def _estimate_lpm(recording: Recording, band, width_hz) -> FRFData:
 def _estimate_designed(recording: Recording, exc, band) -> FRFData:
     """FRFs of a periodic or an impact excitation (`satmd.io.periodic`, `satmd.io.impact`)."""
     from .chain import clipping_findings
-    from .impact import impact_frf
+    from .impact import impact_frf, whole_record_frf
     from .periodic import excitation_findings, periodic_frf
+    from .sweepfrf import at_rest_at_the_end
 
     source, responses = _check_force(recording)
     if exc.kind == "periodic":
@@ -197,6 +198,10 @@ def _estimate_designed(recording: Recording, exc, band) -> FRFData:
         extra = []
         ref = "Pintelon & Schoukens 2012, periodic excitation: mean over steady periods"
         noise = f"spread over {len(exc.steady)} steady periods"
+    elif exc.kind == "impact" and not exc.dropped and at_rest_at_the_end(recording, responses):
+        f, frf, std, coh, dof, extra = whole_record_frf(recording, exc, responses, band)
+        ref = "hits as one transient: the whole record's spectra, force windowed to its pulses, G fitted locally"
+        noise = "local residual, smoothed over neighbouring windows"
     elif exc.kind == "impact":
         f, frf, std, coh, dof, extra = impact_frf(recording, exc, responses, band)
         ref = "H1 over hits, force window (ISO 7626-5)"

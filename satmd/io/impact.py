@@ -44,6 +44,45 @@ def _force_window(x, fs, start, peak, length):
     return seg * w
 
 
+def windowed_force(recording, excitation):
+    """The record's force with every kept hit's pulse windowed (`_force_window`) and zeros between them."""
+    fs, L = recording.fs_hz, excitation.segment_samples
+    out = np.zeros(recording.n_samples)
+    for s, p in excitation.hits:
+        seg = _force_window(recording["force"], fs, s, p, L)
+        out[s:s + seg.size] = seg
+    return out
+
+
+def whole_record_frf(recording, excitation, responses, band=None):
+    """(freq_hz, frf, std, coherence, noise_dof, findings) of hits taken as one transient of the whole record.
+
+    When the rig rests at the record's start and end and no hit was dropped, the responses of all hits
+    superpose: ``Y = G X`` over the whole record with the force windowed to its pulses, and no segment
+    is cut while a response still rings (the leakage of per-hit segments hits too close together).
+    `satmd.io.sweepfrf.sweep_frf` fits G locally, its noise from the local residual.
+    """
+    from .sweepfrf import sweep_frf
+
+    x = windowed_force(recording, excitation)
+    X = np.fft.rfft(x)
+    fs, n = recording.fs_hz, recording.n_samples
+    f = np.fft.rfftfreq(n, 1.0 / fs)
+    power = np.abs(X) ** 2
+    usable = (np.arange(f.size) >= 1) & (f <= 0.8 * fs / 2)
+    smooth = np.convolve(power, np.ones(15) / 15, "same")
+    on = usable & (smooth >= np.max(smooth[usable]) * 10 ** (-FORCE_BAND_DB / 10))
+    idx = np.flatnonzero(on)
+    lo, hi = float(f[idx[0]]), float(f[idx[-1]])
+    if band:
+        lo = lo if band[0] is None else max(lo, band[0])
+        hi = hi if band[1] is None else min(hi, band[1])
+    if hi <= lo:
+        raise DataError(f"the hits excite {f[idx[0]]:.4g}–{f[idx[-1]]:.4g} Hz: nothing left in {band[0]}:{band[1]} Hz")
+    freq, frf, std, coh, dof = sweep_frf(recording, responses, (lo, hi), force=x)
+    return freq, frf, std, coh, dof, []
+
+
 def impact_frf(recording, excitation, responses, band=None):
     """(freq_hz, frf, std, coherence, noise_dof, findings) of an impact recording.
 

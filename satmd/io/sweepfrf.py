@@ -1,4 +1,4 @@
-"""FRFs of a single swept sine that starts and ends at rest: the whole record's spectra, fitted locally.
+"""FRFs of a record that starts and ends at rest (a sweep, or hits): the whole record's spectra, fitted locally.
 
 When the force and the responses are both whole transients in the record (the rig at rest before the
 sweep and rung down after it), ``Y(k) = G(k) X(k) + N(k)`` holds at every DFT bin with no leakage
@@ -33,7 +33,7 @@ def at_rest_at_the_end(recording, responses) -> bool:
     return True
 
 
-def sweep_frf(recording, responses, band):
+def sweep_frf(recording, responses, band, force=None):
     """(freq_hz, frf, std, coherence, noise_dof) of a sweep at rest at both ends, over ``band`` (lo, hi) Hz.
 
     Parameters
@@ -41,6 +41,7 @@ def sweep_frf(recording, responses, band):
     recording : Recording
     responses : recording channels (``acc1``, ``acc2``)
     band : (lo, hi) Hz: the band the force excites
+    force : the force to use instead of the recording's (an impact record's force windowed to its pulses)
 
     Returns
     -------
@@ -49,8 +50,8 @@ def sweep_frf(recording, responses, band):
         of its parts and a local coherence (1 − residual share); the noise degrees of freedom.
     """
     fs, n = recording.fs_hz, recording.n_samples
-    x = np.asarray(recording["force"], float)
-    X = np.fft.rfft(x - np.median(x))
+    x = np.asarray(recording["force"] if force is None else force, float)
+    X = np.fft.rfft(x - np.median(x) if force is None else x)
     f = np.fft.rfftfreq(n, 1.0 / fs)
     width = 2 * HALF + 1
     lo_k = max(HALF + 1, int(np.ceil(band[0] * n / fs)))
