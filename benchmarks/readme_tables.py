@@ -1,6 +1,7 @@
-"""Write the README's result tables and figures from `benchmarks/results/*.json`.
+"""Write the README's and the documentation's result tables and figures from `benchmarks/results/*.json`.
 
-Every number the README reports from a benchmark sits between two markers,
+Every number the README, or a page of the documentation site (`docs/**/*.md`, the results page
+first of all), reports from a benchmark sits between two markers,
 
     <!-- results:NAME -->
     ...generated lines...
@@ -10,8 +11,11 @@ and this script rewrites those regions from the JSON files that the benchmarks
 write (no number in a region is typed by hand). Text outside the markers is
 left alone.
 
-    python benchmarks/readme_tables.py            # rewrite README.md in place
-    python benchmarks/readme_tables.py --check    # exit 1 (and name the regions) if README.md is stale
+    python benchmarks/readme_tables.py            # rewrite README.md and the docs pages in place
+    python benchmarks/readme_tables.py --check    # exit 1 (and name the regions) if one of them is stale
+
+A region ``machine-NAME`` says where the results of `benchmarks/results/NAME.json` come from: the
+script that writes them and the machine it ran on (as the JSON records it).
 
 `tests/test_readme.py` runs the check, so README and results cannot drift:
 after a benchmark writes new JSON, run this script and commit both.
@@ -28,6 +32,16 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[1]
 RESULTS = ROOT / "benchmarks" / "results"
 README = ROOT / "README.md"
+DOCS = ROOT / "docs"
+SCRIPT_OF = {"inverse_training": "inverse", "nonlinear_model_weak": "nonlinear_model"}  # JSON -> script, when named apart
+
+
+def targets() -> list[Path]:
+    """README.md and every Markdown page of the docs site that holds a region (not generated pages)."""
+    pages = [p for p in sorted(DOCS.rglob("*.md"))
+             if not any(part.startswith(("_", ".")) or part == "auto_examples" for part in p.relative_to(DOCS).parts)
+             and "<!-- results:" in p.read_text(encoding="utf-8")] if DOCS.is_dir() else []
+    return [README] + pages
 
 # the opening marker ends its line; the body is whole lines; the closing marker may be indented (inside a list item)
 REGION = re.compile(r"(<!-- results:(?P<name>[\w-]+) -->\n)(?P<body>(?:.*\n)*?)([ \t]*<!-- /results:(?P=name) -->)")
@@ -411,6 +425,74 @@ def recordings() -> str:
     return "\n".join(rows)
 
 
+def excitation_families() -> str:
+    """Issue 34's benchmark (`benchmarks/excitations.py`): one row per excitation family, both simulators."""
+    path = RESULTS / "excitations.json"
+    r = load("excitations") if path.exists() else {}
+    if "by_family" not in r:
+        return "_No results yet: run `python benchmarks/excitations.py`, then `python benchmarks/readme_tables.py`._"
+
+    def cal(v, n):
+        return "—" if v is None else f"{v:.2f} ({n})"
+
+    rows = ["| family (null rigs, satmd + independent simulator) | n | kind detected right | physics named | "
+            "nonlinear flagged | std calibration near resonances (points) | elsewhere (points) | "
+            "median per case near / elsewhere | crashes | median s | concealed effects found, no spurious "
+            "(of detectable) |", "|---|---|---|---|---|---|---|---|---|---|---|"]
+    for fam, x in r["by_family"].items():
+        if not x["n"]:
+            continue
+        by_sim = r["by_family_and_simulator"][fam]
+        n = f"{x['n']} ({by_sim['satmd']['n']} + {by_sim['independent']['n']})"
+        named = f"{x['physics_named']}" + (f" ({', '.join(x['named'])})" if x["named"] else "")
+        med = " / ".join("—" if v is None else f"{v:.2f}" for v in x["median_case_calibration"])
+        e = r["effects_by_family"][fam]
+        eff = (f"{e['no_spurious']}/{e['detectable']}" + (f" ({e['set_aside_for_nonlinearity']} set aside as "
+                                                           f"nonlinear)" if e["set_aside_for_nonlinearity"] else "")
+               if e["n"] else "not run")
+        sec = "—" if x["median_seconds"] is None else f"{x['median_seconds']:.1f}"
+        rows.append(f"| {fam.replace('_', ' ')} | {n} | {x['kind_right']}/{x['n'] - x['crashed']} | {named} | "
+                    + (f"{x['nonlinear_flagged']}/{x['nonlinear_tested']}" if x["nonlinear_tested"] else "not tested") + " | "
+                    f"{cal(x['calibration_near'], x['points_near'])} | "
+                    f"{cal(x['calibration_elsewhere'], x['points_elsewhere'])} | {med} | {x['crashed']} | {sec} | {eff} |")
+    nl = r["nulls"]
+    rows.append("")
+    rows.append(f"{nl['n']} null cases, {r['effects']['n']} with one concealed effect; {nl['crashed']} crash(es). "
+                "Calibration: RMS of (estimate − true FRF)/std over every point and part, near = within 3 half-power "
+                "widths of a pole with ζ < 0.1; the median per case beside it. Nonlinearity is not tested on impacts. "
+                f"One process; {r['benchmark_seconds']:.0f} s in all.")
+    return "\n".join(rows)
+
+
+def machine(name: str) -> str:
+    """Region ``machine-NAME``: the script behind `benchmarks/results/NAME.json` and the machine it ran on."""
+    d = load(name)
+    if isinstance(d, list):  # a log of runs: the latest
+        d = d[-1]
+    script = SCRIPT_OF.get(name, name)
+    where = f"`python benchmarks/{script}.py` → `benchmarks/results/{name}.json`"
+    if not isinstance(d, dict):
+        return f"{where}; machine: not recorded."
+    # the machine block where the script writes one, else what the result records at its top level
+    m = {**d, **d["machine"]} if isinstance(d.get("machine"), dict) else d
+    cpus = m.get("cpu_count") or m.get("cpus")
+    parts = [f"{cpus}-core CPU" + (f" ({m['device_name']})" if m.get("device_name") else "")] if cpus else []
+    if m.get("device") and m["device"] != "cpu":
+        parts.append(str(m["device"]))
+    before = m.get("load_average_1_5_15_before") or m.get("load_average")
+    load_avg = (before[0] if isinstance(before, list) and before else None) or m.get("load_average_1min") \
+        or m.get("load_avg_1min_start") or m.get("load_avg_1min")
+    if load_avg is not None:
+        parts.append(f"load average {load_avg:.1f}")
+    if m.get("workers"):
+        parts.append(f"{m['workers']} workers")
+    parts += [f"{k} {m[k]}" for k in ("python", "numpy", "torch") if m.get(k)]
+    if m.get("torch_threads"):
+        parts.append(f"{m['torch_threads']} torch thread{'s' if m['torch_threads'] > 1 else ''}")
+    date = d.get("date")
+    return f"{where}; machine: {', '.join(parts) or 'not recorded'}" + (f"; run {str(date)[:10]}" if date else "") + "."
+
+
 def _from_benchmark(name: str):
     """A region NAME that this file does not define: `benchmarks/NAME.py` may define `readme_markdown(result)`,
     rendered from `benchmarks/results/NAME.json`."""
@@ -439,6 +521,7 @@ REGIONS = {
     "tuning-summary": tuning_summary,
     "measured": measured,
     "recordings": recordings,
+    "excitation-families": excitation_families,
 }
 
 
@@ -448,7 +531,8 @@ def render(text: str) -> tuple[str, list[str]]:
 
     def sub(m):
         name = m.group("name")
-        fn = REGIONS.get(name) or _from_benchmark(name)
+        fn = REGIONS.get(name) or (
+            (lambda: machine(name[len("machine-"):])) if name.startswith("machine-") else _from_benchmark(name))
         if fn is None:
             unknown.append(name)
             return m.group(0)
@@ -459,35 +543,48 @@ def render(text: str) -> tuple[str, list[str]]:
 
     out = REGION.sub(sub, text)
     if unknown:
-        raise SystemExit(f"readme_tables: README has regions this script does not know: {', '.join(unknown)} "
+        raise SystemExit(f"readme_tables: regions this script does not know: {', '.join(unknown)} "
                          "(add a function to REGIONS here, or `readme_markdown(result)` to benchmarks/NAME.py)")
     opened = re.findall(r"<!-- results:([\w-]+) -->", text)
     closed = {m.group("name") for m in REGION.finditer(text)}
     unmatched = [n for n in opened if n not in closed]
     if unmatched:
-        raise SystemExit(f"readme_tables: unclosed region(s) in README: {', '.join(unmatched)}")
+        raise SystemExit(f"readme_tables: unclosed region(s): {', '.join(unmatched)}")
     return out, changed
 
 
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    ap.add_argument("--check", action="store_true", help="exit 1 if README.md differs from the results")
-    ap.add_argument("--readme", type=Path, default=README)
+    ap.add_argument("--check", action="store_true", help="exit 1 if a file differs from the results")
+    ap.add_argument("--readme", type=Path, default=None,
+                    help="only this file (default: README.md and every docs page with a region)")
     args = ap.parse_args(argv)
-    text = args.readme.read_text(encoding="utf-8")
-    out, changed = render(text)
-    missing = [n for n in REGIONS if f"<!-- results:{n} -->" not in text]
+    files = [args.readme] if args.readme else targets()
+    texts = {path: path.read_text(encoding="utf-8") for path in files}
+    missing = [n for n in REGIONS if not any(f"<!-- results:{n} -->" in t for t in texts.values())]
     if missing:
-        print(f"readme_tables: note: no region for {', '.join(missing)} in {args.readme.name}", file=sys.stderr)
+        print(f"readme_tables: note: no region for {', '.join(missing)} in {', '.join(p.name for p in files)}",
+              file=sys.stderr)
+    stale, rewritten = [], []
+    for path, text in texts.items():
+        try:
+            out, changed = render(text)
+        except SystemExit as exc:
+            raise SystemExit(f"{exc} (in {path})") from None
+        if not changed:
+            continue
+        if args.check:
+            stale.append(f"{path.relative_to(ROOT) if path.is_relative_to(ROOT) else path}: {', '.join(changed)}")
+        else:
+            path.write_text(out, encoding="utf-8")
+            rewritten += changed
     if args.check:
-        if changed:
-            print(f"readme_tables: {args.readme.name} is stale in: {', '.join(changed)} "
-                  f"(run `python benchmarks/readme_tables.py`)", file=sys.stderr)
+        if stale:
+            print("readme_tables: stale regions (run `python benchmarks/readme_tables.py`): " + "; ".join(stale),
+                  file=sys.stderr)
             return 1
         return 0
-    if changed:
-        args.readme.write_text(out, encoding="utf-8")
-    print(f"readme_tables: {len(changed)} region(s) rewritten" + (f": {', '.join(changed)}" if changed else ""))
+    print(f"readme_tables: {len(rewritten)} region(s) rewritten" + (f": {', '.join(rewritten)}" if rewritten else ""))
     return 0
 
 
