@@ -155,8 +155,13 @@ def repeated_hits(items):
                for x, e in zip(items, excs)]
     if max(heights) > IMPACT_LEVEL_FACTOR * min(heights):
         return None
+    from ..io.sweepfrf import at_rest_at_the_end
+
     joined = {c: np.concatenate([x[c] for x in items]) for c in items[0].channels}
     meta = {"source": " + ".join(str(x.meta.get("source", "recording")) for x in items)}
+    responses = [c for c in ("acc1", "acc2") if c in items[0].channels]
+    if not all(at_rest_at_the_end(x, responses, strict=True) for x in items):  # a file cut mid-ring: no whole-record transient
+        meta["cut_mid_ring"] = "a file ends before its response has rung down"
     rec = Recording(items[0].fs_hz, joined, dict(items[0].units), meta)
     return with_excitation(rec, detect_excitation(rec, "impact"))
 

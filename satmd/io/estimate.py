@@ -198,7 +198,8 @@ def _estimate_designed(recording: Recording, exc, band) -> FRFData:
         extra = []
         ref = "Pintelon & Schoukens 2012, periodic excitation: mean over steady periods"
         noise = f"spread over {len(exc.steady)} steady periods"
-    elif exc.kind == "impact" and not exc.dropped and at_rest_at_the_end(recording, responses):
+    elif (exc.kind == "impact" and not exc.dropped and "cut_mid_ring" not in recording.meta
+          and at_rest_at_the_end(recording, responses)):
         f, frf, std, coh, dof, extra = whole_record_frf(recording, exc, responses, band)
         ref = "hits as one transient: the whole record's spectra, force windowed to its pulses, G fitted locally"
         noise = "local residual, smoothed over neighbouring windows"

@@ -20,8 +20,12 @@ DEGREE = 2
 SMOOTH = 9  # windows the noise variance is averaged over
 
 
-def at_rest_at_the_end(recording, responses) -> bool:
-    """Whether every response has rung down by the record's end (so the record holds whole transients)."""
+def at_rest_at_the_end(recording, responses, strict: bool = False) -> bool:
+    """Whether every response has rung down by the record's end (so the record holds whole transients).
+
+    ``strict``: 80 dB down, or 40 dB down and no longer falling (the sensor's noise floor), as files joined
+    end to end need (each join cuts what is left); otherwise 40 dB down.
+    """
     n = recording.n_samples
     m = max(8, n // 50)
     for r in responses:
@@ -29,6 +33,8 @@ def at_rest_at_the_end(recording, responses) -> bool:
         blocks = y[: n // m * m].reshape(-1, m)
         rms = np.sqrt(np.mean((blocks - blocks.mean()) ** 2, axis=1))
         if rms[-1] > RUNG_DOWN * rms.max():
+            return False
+        if strict and rms[-1] > 1e-4 * rms.max() and rms[-1] < 0.97 * rms[-2]:
             return False
     return True
 
