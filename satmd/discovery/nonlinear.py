@@ -185,7 +185,7 @@ def multisine_test(recording, alpha: float = 1e-3) -> NonlinearTest:
     NonlinearTest
         ``distortion_lines``; ``details`` per channel with the odd and even ratios.
     """
-    from .nonlinear_periodic import detection_lines_test
+    from .nonlinear_periodic import detection_lines_test, forced_lines, without_linear_response
 
     u, outs, lines = multisine_arrays(recording)
     hi = lines.max() * recording.fs_hz / u.shape[-1]
@@ -197,63 +197,6 @@ def multisine_test(recording, alpha: float = 1e-3) -> NonlinearTest:
     p = min(1.0, worst.p_value * len(tests))
     details = {c: t.details for c, t in tests.items()} | {"explained": {}}
     return NonlinearTest("distortion_lines", p, worst.bands_hz, alpha, details)
-
-
-def without_linear_response(u, y, lines) -> np.ndarray:
-    """The output periods less what the best linear approximation predicts from the force at every line.
-
-    The force is not zero between a design's lines (the shaker's interaction, a filter's skirt, noise); a
-    linear rig answers it there. The BLA at the excited lines, interpolated (held at the band's edges),
-    times each period's force spectrum is taken out, so the detection lines hold noise and distortion only.
-
-    Parameters
-    ----------
-    u, y : (M, P, N) force and output periods
-    lines : excited lines
-
-    Returns
-    -------
-    ndarray (M, P, N)
-    """
-    u, y = np.asarray(u, float), np.asarray(y, float)
-    N = u.shape[-1]
-    U, Y = np.fft.rfft(u, axis=-1), np.fft.rfft(y, axis=-1)
-    lines = np.asarray(lines, int)
-    G = Y[..., lines].mean(axis=(0, 1)) / U[..., lines].mean(axis=(0, 1))
-    k = np.arange(U.shape[-1])
-    Gk = np.interp(k, lines, G.real) + 1j * np.interp(k, lines, G.imag)
-    Gk[lines] = 0.0  # the excited lines are not detection lines: left as they are
-    Gk[0] = 0.0
-    return np.fft.irfft(Y - Gk * U, N, axis=-1)
-
-
-def forced_lines(u, factor: float = 10.0) -> np.ndarray:
-    """Lines where the mean force over periods stands above its own period-to-period noise (x ``factor`` in power).
-
-    A linear rig answers there (a filter's skirt, a chirp's spectral tails, the shaker's interaction), so
-    its response is no evidence of distortion.
-
-    Parameters
-    ----------
-    u : (M, P, N) force periods (P ≥ 2)
-    factor : power ratio over the noise of the mean that counts as force
-
-    Returns
-    -------
-    ndarray of int
-    """
-    u = np.asarray(u, float)
-    if u.ndim == 2:
-        u = u[None]
-    M, P, N = u.shape
-    if P < 2:
-        return np.zeros(0, int)
-    U = np.fft.rfft(u - u.mean(axis=2, keepdims=True), axis=2)
-    mean = U.mean(axis=1)
-    noise = np.sum(np.abs(U - mean[:, None]) ** 2, axis=1) / (P - 1) / P
-    floor = np.median(noise, axis=1, keepdims=True)  # the force's noise is broad: its median is robust
-    floor = np.maximum(floor, 1e-12 * np.max(np.abs(mean) ** 2, axis=1, keepdims=True))  # a noise-free force
-    return np.flatnonzero(np.any(np.abs(mean) ** 2 > factor * np.maximum(np.maximum(noise, floor), TINY), axis=0))
 
 
 def multisine_frf(recording):
