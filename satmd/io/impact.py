@@ -116,7 +116,7 @@ def impact_frf(recording, excitation, responses, band=None):
         if lead >= max(16, int(0.05 * fs)) else 0.0
     # or its tail has stopped falling: the last tenth no quieter than the one before it, the noise floor
     flat = min(float(np.sqrt(np.mean(v[:, -tenth:] ** 2)) / max(np.sqrt(np.mean(v[:, -2 * tenth:-tenth] ** 2)), TINY))
-               for v in segs.values()) > 0.97
+               for v in segs.values()) > 1.0 - 3.0 / np.sqrt(2.0 * tenth * len(hits))  # within its scatter
     if ring > max(DECAYED, 3.0 * quiet) and not flat:
         tau = L / fs / np.log(1.0 / DECAYED)  # the window falls to DECAYED at the segment's end
         w = np.exp(-np.arange(L) / fs / tau)
