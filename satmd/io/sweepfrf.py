@@ -34,7 +34,7 @@ def at_rest_at_the_end(recording, responses, strict: bool = False) -> bool:
         rms = np.sqrt(np.mean((blocks - blocks.mean()) ** 2, axis=1))
         if rms[-1] > RUNG_DOWN * rms.max():
             return False
-        if strict and rms[-1] > 1e-4 * rms.max() and rms[-1] < (1.0 - 3.0 / np.sqrt(2.0 * m)) * rms[-2]:
+        if strict and rms[-1] > 1e-4 * rms.max() and rms[-1] < 0.97 * rms[-2]:  # still falling
             return False
     return True
 
