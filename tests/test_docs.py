@@ -11,19 +11,16 @@ every code block of its pages runs and prints what the page shows.
 """
 from __future__ import annotations
 
-import contextlib
 import importlib.util
-import io
 import os
 import re
 import subprocess
 import sys
-import warnings
 from pathlib import Path
 
 import pytest
 
-from .test_readme import Block, bash_commands, check_output, parse
+from .test_readme import Block, bash_commands, parse, run_block
 
 ROOT = Path(__file__).resolve().parents[1]
 DOCS = ROOT / "docs"
@@ -108,29 +105,7 @@ def test_docs_block(page, block, tmp_path, monkeypatch):
     if block.skip:
         pytest.skip(f"{page} line {block.line}: {block.skip}")
     monkeypatch.chdir(tmp_path)
-    out = io.StringIO()
-    where = f"{page} line {block.line}"
-    if block.lang == "python":
-        from satmd.physics import effects
-
-        before = set(effects._REGISTRY)
-        try:
-            with contextlib.redirect_stdout(out), warnings.catch_warnings():
-                warnings.simplefilter("ignore")  # a block may warn (e.g. a poor fit); the page shows stdout
-                exec(compile(block.code, f"{page}:{block.line}", "exec"), {"__name__": "__docs__"})
-        finally:
-            for name in set(effects._REGISTRY) - before:  # an example that registers an effect
-                effects.unregister(name)
-    else:
-        from satmd.cli import main
-
-        for argv in bash_commands(block.code):
-            err = io.StringIO()
-            with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
-                rc = main(argv[1:])
-            assert rc == 0, f"{where}: `{' '.join(argv)}` exited {rc}: {err.getvalue()[-2000:]}"
-    if block.expected:
-        check_output(block.expected, out.getvalue(), where)
+    run_block(block, page)
 
 
 def test_the_readme_is_a_landing_page():

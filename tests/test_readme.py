@@ -125,21 +125,18 @@ def test_readme_has_blocks_and_every_block_is_run_or_marked():
                                             "mark the block `<!-- readme-test: skip (why) -->`")
 
 
-@pytest.mark.parametrize("block", BLOCKS, ids=[b.id for b in BLOCKS])
-def test_readme_block(block, tmp_path, monkeypatch):
-    if block.skip:
-        pytest.skip(f"README line {block.line}: {block.skip}")
-    monkeypatch.chdir(tmp_path)
+def run_block(block, origin: str):
+    """Run one block (python in-process; bash through the CLI) and check what it prints; ``origin``: its file."""
     out = io.StringIO()
-    where = f"README line {block.line}"
+    where = f"{origin} line {block.line}"
     if block.lang == "python":
         from satmd.physics import effects
 
         before = set(effects._REGISTRY)
         try:
             with contextlib.redirect_stdout(out), warnings.catch_warnings():
-                warnings.simplefilter("ignore")  # a block may warn (e.g. a poor fit); the README shows stdout
-                exec(compile(block.code, f"README.md:{block.line}", "exec"), {"__name__": "__readme__"})
+                warnings.simplefilter("ignore")  # a block may warn (e.g. a poor fit); the page shows stdout
+                exec(compile(block.code, f"{origin}:{block.line}", "exec"), {"__name__": "__readme__"})
         finally:
             for name in set(effects._REGISTRY) - before:  # an example that registers an effect
                 effects.unregister(name)
@@ -153,6 +150,14 @@ def test_readme_block(block, tmp_path, monkeypatch):
             assert rc == 0, f"{where}: `{' '.join(argv)}` exited {rc}: {err.getvalue()[-2000:]}"
     if block.expected:
         check_output(block.expected, out.getvalue(), where)
+
+
+@pytest.mark.parametrize("block", BLOCKS, ids=[b.id for b in BLOCKS])
+def test_readme_block(block, tmp_path, monkeypatch):
+    if block.skip:
+        pytest.skip(f"README line {block.line}: {block.skip}")
+    monkeypatch.chdir(tmp_path)
+    run_block(block, "README.md")
 
 
 def test_readme_tables_match_results():
