@@ -274,7 +274,7 @@ def run_case(job):
                excitation=exc_info, method=(rep.estimator or {}).get("method"),
                effects=rep.effect_names, physics_named=bool(rep.effect_names),
                nonlinear=bool(nl is not None and nl.detected),
-               nonlinear_tested=nl is not None,
+               nonlinear_tested=nl is not None and any(not t.not_run for t in nl.tests),
                nonlinear_tests=[t.to_dict() for t in nl.tests] if nl is not None and nl.detected else [],
                set_aside=list(nl.set_aside) if nl is not None else [],
                noise_dof=(rep.estimator or {}).get("noise_dof"),

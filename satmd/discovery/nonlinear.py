@@ -77,6 +77,8 @@ class NonlinearReport:
     def report(self) -> str:
         """Plain-language text."""
         head = "nonlinearity DETECTED" if self.detected else "no nonlinearity detected (consistent with a linear rig)"
+        if not self.detected and self.tests and all(t.not_run for t in self.tests):
+            head = "linearity not tested: no test could run on these data"
         lines = [f"[[Nonlinearity]] {head}"]
         lines += [f"    test {t.report()}" for t in self.tests]
         for f in self.findings:
@@ -189,13 +191,15 @@ def multisine_test(recording, alpha: float = 1e-3) -> NonlinearTest:
 
     u, outs, lines = multisine_arrays(recording)
     hi = lines.max() * recording.fs_hz / u.shape[-1]
-    forced = np.union1d(lines, forced_lines(u))  # a line with force on it is no detection line, weak or not
+    forced = np.union1d(lines, forced_lines(u, lines=lines))  # a line with force on it is no detection line
     outs = {c: without_linear_response(u, y, lines) for c, y in outs.items()}
     tests = {c: detection_lines_test(u, y, forced, recording.fs_hz, band=(0.0, 1.5 * hi), alpha=alpha / len(outs))
              for c, y in outs.items()}
     worst = min(tests.values(), key=lambda t: t.p_value)
     p = min(1.0, worst.p_value * len(tests))
     details = {c: t.details for c, t in tests.items()} | {"explained": {}}
+    if all(t.not_run for t in tests.values()):  # e.g. a chirp over the whole band leaves no line free of force
+        details["reason"] = "; ".join(sorted({f"{t.not_run}" for t in tests.values()}))
     return NonlinearTest("distortion_lines", p, worst.bands_hz, alpha, details)
 
 

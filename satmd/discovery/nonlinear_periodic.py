@@ -116,7 +116,8 @@ def detection_lines_test(u, y, lines, fs_hz: float, band=None, alpha: float = 1e
     mask &= (k * fs_hz / N >= lo) & (k * fs_hz / N <= hi) & (k < N // 2)
     det = np.flatnonzero(mask)
     if det.size < 4:
-        return NonlinearTest(name, 1.0, [], alpha, {"reason": "no detection lines"})
+        return NonlinearTest(name, 1.0, [], alpha, {"reason": "no detection lines: the force reaches every line "
+                                                     "up to 1.5x the band"})
     mean = Y[..., det].mean(axis=1)  # (M, D)
     var = Y[..., det].var(axis=1, ddof=1)  # per-period noise variance
     from scipy import stats
@@ -212,16 +213,25 @@ def without_linear_response(u, y, lines) -> np.ndarray:
     return np.fft.irfft(Y - Gk * U, N, axis=-1)
 
 
-def forced_lines(u, factor: float = 10.0) -> np.ndarray:
-    """Lines where the mean force over periods stands above its own period-to-period noise (x ``factor`` in power).
+def forced_lines(u, factor: float = 10.0, lines=None, width: int = 8, level: float = 3.0) -> np.ndarray:
+    """Lines where the force stands above its own period-to-period noise.
 
     A linear rig answers there (a filter's skirt, a chirp's spectral tails, the shaker's interaction), so
-    its response is no evidence of distortion.
+    its response is no evidence of distortion. Two rules:
+
+    - any line whose mean force over periods exceeds ``factor`` x its noise (power);
+    - beyond the excited ``lines`` (where the best linear approximation is not known and the rig's answer
+      to a weak force cannot be taken out), a line whose neighbourhood holds force: the running median of
+      the force's F statistic over ``2 width + 1`` non-excited lines above ``level`` x its median under
+      no force. A chirp's tail is weak line by line but present on every line.
 
     Parameters
     ----------
     u : (M, P, N) force periods (P ≥ 2)
-    factor : power ratio over the noise of the mean that counts as force
+    factor : power ratio over the noise of the mean that counts as force on one line
+    lines : excited lines (None: the first rule only)
+    width : half-width of the running median, in non-excited lines
+    level : ratio of the running median over the F(2, 2(P-1)) median that counts as force
 
     Returns
     -------
@@ -238,4 +248,26 @@ def forced_lines(u, factor: float = 10.0) -> np.ndarray:
     noise = np.sum(np.abs(U - mean[:, None]) ** 2, axis=1) / (P - 1) / P
     floor = np.median(noise, axis=1, keepdims=True)  # the force's noise is broad: its median is robust
     floor = np.maximum(floor, 1e-12 * np.max(np.abs(mean) ** 2, axis=1, keepdims=True))  # a noise-free force
-    return np.flatnonzero(np.any(np.abs(mean) ** 2 > factor * np.maximum(np.maximum(noise, floor), TINY), axis=0))
+    power = np.abs(mean) ** 2
+    forced = np.any(power > factor * np.maximum(np.maximum(noise, floor), TINY), axis=0)
+    if lines is not None and len(lines):
+        forced |= _force_beyond(power / np.maximum(noise, TINY), np.asarray(lines, int), P, width, level)
+    return np.flatnonzero(forced)
+
+
+def _force_beyond(F, lines, P: int, width: int, level: float) -> np.ndarray:
+    """(K,) bool: lines beyond the excited ones whose neighbourhood holds force (see `forced_lines`)."""
+    from scipy import stats
+    from scipy.ndimage import median_filter
+
+    K = F.shape[-1]
+    out = np.zeros(K, bool)
+    free = np.ones(K, bool)
+    free[lines] = False
+    free[0] = False
+    cand = np.flatnonzero(free & ((np.arange(K) < lines.min()) | (np.arange(K) > lines.max())))
+    if cand.size == 0:
+        return out
+    running = median_filter(np.median(F, axis=0)[cand], size=2 * width + 1, mode="nearest")
+    out[cand[running > level * stats.f.median(2, 2 * (P - 1))]] = True
+    return out

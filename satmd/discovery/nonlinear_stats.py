@@ -63,13 +63,23 @@ class NonlinearTest:
         """True when the test rejects linearity at its level."""
         return self.p_value < self.alpha
 
+    @property
+    def not_run(self) -> str | None:
+        """Why the test could not run (no detection lines, too short, ...); None when it ran."""
+        reason = self.details.get("reason")
+        return str(reason) if reason else None
+
     def to_dict(self) -> dict:
-        """The SPEC §9 entry: name, p_value, bands_hz."""
+        """The SPEC §9 entry: name, p_value, bands_hz; a test that could not run has no p-value, and says why."""
+        if self.not_run:
+            return {"name": self.name, "p_value": None, "bands_hz": [], "not_run": self.not_run}
         return {"name": self.name, "p_value": float(self.p_value),
                 "bands_hz": [[round(a, 3), round(b, 3)] for a, b in self.bands_hz]}
 
     def report(self) -> str:
         """One line in words."""
+        if self.not_run:
+            return f"{self.name}: not run ({self.not_run})"
         where = ", ".join(f"{a:.1f}–{b:.1f} Hz" for a, b in self.bands_hz) or "no band alone"
         verdict = "rejects linearity" if self.significant else "consistent with a linear system"
         channel = self.channel

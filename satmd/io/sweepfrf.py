@@ -14,7 +14,8 @@ import numpy as np
 
 from ..conventions import RECORDING_CHANNELS, TINY
 
-RUNG_DOWN = 1e-2  # the responses' RMS over the record's last 2 %, as a share of their loudest 2 %: at rest
+RUNG_DOWN = 1e-2  # the responses' RMS over the record's end, as a share of their loudest 2 %: at rest
+TAIL_S = 0.1  # the record's end, at most (s)
 HALF = 3  # window: 2·HALF + 1 bins
 DEGREE = 2
 SMOOTH = 9  # windows the noise variance is averaged over
@@ -28,11 +29,12 @@ def at_rest_at_the_end(recording, responses, strict: bool = False) -> bool:
     """
     n = recording.n_samples
     m = max(8, n // 50)
+    last = max(8, min(m, int(TAIL_S * recording.fs_hz)))  # a long sweep's quiet tail is short beside n / 50
     for r in responses:
         y = np.asarray(recording[r], float)
         blocks = y[: n // m * m].reshape(-1, m)
         rms = np.sqrt(np.mean((blocks - blocks.mean()) ** 2, axis=1))
-        if rms[-1] > RUNG_DOWN * rms.max():
+        if np.sqrt(np.mean((y[-last:] - blocks.mean()) ** 2)) > RUNG_DOWN * rms.max():
             return False
         if strict and rms[-1] > 1e-4 * rms.max() and rms[-1] < 0.97 * rms[-2]:  # still falling
             return False

@@ -133,6 +133,36 @@ def test_linear_rig_under_a_multisine_is_linear_with_no_physics():
     assert rep.to_dict()["estimator"]["excitation"]["kind"] == "periodic"
 
 
+
+def test_a_periodic_chirps_weak_tails_are_not_detection_lines():
+    """A linear chirp repeated from rest: its spectrum leaks, weakly on every line, far above the band. The
+    rig answers there; that answer is no distortion (the old rule, force over 10x its noise line by line,
+    flagged the third of these seeds at p ~ 1e-15)."""
+    from scipy.signal import chirp
+
+    from satmd import discover
+    from satmd.discovery.nonlinear import multisine_arrays, multisine_test
+    from satmd.discovery.nonlinear_periodic import forced_lines
+    from satmd.io.excitation import with_excitation
+
+    fs = 2000.0
+    t = np.arange(2000) / fs
+    out = _convolve(np.tile(chirp(t, 13.0, 1.0, 435.0), 16), fs, Rig(), ())
+    for seed in range(4):
+        rng = np.random.default_rng(seed)
+        share = {"force": 0.02, "acc1": 0.002, "acc2": 0.002}  # a noisier force than responses
+        noisy = {c: x + share[c] * np.std(x) * rng.standard_normal(x.size) for c, x in out.items()}
+        rec = Recording(fs, noisy, meta={"source": "test"})
+        rec = with_excitation(rec, detect_excitation(rec))
+        u, _, lines = multisine_arrays(rec)
+        assert forced_lines(u, lines=lines).max() > lines.max() + 20  # the tail is force, if weak
+        test = multisine_test(rec)
+        assert not test.significant, (seed, test.report())
+        if test.not_run:
+            assert test.to_dict()["p_value"] is None and "not run" in test.report()
+    rep = discover(rec)
+    assert rep.effect_names == [] and not rep.nonlinear.detected
+
 # --- impacts --------------------------------------------------------------------------------------------
 def test_hits_are_segmented_and_h1_is_calibrated():
     n = int(20 * FS)
@@ -197,7 +227,10 @@ def test_a_log_sweep_is_recognised_with_its_law():
     assert exc.kind == "sweep"
     assert exc.sweep["law"] == "logarithmic" and exc.sweep["direction"] == "up"
     assert 12 < exc.sweep["f_start_hz"] < 25 and 200 < exc.sweep["f_end_hz"] < 300
-    data = estimate_frf(rec)
+    data = estimate_frf(rec)  # tapered to rest over its last 2 s: the record holds whole transients
+    assert data.estimator["method"] == "sweep" and 0.8 < _calibration(data) < 1.25
+    cut = Recording(FS, {c: rec[c][: int(30 * FS)] for c in rec.channels})  # stopped mid-sweep, still ringing
+    data = estimate_frf(cut)
     assert data.estimator["method"] == "lpm" and data.estimator["excitation"]["kind"] == "sweep"
 
 
