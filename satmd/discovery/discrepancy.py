@@ -16,6 +16,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..conventions import TINY
+from ..identification.covariance import jacobian_covariance
 
 MAX_DEGREE = 12
 
@@ -55,8 +56,8 @@ def fit_discrepancy(freq_hz, residual: dict, sigma: dict) -> Discrepancy:
             for _ in range(3):  # STLSQ: refit on the terms that matter
                 A = basis[:, active] * w[:, None]
                 theta, *_ = np.linalg.lstsq(A, rw, rcond=None)
-                cov = np.linalg.pinv(A.conj().T @ A)
-                z = np.abs(theta) / np.sqrt(np.maximum(np.real(np.diag(cov)), TINY))
+                cov = jacobian_covariance(A)
+                z = np.abs(theta) / np.sqrt(np.maximum(np.real(np.diag(cov)), TINY))  # NaN (dependent terms): kept
                 keep = z > 2.0
                 if keep.all() or not keep.any():
                     break

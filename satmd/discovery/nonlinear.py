@@ -197,7 +197,7 @@ def multisine_test(recording, alpha: float = 1e-3) -> NonlinearTest:
              for c, y in outs.items()}
     worst = min(tests.values(), key=lambda t: t.p_value)
     p = min(1.0, worst.p_value * len(tests))
-    details = {c: t.details for c, t in tests.items()} | {"explained": {}}
+    details: dict = {c: t.details for c, t in tests.items()} | {"explained": {}}
     if all(t.not_run for t in tests.values()):  # e.g. a chirp over the whole band leaves no line free of force
         details["reason"] = "; ".join(sorted({f"{t.not_run}" for t in tests.values()}))
     return NonlinearTest("distortion_lines", p, worst.bands_hz, alpha, details)

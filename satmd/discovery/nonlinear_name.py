@@ -20,6 +20,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..identification.covariance import jacobian_covariance
 from ..physics import frf
 from ..physics.nonlinear import NONLINEAR, response_rms
 
@@ -111,10 +112,7 @@ def joint_fit(datas, rig, free, channels, moving, start: dict, moving_start=None
     chi2 = float(np.sum(sol.fun ** 2))
     n = y.size
     bic = chi2 + len(names) * np.log(n)
-    try:
-        cov = np.linalg.inv(sol.jac.T @ sol.jac)
-    except np.linalg.LinAlgError:
-        cov = np.full((len(names), len(names)), np.nan)
+    cov = jacobian_covariance(sol.jac)
     vals = {nm: base[nm] * np.exp(np.clip(sol.x[i], -LOG_REACH, LOG_REACH)) for i, nm in enumerate(names)}
     per, per_std = [], []
     if moving:
@@ -277,10 +275,7 @@ def fit_strength(cls, values, stds, rigs, forces, fs_hz):
                             x_scale="jac", max_nfev=400)
         if best is None or sol.cost < best.cost:
             best = sol
-    try:
-        sd = float(np.sqrt(max(np.linalg.inv(best.jac.T @ best.jac)[1, 1], 0.0)))
-    except np.linalg.LinAlgError:
-        sd = float("nan")
+    sd = float(np.sqrt(max(jacobian_covariance(best.jac)[1, 1], 0.0)))  # NaN stays NaN: max(nan, 0) is nan
     raw = float(best.x[1])
     el = cls(**{cls.strength: strength(raw)}, **extra)
     ci = [strength(raw - 1.96 * sd), strength(raw + 1.96 * sd)]

@@ -151,6 +151,8 @@ def one_mode_fit(freq, H, std, band=None) -> dict:
     """
     from scipy.optimize import least_squares
 
+    from ..identification.covariance import jacobian_covariance
+
     freq, H, std = np.asarray(freq, float), np.asarray(H, complex), np.asarray(std, float)
     fpk = float(freq[np.argmax(np.abs(H))])
     lo, hi = band if band is not None else (0.7 * fpk, 1.35 * fpk)
@@ -176,11 +178,7 @@ def one_mode_fit(freq, H, std, band=None) -> dict:
             best = sol
     assert best is not None  # three starts
     dof = max(2 * sel.sum() - 6, 1)
-    try:
-        cov = np.linalg.inv(best.jac.T @ best.jac) * max(2 * best.cost / dof, 1.0)
-        sd = np.sqrt(np.maximum(np.diag(cov), 0.0))
-    except np.linalg.LinAlgError:
-        sd = np.full(2, np.nan)
+    sd = np.sqrt(np.maximum(np.diag(jacobian_covariance(best.jac, max(2 * best.cost / dof, 1.0))), 0.0))
     return {"f_n_hz": float(best.x[0]), "zeta": float(best.x[1]), "f_n_std": float(sd[0]),
             "zeta_std": float(sd[1]), "chi2_reduced": float(2 * best.cost / dof)}
 

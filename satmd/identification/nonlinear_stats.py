@@ -5,6 +5,7 @@ import math
 
 import numpy as np
 
+from .covariance import jacobian_covariance
 from .nonlinear_signal import band_gain
 
 
@@ -91,7 +92,7 @@ def sandwich(J, r, block_sizes, channel_length, lags: int = 1024) -> np.ndarray:
     -------
     ndarray (p, p)
     """
-    B = np.linalg.pinv(J.T @ J)
+    B = jacobian_covariance(J)
     M = np.zeros_like(B)
     start = 0
     for size, n in zip(block_sizes, channel_length):

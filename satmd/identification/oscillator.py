@@ -29,6 +29,7 @@ from scipy import signal
 from scipy.optimize import least_squares
 
 from ..errors import DataError
+from .covariance import jacobian_covariance
 from ..physics.oscillator import PolynomialOscillator, fine_input, rk4_batch, segment_windows
 
 T95 = 1.959963984540054
@@ -274,9 +275,8 @@ def _intervals(problem, r, names):
     """95 % half-widths of the physical parameters (Jacobian covariance, delta method)."""
     n, p = r.fun.size, r.x.size
     s2 = 2 * r.cost / max(n - p, 1)
-    try:
-        cov = np.linalg.pinv(r.jac.T @ r.jac) * s2
-    except np.linalg.LinAlgError:
+    cov = jacobian_covariance(r.jac, s2)
+    if not np.all(np.isfinite(cov)):  # rank deficient: no interval rather than a pseudo-inverse's
         return {}
     base = _physical(problem, r.x, names)
     grads = []
