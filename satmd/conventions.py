@@ -25,3 +25,6 @@ MIN_DELTA_BIC = 10.0
 
 #: A positive floor for divisions and logarithms (far below any physical quantity, above 0).
 TINY = 1e-300
+
+#: The paper's band [Hz]: the default wherever a band is not given (simulation, tuning, linearisation).
+PAPER_BAND_HZ = (20.0, 200.0)

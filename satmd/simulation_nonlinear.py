@@ -17,7 +17,7 @@ from typing import Sequence
 
 import numpy as np
 
-from .conventions import ACCEL_CHANNELS
+from .conventions import ACCEL_CHANNELS, PAPER_BAND_HZ
 from .errors import DataError
 from .io.recording import Recording
 from .io.timesim import log_sweep
@@ -34,7 +34,7 @@ def _sweep(n, fs_hz, lo, hi) -> np.ndarray:
 
 
 def simulate_nonlinear_recording(rig: Rig | None = None, nonlinear: Sequence = (), level: float = 1.0,
-                                 duration_s: float = 90.0, fs_hz: float = 2048.0, band_hz=(20.0, 200.0),
+                                 duration_s: float = 90.0, fs_hz: float = 2048.0, band_hz=PAPER_BAND_HZ,
                                  noise: float = 0.0, force_noise: float | None = None, seed: int | None = None,
                                  excitation: str = "random", periods: int = 3, realisations: int = 4,
                                  effects: Sequence = ()) -> Recording:

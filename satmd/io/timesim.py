@@ -43,7 +43,7 @@ from typing import Sequence
 
 import numpy as np
 
-from ..conventions import ACCEL_CHANNELS, RECORDING_CHANNELS
+from ..conventions import ACCEL_CHANNELS, PAPER_BAND_HZ, RECORDING_CHANNELS
 from ..errors import DataError
 from ..physics import Rig, frf
 from .conditions import ForceSpectrum
@@ -60,7 +60,7 @@ LAB_NOISE = 0.02
 
 
 def simulate_recording(duration_s: float = 60.0, fs_hz: float = 1000.0, rig: Rig | None = None,
-                       effects: Sequence = (), band_hz=(20.0, 200.0), force_rms: float = 1.0,
+                       effects: Sequence = (), band_hz=PAPER_BAND_HZ, force_rms: float = 1.0,
                        noise: float | None = None, seed: int | None = None, excitation: str = "random",
                        force_noise: float | None = None, burn_in_s: float = 0.0, force_spectrum=None,
                        sensor_noise=None, ideal: bool = False) -> Recording:

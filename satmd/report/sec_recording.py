@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 import numpy as np
+from ..conventions import PAPER_BAND_HZ
 
 ORDER = 55
 TITLE = "From recordings: the measurement chain is never taken for physics"
@@ -12,7 +13,7 @@ def _figure(truth_freq, truth, estimates):
 
     plt = pyplot()
     fig, axes = plt.subplots(1, 2, figsize=(10, 3.8))
-    for ax, (lo, hi) in zip(axes, ((44.0, 56.0), (20.0, 200.0))):
+    for ax, (lo, hi) in zip(axes, ((44.0, 56.0), PAPER_BAND_HZ)):
         keep = (truth_freq >= lo) & (truth_freq <= hi)
         ax.semilogy(truth_freq[keep], np.abs(truth[keep]), color="k", lw=1.2, label="true model")
         for (label, data), color in zip(estimates.items(), ("tab:blue", "tab:red")):

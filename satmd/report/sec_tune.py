@@ -2,11 +2,12 @@
 from __future__ import annotations
 
 import math
+from ..conventions import PAPER_BAND_HZ
 
 ORDER = 60
 TITLE = "Shunt tuning: the best R and L for the paper's rig"
 
-BAND = (20.0, 200.0)
+BAND = PAPER_BAND_HZ
 
 
 def _textbook_rows():

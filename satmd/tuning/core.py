@@ -25,11 +25,12 @@ from .optimiser import DesignSpace, Minimum, minimise
 from .result import TuneResult, db
 from .robust import make_draws, robust_optimum
 from .source import RIG_FREE, ResolvedModel, is_augmented, model_verdict, resolve_model
+from ..conventions import PAPER_BAND_HZ
 
 __all__ = ["tune", "TUNE_CONSTRAINTS", "Robustness", "SearchPlan", "TuneProblem", "ResolvedModel",
            "resolve_model", "model_verdict", "RIG_FREE", "DEFAULT_BAND"]
 
-DEFAULT_BAND = (20.0, 200.0)
+DEFAULT_BAND = PAPER_BAND_HZ
 
 #: What every keyword of `tune` may be (`satmd.validation`); the model itself is checked by `resolve_model`.
 TUNE_CONSTRAINTS = {

@@ -14,7 +14,7 @@ from typing import Sequence
 
 import numpy as np
 
-from ..conventions import DEFAULT_FREE
+from ..conventions import DEFAULT_FREE, PAPER_BAND_HZ
 from ..errors import DataError
 from ..physics.rig import Rig
 from .laws import OPEN_CIRCUIT_R
@@ -115,7 +115,7 @@ def retune(
     labels: Sequence[str] | None = None,
     objective: str = "hinf",
     output: str = "u1",
-    band: tuple[float, float] = (20.0, 200.0),
+    band: tuple[float, float] = PAPER_BAND_HZ,
     design: Sequence[str] = ("R", "L"),
     bounds: dict | None = None,
     **tune_options,

@@ -7,7 +7,7 @@ force spectrum, so the two are iterated to their fixed point.
 """
 from __future__ import annotations
 
-from ...conventions import TINY
+from ...conventions import PAPER_BAND_HZ, TINY
 
 import numpy as np
 
@@ -40,7 +40,7 @@ def _force_psd(band_hz, force_rms, force, fs_hz, n_grid):
     return fine, np.interp(fine, f, p)
 
 
-def response_rms(rig: Rig, band_hz=(20.0, 200.0), force_rms: float = 1.0, force=None, fs_hz=None,
+def response_rms(rig: Rig, band_hz=PAPER_BAND_HZ, force_rms: float = 1.0, force=None, fs_hz=None,
                  n_grid: int = 6000) -> dict:
     """RMS of the signals elements read, for the linear rig under a random force.
 
@@ -68,7 +68,7 @@ def response_rms(rig: Rig, band_hz=(20.0, 200.0), force_rms: float = 1.0, force=
     return {k: np.sqrt(np.trapezoid(np.abs(x) ** 2 * psd, f, axis=-1)) for k, x in sig.items()}
 
 
-def equivalent_rig(rig: Rig, elements, band_hz=(20.0, 200.0), force_rms: float = 1.0, force=None, fs_hz=None,
+def equivalent_rig(rig: Rig, elements, band_hz=PAPER_BAND_HZ, force_rms: float = 1.0, force=None, fs_hz=None,
                    iterations: int = 60, rtol: float = 1e-8, n_grid: int = 6000):
     """The equivalent linear rig at a drive level (statistical linearisation iterated to its fixed point).
 
