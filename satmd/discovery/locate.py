@@ -53,33 +53,52 @@ def test_mismatch(fit, alpha: float = 1e-3, noise_dof: float | None = None) -> M
         p_global = float(stats.f.sf(fit.chi2_reduced, fit.dof, noise_dof))
     else:
         p_global = float(stats.chi2.sf(fit.chi2, fit.dof))
-    n = per_point.size
+    p_band, bands_hz = scan_bands(freq, per_point, 2 * C, alpha, WIDTHS, noise_dof)
+    whiteness = {c: _lag1(v) for c, v in z.items()}
+    significant = (p_global < alpha / 2) or (p_band < alpha / 2)
+    return MismatchTest(significant, p_global, p_band, bands_hz, whiteness, per_point)
+
+
+def scan_bands(freq, score, point_dof: float, alpha: float, widths=WIDTHS, noise_dof: float | None = None):
+    """The band scan, written once: windows of ``widths`` points, Bonferroni over all of them, merged.
+
+    Parameters
+    ----------
+    freq : (n,) Hz
+    score : (n,) per-point statistic, χ²(point_dof) under the null (σ known), or σ²-scaled when
+        ``noise_dof`` is given (σ estimated with that many degrees of freedom: an F test per window)
+    point_dof : degrees of freedom of one point's score
+    alpha : level of the scan (windows are kept at α/2: the other half is the global test's)
+    widths : window widths, in points
+    noise_dof : degrees of freedom behind an estimated σ (None: σ known)
+
+    Returns
+    -------
+    (p_band, bands_hz)
+        Smallest Bonferroni-corrected window p-value (1 with no window) and the merged significant bands.
+    """
+    from scipy import stats
+
+    score = np.asarray(score, float)
+    n = score.size
     windows = []
-    for w in WIDTHS:
+    for w in widths:
         if w > n:
             break
-        s = np.convolve(per_point, np.ones(w), mode="valid")
-        dof = 2 * C * w
-        if noise_dof:  # estimated σ: F(dof, noise_dof) for the window mean
-            p = stats.f.sf(s / dof, dof, noise_dof)
-        else:
-            p = stats.chi2.sf(s, dof)
+        s = np.convolve(score, np.ones(w), mode="valid")
+        dof = point_dof * w
+        p = stats.f.sf(s / dof, dof, noise_dof) if noise_dof else stats.chi2.sf(s, dof)
         windows += [(p[i], i, i + w - 1) for i in range(p.size)]
-    n_tests = len(windows)
-    p_adj = np.minimum(np.array([p for p, _, _ in windows]) * n_tests, 1.0)
-    hit = p_adj < alpha / 2
-    spans = sorted((i0, i1) for (p, i0, i1), h in zip(windows, hit) if h)
+    p_adj = np.minimum(np.array([p for p, _, _ in windows]) * len(windows), 1.0)
+    spans = sorted((i0, i1) for (p, i0, i1), pa in zip(windows, p_adj) if pa < alpha / 2)
     bands: list[list[int]] = []
     for i0, i1 in spans:
         if bands and i0 <= bands[-1][1] + 1:
             bands[-1][1] = max(bands[-1][1], i1)
         else:
             bands.append([i0, i1])
-    bands_hz = [[float(freq[a]), float(freq[b])] for a, b in bands]
-    whiteness = {c: _lag1(v) for c, v in z.items()}
     p_band = float(p_adj.min()) if p_adj.size else 1.0
-    significant = (p_global < alpha / 2) or (p_band < alpha / 2)
-    return MismatchTest(significant, p_global, p_band, bands_hz, whiteness, per_point)
+    return p_band, [[float(freq[a]), float(freq[b])] for a, b in bands]
 
 
 def _lag1(v: np.ndarray) -> float:

@@ -99,30 +99,15 @@ def band_scan(freq, score, dof, alpha, widths=WIDTHS):
 
     Returns (p_value, bands_hz, p_global, p_band): p_value = 2·min(p_global,
     p_band) (both tests at level α/2), bands where a Bonferroni-corrected window
-    p-value is below α/2, merged.
+    p-value is below α/2, merged (`satmd.discovery.locate.scan_bands`, the scan of the linear fit's residuals).
     """
     from scipy import stats
 
+    from .locate import scan_bands
+
     score = np.asarray(score, float)
-    n = score.size
-    p_global = float(stats.chi2.sf(score.sum(), dof * n))
-    windows = []
-    for w in widths:
-        if w > n:
-            break
-        s = np.convolve(score, np.ones(w), mode="valid")
-        p = stats.chi2.sf(s, dof * w)
-        windows += [(p[i], i, i + w - 1) for i in range(p.size)]
-    p_adj = np.minimum(np.array([p for p, _, _ in windows]) * len(windows), 1.0) if windows else np.ones(1)
-    spans = sorted((i0, i1) for (p, i0, i1), pa in zip(windows, p_adj) if pa < alpha / 2)
-    merged = []
-    for i0, i1 in spans:
-        if merged and i0 <= merged[-1][1] + 1:
-            merged[-1][1] = max(merged[-1][1], i1)
-        else:
-            merged.append([i0, i1])
-    bands = [[float(freq[a]), float(freq[b])] for a, b in merged]
-    p_band = float(p_adj.min())
+    p_global = float(stats.chi2.sf(score.sum(), dof * score.size))
+    p_band, bands = scan_bands(freq, score, dof, alpha, widths)
     return min(1.0, 2 * min(p_global, p_band)), bands, p_global, p_band
 
 
