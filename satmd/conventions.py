@@ -28,3 +28,7 @@ TINY = 1e-300
 
 #: The paper's band [Hz]: the default wherever a band is not given (simulation, tuning, linearisation).
 PAPER_BAND_HZ = (20.0, 200.0)
+
+#: The relative error an FRF estimated from a recording carries beyond its noise std (the estimator's own
+#: model, sampling and the chain's filters): a change smaller than this everywhere is not evidence of physics.
+ESTIMATE_REL_FLOOR = 1e-3

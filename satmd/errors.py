@@ -9,6 +9,10 @@ class DataError(SatmdError):
     """Data that cannot be used (wrong shape, NaN, inconsistent channels)."""
 
 
+class DataTypeError(DataError, TypeError):
+    """An argument of the wrong type: a satmd error (one line, CLI exit status 2) and a `TypeError` too."""
+
+
 class FormatError(DataError):
     """A malformed file; the message names the file, line and column."""
 

@@ -7,6 +7,7 @@ to the channel's peak.
 """
 from __future__ import annotations
 
+from numbers import Real
 from typing import Any, Sequence
 
 import numpy as np
@@ -16,6 +17,7 @@ from .errors import DataError
 from .io.frfdata import FRFData
 from .physics import PAPER_GRID_HZ, Rig, frf
 from .physics.effects import Effect
+from .validation import NAMES, Interval, validate_params
 
 
 def noise_std(values: np.ndarray, rel: float, floor: float = 0.0) -> np.ndarray:
@@ -24,6 +26,8 @@ def noise_std(values: np.ndarray, rel: float, floor: float = 0.0) -> np.ndarray:
     return rel * mag + floor * mag.max(axis=-1, keepdims=True)
 
 
+@validate_params({"rig": [None, Rig], "channels": [NAMES], "meta": [None, dict], "time": [bool],
+                  "level": [Interval(Real, 0, open="lo")]})
 def simulate(
     freq_hz=PAPER_GRID_HZ,
     rig: Rig | None = None,
@@ -88,7 +92,7 @@ def simulate(
     pair: Any = (noise, 0.0) if np.isscalar(noise) else noise
     rel, floor = pair
     if rel < 0 or floor < 0 or (rel == 0 and floor == 0):
-        raise DataError(f"noise must be REL[:FLOOR] with REL, FLOOR >= 0 and not both 0 (got {rel}:{floor})")
+        raise DataError(f"simulate: noise must be rel or (rel, floor), numbers >= 0 and not both 0, got {noise!r}")
     rng = np.random.default_rng(seed)
     noisy, std = {}, {}
     for c, v in clean.items():

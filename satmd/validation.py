@@ -25,7 +25,7 @@ from typing import Any
 
 import numpy as np
 
-from .errors import DataError, SatmdError
+from .errors import DataError, DataTypeError, SatmdError
 
 
 class Whole(Real):
@@ -218,6 +218,8 @@ class SequenceOf:
 
 #: A list or tuple of names (parameters, channels, effects).
 NAMES = SequenceOf(str)
+#: How data arguments come to be, for `check_data`'s messages.
+LOAD_HINT = " (e.g. satmd.io.load_frf(path) or load_recording(path))"
 
 
 def describe(c) -> str:
@@ -287,6 +289,30 @@ def check(name: str, value, allowed, owner: str = "", error: type = DataError):
                     + ", ".join(options[0].values))
     raise error(f"{owner + ': ' if owner else ''}{name} must be " + " or ".join(describe(c) for c in allowed)
                 + f", got {_shown(value)}")
+
+
+def _kind_of(value) -> str:
+    return f"str {value!r}" if isinstance(value, str) and len(value) <= 60 else type(value).__name__
+
+
+def check_data(value, name: str, kinds: tuple, owner: str = "", single: bool = True, many: bool = False,
+               hint: str = ""):
+    """``value`` when it is one of the classes ``kinds`` (with ``single``) or a non-empty list or tuple of
+    them (with ``many``); else one `DataTypeError` line naming ``name``, or the first wrong item
+    ``name[i]``, what is wanted (then ``hint``, e.g. how to load it) and what was given. ``owner``: the
+    function named in the message (empty: none)."""
+    wanted, lead = " or ".join(k.__name__ for k in kinds), f"{owner}: " if owner else ""
+    if single and isinstance(value, kinds):
+        return value
+    if many and isinstance(value, (list, tuple)):
+        if not len(value):
+            raise DataTypeError(f"{lead}{name} is empty: give at least one {wanted}")
+        for i, item in enumerate(value):
+            if not isinstance(item, kinds):
+                raise DataTypeError(f"{lead}{name}[{i}] must be {wanted}{hint}, got {_kind_of(item)}")
+        return value
+    forms = f"{wanted}, or a list of them" if single and many else f"a list of {wanted}" if many else wanted
+    raise DataTypeError(f"{lead}{name} must be {forms}{hint}, got {_kind_of(value)}")
 
 
 def validate(params: dict, constraints: dict, owner: str = "", error: type = SatmdError) -> None:

@@ -3,8 +3,10 @@ into another package's private modules or names.
 
 The import graph is built statically (``ast`` over every module of ``satmd``), counting imports at
 module level and inside functions alike: a function-level import that closes a circle is still a
-circle, only a later one (imports under ``if TYPE_CHECKING:`` never run and do not count). Edges are
-resolved as Python resolves them:
+circle, only a later one. Imports under ``if TYPE_CHECKING:`` never run: they are left out of the
+run-time graph, and a second graph that counts them too must have no circle either (two modules that
+need each other's types are one responsibility split in two; issue 36). Edges are resolved as Python
+resolves them:
 
 * ``from .x import name`` points at the module ``x``; ``from . import x`` at the submodule ``x``.
 * ``from pkg import name``, where ``pkg/__init__.py`` only re-exports ``name`` from one of its
@@ -65,10 +67,12 @@ def _type_only(tree) -> set:
     return out
 
 
-def _imports(module: str):
-    """(target module, imported names or None, line) for every satmd import that runs in the module."""
-    skip = _type_only(TREES[module])
-    for node in ast.walk(TREES[module]):
+def _imports(module: str, typed: bool = False, trees=None):
+    """(target module, imported names or None, line) for every satmd import that runs in the module
+    (``typed``: those under ``if TYPE_CHECKING:`` as well)."""
+    tree = (TREES if trees is None else trees)[module]
+    skip = set() if typed else _type_only(tree)
+    for node in ast.walk(tree):
         if id(node) in skip:
             continue
         if isinstance(node, ast.Import):
@@ -115,11 +119,12 @@ def _ancestors(module: str):
     return {".".join(parts[:k]) for k in range(1, len(parts))}
 
 
-def _edges(module: str) -> dict:
-    """{target module: first line} of the module's imports within satmd."""
+def _edges(module: str, typed: bool = False, trees=None) -> dict:
+    """{target module: first line} of the module's imports within satmd (``typed``: with the imports
+    under ``if TYPE_CHECKING:``)."""
     out = {}
     own = _ancestors(module) | {module}
-    for target, names, line in _imports(module):
+    for target, names, line in _imports(module, typed, trees):
         while target not in MODULES:  # `import satmd.x.y` of something that is not a module
             target = target.rpartition(".")[0]
         hits = {_defining_module(target, n) for n in names} if names and target in PACKAGES else {target}
@@ -131,6 +136,7 @@ def _edges(module: str) -> dict:
 
 
 GRAPH = {m: _edges(m) for m in MODULES}
+TYPED_GRAPH = {m: _edges(m, typed=True) for m in MODULES}
 
 
 def _cycles(graph: dict) -> list[list[str]]:
@@ -184,8 +190,9 @@ def _one_cycle(graph, comp) -> list[str]:
     return sorted(comp)
 
 
-def _describe(cycle) -> str:
-    hops = [f"{a} (line {GRAPH[a][b]})" for a, b in itertools.pairwise(cycle)]
+def _describe(cycle, graph=None) -> str:
+    graph = GRAPH if graph is None else graph
+    hops = [f"{a} (line {graph[a][b]})" for a, b in itertools.pairwise(cycle)]
     return " -> ".join(hops + [cycle[-1]])
 
 
@@ -248,6 +255,40 @@ def test_the_checks_see_what_they_look_for():
 def test_no_import_cycle():
     done = _cycles(SETTLED)
     assert not done, "import cycles (module (line of the import) -> ...):\n" + "\n".join(map(_describe, done))
+
+
+def test_no_import_cycle_through_type_checking_imports():
+    """A circle closed by an import under ``if TYPE_CHECKING:`` never fails at run time, but the two
+    modules still need each other: move what both need to a module of its own (issue 36)."""
+    typed = [c for c in _cycles(TYPED_GRAPH) if c not in CYCLES]
+    assert not typed, ("import cycles through imports under `if TYPE_CHECKING:` (module (line) -> ...):\n"
+                       + "\n".join(_describe(c, TYPED_GRAPH) for c in typed))
+
+
+def test_the_cycle_check_sees_a_type_checking_import():
+    planted = {
+        "satmd.zz.a": ast.parse("from typing import TYPE_CHECKING\nfrom .b import f\n"
+                                "if TYPE_CHECKING:\n    from .b import T\n"),
+        "satmd.zz.b": ast.parse("from typing import TYPE_CHECKING\nif TYPE_CHECKING:\n    from .a import A\n"),
+    }
+    saved = dict(MODULES)
+    try:  # the planted modules resolve like real ones while the check runs
+        MODULES.update({m: ROOT / "zz" / (m.rpartition(".")[2] + ".py") for m in planted})
+        run = {m: _edges(m, trees=planted) for m in planted}
+        typed = {m: _edges(m, typed=True, trees=planted) for m in planted}
+    finally:
+        MODULES.clear()
+        MODULES.update(saved)
+    assert run == {"satmd.zz.a": {"satmd.zz.b": 2}, "satmd.zz.b": {}}
+    assert _cycles(run) == []
+    assert _cycles(typed) == [["satmd.zz.a", "satmd.zz.b", "satmd.zz.a"]]
+    assert _describe(["satmd.zz.a", "satmd.zz.b", "satmd.zz.a"], typed) == (
+        "satmd.zz.a (line 2) -> satmd.zz.b (line 3) -> satmd.zz.a")
+    # a private name taken under TYPE_CHECKING is a private name taken all the same
+    assert _private_names_across_modules({"satmd.zz.a": list(_imports("satmd.zz.b", True, {
+        "satmd.zz.b": ast.parse("from typing import TYPE_CHECKING\nif TYPE_CHECKING:\n"
+                                "    from .training import _Batches\n")}))}) == [
+        "satmd.zz.a:3: private name _Batches from satmd.zz.training"]
 
 
 def test_no_import_cycle_through_inverse():
@@ -412,9 +453,9 @@ def test_the_convention_checks_see_what_they_look_for():
 
 def _private_names_across_modules(imports=None) -> list[str]:
     """``from module import _name`` in another module (``imports``: {module: [(target, names, line)]},
-    default the package's own)."""
+    default the package's own, imports under ``if TYPE_CHECKING:`` included)."""
     out = []
-    for module, found in (imports or {m: _imports(m) for m in MODULES}).items():
+    for module, found in (imports or {m: _imports(m, typed=True) for m in MODULES}).items():
         for target, names, line in found:
             for n in names or ():
                 if n.startswith("_") and not n.startswith("__") and f"{target}.{n}" not in MODULES:

@@ -26,7 +26,7 @@ from functools import partial
 from numbers import Real
 from typing import Sequence
 
-from ..validation import NAMES, Interval, Whole, validate_params
+from ..validation import LOAD_HINT, NAMES, Interval, Whole, check_data, validate_params
 from ..conventions import ACCEL_CHANNELS, DEFAULT_FREE
 from .._fleet import fleet_map
 from ..identification import identify
@@ -86,6 +86,7 @@ def discover(
 
     from ..io.recording import Recording
 
+    check_data(data, "data", (FRFData, Recording), "discover", many=True, hint=LOAD_HINT)
     if isinstance(data, (list, tuple)):  # several recordings of one rig: judged together (issue 26)
         from .nonlinear_discover import discover_recordings
 

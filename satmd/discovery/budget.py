@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..conventions import TINY
+from ..conventions import ESTIMATE_REL_FLOOR, TINY
 
 __all__ = ["bias_share", "bias_note"]
 
@@ -45,6 +45,15 @@ def bias_share(with_effect, without_effect, bound) -> float:
 
 def bias_note(name: str, explanation: str, share: float, bound) -> dict:
     """The ``measurement`` finding for an effect within the estimator's bias."""
+    if float(np.max(bound)) <= ESTIMATE_REL_FLOOR:  # only the floor every estimate carries, no force-noise bias
+        return {"name": "within_estimator_bias",
+                "explanation": f"{name} would explain part of the mismatch ({explanation}), but its change to the "
+                               f"FRF is nowhere larger than the {100 * ESTIMATE_REL_FLOOR:.2g} % systematic error an "
+                               "estimate from a recording carries beyond its noise (its model, sampling, the chain's "
+                               "filters): too small to be told from the measurement, so it is not named as physics",
+                "remedy": "a change that moves it tests it (a recalibrated or second sensor, another rig setting); "
+                          "more averaging narrows the noise, not this floor",
+                "corrected": False}
     return {"name": "within_estimator_bias",
             "explanation": f"{name} would explain part of the mismatch ({explanation}), but its change to the FRF "
                            f"is nowhere larger than the bias the estimate may carry (at most {100 * share:.0f} % of "

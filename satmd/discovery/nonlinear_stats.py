@@ -29,7 +29,7 @@ global sum and the band scan of `band_scan` apply to both tests alike.
 """
 from __future__ import annotations
 
-from ..conventions import TINY
+from ..conventions import ESTIMATE_REL_FLOOR, TINY
 
 from dataclasses import dataclass, field
 from typing import Callable
@@ -289,7 +289,7 @@ def integrate(signal, fs_hz, times: int, band):
 
 
 # --- several records: level dependence -------------------------------------------------------------------
-REL_FLOOR = 0.001  # relative error an FRF estimate carries beyond its noise std (local-polynomial model error)
+REL_FLOOR = ESTIMATE_REL_FLOOR  # relative error an FRF estimate carries beyond its noise std
 
 
 def level_dependence(freq, frfs: list, stds: list, alpha: float = 1e-3, name: str = "level_dependence",

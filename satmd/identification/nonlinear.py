@@ -20,6 +20,7 @@ from __future__ import annotations
 
 import math
 import time
+from numbers import Integral, Real
 
 import numpy as np
 from scipy.optimize import least_squares
@@ -27,8 +28,10 @@ from scipy.optimize import least_squares
 from ..conventions import ACCEL_CHANNELS, DEFAULT_FREE
 from ..errors import DataError
 from ..io.estimate import estimate_frf
+from ..io.recording import Recording
 from ..physics import Rig, integrate
 from ..physics.nonlinear import NONLINEAR, NonlinearElement, element as make_element, response_rms
+from ..validation import NAMES, Interval, Whole, check_data, validate_params
 from .fit import identify
 from .nonlinear_result import NonlinearFit
 from .nonlinear_signal import band_error, band_limit, excited_error, valid
@@ -190,6 +193,10 @@ def linear_start(recordings, rig) -> Rig:
     return rig.replace(**{p: float(fit.values[p]) for p in LINEAR_FREE})
 
 
+@validate_params({"rig": [None, Rig], "start": [None, Rig], "free": [NAMES],
+                  "seconds": [None, Interval(Real, 0, open="lo")], "skip_s": [Interval(Real, 0)],
+                  "max_nfev": [Interval(Whole, 1)], "passes": [Interval(Whole, 1)], "simex": [Interval(Whole, 0)],
+                  "seed": [Interval(Integral, 0)], "oversample": [Interval(Whole, 1)]})
 def fit_nonlinear(recordings, element=None, rig: Rig | None = None, free=LINEAR_FREE, seconds: float | None = 30.0,
                   skip_s: float = 2.0, start: Rig | None = None, max_nfev: int = 40, passes: int = 2,
                   simex: int = 8, seed: int = 0, oversample: int = 4) -> NonlinearFit:
@@ -217,8 +224,7 @@ def fit_nonlinear(recordings, element=None, rig: Rig | None = None, free=LINEAR_
     NonlinearFit
     """
     t0 = time.perf_counter()
-    if not recordings:
-        raise DataError("fit_nonlinear needs at least one recording")
+    check_data(recordings, "recordings", (Recording,), "fit_nonlinear", single=False, many=True)
     rig = Rig() if rig is None else rig
     if isinstance(element, str):  # the class is what is fitted: start it at rest (strength from the scan)
         if element not in NONLINEAR:

@@ -112,6 +112,8 @@ class Problem:
         self.n_data = 2 * self.target.size
         self.pair = self._correlated_pair(data) if self.weighted else None
         self.kernel_rms_hz = float(data.estimator.get("kernel_rms_hz") or 0.0)
+        decay_s = float(data.estimator.get("window_decay_s") or 0.0)
+        self.window_decay_hz = 1.0 / (2.0 * np.pi * decay_s) if decay_s > 0 else 0.0
 
     def _correlated_pair(self, data):
         """(i, j, conj ρ, 1/sqrt(1 − |ρ|²)) for two channels whose noise is correlated, else None.
@@ -230,8 +232,12 @@ class Problem:
         kernel; to second order that is the mean of H(f − s) and H(f + s), s the
         kernel's RMS width (for Hann s = Δf/√3, the −(4/3)(Δf/B_r)² peak bias of
         Bendat & Piersol). Comparing the model through the same kernel compares
-        like with like, so the window's bias is never taken for physics.
+        like with like, so the window's bias is never taken for physics. An exponential
+        window (an impact test that does not ring down) is exact: the model at
+        the complex frequency ``f − i/(2πτ)``.
         """
+        if self.window_decay_hz:  # an exponential window e^(-t/τ) gives H(iω + 1/τ): f − i/(2πτ) in Hz
+            return self.freq_hz - 1j * self.window_decay_hz
         s = self.kernel_rms_hz
         if not s:
             return self.freq_hz

@@ -13,17 +13,15 @@ from __future__ import annotations
 import math
 import time
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 import torch
 
 from ..physics import Rig
+from .batches import Batches
+from .config import TrainConfig
 from .nets import EnsembleNet
 from .objective import MAX_STEP, ShuntMobius, gauss_newton_step, physics_loss, physics_objective
-
-if TYPE_CHECKING:
-    from .training import TrainConfig
-    from .training import _Batches as Batches
 
 N_VAL_POINTS = 20  # validation MAE is recorded this many times per run (cheap history, not every epoch)
 

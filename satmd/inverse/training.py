@@ -71,7 +71,6 @@ from __future__ import annotations
 import contextlib
 import math
 import time
-from dataclasses import asdict, dataclass
 from typing import Any
 
 import numpy as np
@@ -87,33 +86,12 @@ from ..physics import Rig
 from .dataset import BOUNDS, InverseDataset
 from .nets import EnsembleNet
 from .objective import ShuntMobius, gauss_newton_step, physics_loss, physics_objective, real_of  # noqa: F401 - re-exported
+from .batches import Batches, Scaler
+from .config import TrainConfig  # noqa: F401 - re-exported (satmd.inverse.training.TrainConfig)
 from .steps import TrainingRun, run_phase
 
 REFERENCE_BATCH = 64  # the batch at which ``lr`` is quoted (sqrt rule above)
-
-
-@dataclass(frozen=True)
-class TrainConfig:
-    """Resolved training settings. Build it with `InverseModel.train_config` (the defaults live there)."""
-
-    objective: str
-    epochs: int
-    warm_start_epochs: int
-    batch_size: int
-    lr: float
-    physics_lr: float
-    lr_final: float
-    n_members: int
-    noise: float
-    seed: int
-    device: str | None
-    precondition: bool
-    threads: int | None
-    twin_dtype: str
-    jacobian: str = "mobius"
-
-    def to_dict(self):
-        return asdict(self)
+_Batches = Batches  # the name before the batches moved to their own module (steps and training share them)
 
 
 def pick_device(device=None) -> torch.device:
@@ -142,62 +120,6 @@ def check_device(device) -> None:
 def scaled_lr(lr: float, batch_size: int) -> float:
     """Peak learning rate for ``batch_size`` from the rate quoted at `REFERENCE_BATCH`."""
     return float(lr) * math.sqrt(int(batch_size) / REFERENCE_BATCH)
-
-
-class Scaler:
-    """Per-feature standardisation fitted on training features (stored in the model's metadata)."""
-
-    def __init__(self, mean: np.ndarray, scale: np.ndarray):
-        self.mean = np.asarray(mean, np.float64)
-        self.scale = np.asarray(scale, np.float64)
-
-    @classmethod
-    def fit(cls, x: np.ndarray) -> "Scaler":
-        x = np.asarray(x, np.float64)
-        scale = x.std(axis=0)
-        scale = np.where(scale > 0, scale, 1.0)
-        return cls(x.mean(axis=0), scale)
-
-    def transform(self, x: np.ndarray) -> np.ndarray:
-        return ((np.asarray(x, np.float64) - self.mean) / self.scale).astype(np.float32)
-
-    def to_dict(self):
-        return {"mean": self.mean.tolist(), "scale": self.scale.tolist()}
-
-    @classmethod
-    def from_dict(cls, d):
-        return cls(np.array(d["mean"], float), np.array(d["scale"], float))
-
-
-class _Batches:
-    """Tensors of one partition, resident on the training device."""
-
-    def __init__(self, ds: InverseDataset, scaler: Scaler, bounds, device, dtype, members=None):
-        self.n = len(ds)
-        # members: per ensemble member, the indices of the samples it trains on (None: every member, every sample)
-        self.members = None if members is None else [
-            torch.as_tensor(np.flatnonzero(m), device=device) for m in np.asarray(members, bool)]
-        self.n_epoch = self.n if self.members is None else max(len(m) for m in self.members)
-        self.x = torch.as_tensor(scaler.transform(ds.features()), device=device)
-        # per-feature noise scale in standardised units: |A| / feature scale
-        mag = np.abs(np.concatenate([ds.a1, ds.a2], axis=-1))
-        self.noise_unit = torch.as_tensor(np.concatenate([mag, mag], axis=-1) / scaler.scale, dtype=torch.float32,
-                                          device=device)
-        self.y = torch.as_tensor(ds.labels_normalised(bounds), dtype=torch.float32, device=device)
-        target = np.stack([ds.a1, ds.a2], axis=1)
-        self.target = torch.as_tensor(target, dtype=dtype, device=device)
-        self.s_n = torch.as_tensor(np.abs(target).max(axis=(1, 2)), dtype=real_of(dtype), device=device)
-
-    def epoch_order(self, gen) -> torch.Tensor:
-        """One epoch's sample order: (n,) shared by all members, or (E, n_epoch), each member its own samples
-        (a member with fewer samples than the largest starts its order again to fill the epoch)."""
-        if self.members is None:
-            return torch.randperm(self.n, generator=gen).to(self.x.device)
-        rows = []
-        for m in self.members:
-            p = m[torch.randperm(len(m), generator=gen).to(m.device)]
-            rows.append(p.repeat(math.ceil(self.n_epoch / len(m)))[:self.n_epoch])
-        return torch.stack(rows)
 
 
 def train_ensemble(train: InverseDataset, val: InverseDataset | None, config: TrainConfig, scaler: Scaler,
@@ -233,8 +155,8 @@ def train_ensemble(train: InverseDataset, val: InverseDataset | None, config: Tr
         raise DataError(f"members must be a boolean array ({config.n_members}, {len(train)}), got {np.shape(members)}")
     if members is not None and not np.all(np.any(members, axis=1)):
         raise DataError("every ensemble member needs training samples")
-    tr = _Batches(train, scaler, bounds, device, dtype, members)
-    va = _Batches(val, scaler, bounds, device, dtype) if val is not None and len(val) else None
+    tr = Batches(train, scaler, bounds, device, dtype, members)
+    va = Batches(val, scaler, bounds, device, dtype) if val is not None and len(val) else None
     freq_t = torch.as_tensor(train.freq_hz, dtype=real_of(dtype), device=device)
 
     warm = min(int(config.warm_start_epochs), int(config.epochs)) if config.objective == "physics" else 0
@@ -336,7 +258,7 @@ def per_sample_epoch(net: EnsembleNet, train: InverseDataset, scaler: Scaler, ri
     ``max_samples`` only that many samples are timed and the time is scaled.
     """
     rig = Rig() if rig is None else rig
-    tr = _Batches(train, scaler, bounds, torch.device("cpu"), dtype)
+    tr = Batches(train, scaler, bounds, torch.device("cpu"), dtype)
     freq_t = torch.as_tensor(train.freq_hz, dtype=real_of(dtype))
     opt = torch.optim.Adam(net.parameters(), lr=lr)
     n = tr.n if max_samples is None else min(tr.n, max_samples)

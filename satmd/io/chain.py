@@ -7,7 +7,7 @@ physics, so an artifact of the chain never appears as an effect.
 """
 from __future__ import annotations
 
-from dataclasses import asdict, dataclass
+from dataclasses import asdict, dataclass, field
 
 import numpy as np
 
@@ -23,16 +23,18 @@ class MeasurementFinding:
     name : short identifier (``resolution_bias``, ``force_noise_bias``, ``clipping``, ...)
     explanation : what it is and how large, in words
     remedy : the setting or change that removes it
-    corrected : True when satmd already removed it from the estimate
+    corrected : True when satmd already removed it from the estimate, or models it in every fit
+    values : the numbers a fit needs to model it (e.g. an exponential window's ``decay_s``); not reported
     """
 
     name: str
     explanation: str
     remedy: str
     corrected: bool = False
+    values: dict = field(default_factory=dict, compare=False)
 
     def to_dict(self) -> dict:
-        return asdict(self)
+        return {k: v for k, v in asdict(self).items() if k != "values"}
 
 
 def half_power_widths(freq_hz: np.ndarray, h: np.ndarray, min_height: float = 0.2) -> list[tuple[float, float]]:

@@ -7,12 +7,15 @@ measurement chain did (`satmd.io.chain`); Welch machinery lives in
 """
 from __future__ import annotations
 
+from numbers import Real
+
 import numpy as np
 
-from ..conventions import RECORDING_CHANNELS
+from ..conventions import ESTIMATE_REL_FLOOR, RECORDING_CHANNELS
 from ..errors import DataError
+from ..validation import LOAD_HINT, Interval, Whole, check_data, validate_params
 from ._common import warn
-from .frfdata import FRFData, require_data
+from .frfdata import FRFData
 from .recdata import check_rate
 from .recording import Recording
 from .transmissibility import Transmissibility, model_transmissibility, save_transmissibility, transmissibility
@@ -32,6 +35,8 @@ __all__ = ["estimate_frf", "describe_estimate", "default_nperseg", "get_window",
            "Transmissibility", "model_transmissibility", "transmissibility", "save_transmissibility"]
 
 
+@validate_params({"nperseg": [None, Interval(Whole, 8)], "overlap": [None, Interval(Real, 0, 1, "hi")],
+                  "width_hz": [None, Interval(Real, 0, open="lo")], "period_s": [None, Interval(Real, 0, open="lo")]})
 def estimate_frf(recording: Recording, nperseg: int | None = None, window=None, overlap: float | None = None,
                  estimator: str | None = None, band=None, width_hz: float | None = None,
                  excitation: str = "auto", period_s: float | None = None) -> FRFData:
@@ -73,7 +78,7 @@ def estimate_frf(recording: Recording, nperseg: int | None = None, window=None, 
     """
     from .excitation import detect_excitation
 
-    require_data(recording, "recording", Recording)
+    check_data(recording, "recording", (Recording,), "estimate_frf", hint=LOAD_HINT)
     source, responses = _check_force(recording)
     welch_given = any(v is not None for v in (nperseg, window, overlap))
     exc = detect_excitation(recording, excitation, period_s)
@@ -227,9 +232,14 @@ def _estimate_designed(recording: Recording, exc, band) -> FRFData:
             "band_hz": [round(float(f[0]), 6), round(float(f[-1]), 6)], "points": int(f.size),
             "noise_dof": round(float(dof), 1), "excitation": exc.to_dict(),
             "measurement": [x.to_dict() for x in findings]}
+    decay = [x.values["decay_s"] for x in findings if "decay_s" in x.values]
+    if decay:  # an exponential window: the estimate is H(iω + 1/τ), and fits compare the model there
+        info["window_decay_s"] = float(decay[0])
     meta = {"source": str(source), "estimator": exc.kind, "band_hz": f"{f[0]:.6g}:{f[-1]:.6g}",
             "noise_dof": f"{dof:.0f}", "noise": noise}
-    return FRFData(f, frf, std, meta, coherence=coh, estimator=info)
+    # beyond its noise, an estimate carries its model's and the chain's small systematic error: an effect whose
+    # whole signature stays within it is reported as measurement, not physics (`satmd.discovery.budget`)
+    return FRFData(f, frf, std, meta, coherence=coh, estimator=info, bias_bound=np.full(f.size, ESTIMATE_REL_FLOOR))
 
 
 def _estimate_welch(recording: Recording, nperseg, window, overlap, estimator, band) -> FRFData:

@@ -86,6 +86,7 @@ SCHEMA = {
     "overlap": _number(0, 1),
     "segments": _number(1, 1e12, integer=True),
     "resolution_hz": _number(0, MAX_HZ, lo_open=True),
+    "window_decay_s": _number(0, 1e12, lo_open=True),  # an exponential window's τ: the data are H(iω + 1/τ)
 }
 
 

@@ -54,8 +54,10 @@ def sweep_frf(recording, responses, band, force=None):
     Returns
     -------
     tuple
-        One point per window (independent points): frequencies; per FRF channel the FRF, the std of each
-        of its parts and a local coherence (1 − residual share); the noise degrees of freedom.
+        One point per window (independent points): the FRF (a sweep: the local polynomial's centre; hits:
+        Y/X at the window's most strongly forced bin, exact for whole transients), the std of each of its
+        parts from the noise the local polynomial leaves (smoothed over neighbouring windows), a local
+        coherence (1 − residual share); the noise degrees of freedom.
     """
     fs, n = recording.fs_hz, recording.n_samples
     x = np.asarray(recording["force"] if force is None else force, float)
@@ -72,6 +74,8 @@ def sweep_frf(recording, responses, band, force=None):
     AhA = np.einsum("wkp,wkq->wpq", A.conj(), A)
     inv = np.linalg.inv(AhA + TINY * np.eye(DEGREE + 1))
     dof_window = width - DEGREE - 1
+    rows, best = np.arange(idx.shape[0]), np.argmax(np.abs(X[idx]), axis=1)  # one point per window: its best bin
+    Xb = X[idx][rows, best]
     frf, std, coh = {}, {}, {}
     for r in responses:
         y = np.asarray(recording[r], float)
@@ -81,11 +85,17 @@ def sweep_frf(recording, responses, band, force=None):
         s2 = np.sum(np.abs(resid) ** 2, axis=1) / dof_window
         s2 = np.convolve(s2, np.ones(SMOOTH) / SMOOTH, "same")  # the noise spectrum is smooth
         ch = RECORDING_CHANNELS[r]
-        frf[ch] = coef[:, 0]
-        std[ch] = np.sqrt(np.maximum(s2 * inv[:, 0, 0].real, 0.0) / 2.0)
+        if force is None:  # a sweep: its force is even across a window, and the polynomial's centre averages it
+            frf[ch] = coef[:, 0]
+            std[ch] = np.sqrt(np.maximum(s2 * inv[:, 0, 0].real, 0.0) / 2.0)
+        else:  # hits: their spectra interfere, so a few bins of each window hold the force; the record holds
+            # whole transients, so Y = G X bin by bin: the ratio at the best-forced bin is exact but for noise,
+            # where a polynomial would smooth a resonance narrower than the window
+            frf[ch] = Y[rows, best] / Xb
+            std[ch] = np.sqrt(np.maximum(s2, 0.0) / np.abs(Xb) ** 2 / 2.0)
         coh[ch] = np.clip(1.0 - np.sum(np.abs(resid) ** 2, axis=1) / np.maximum(np.sum(np.abs(Y) ** 2, axis=1), TINY),
                           0.0, 1.0)
-    return f[centres], frf, std, coh, 2.0 * dof_window * SMOOTH
+    return f[idx[rows, best] if force is not None else centres], frf, std, coh, 2.0 * dof_window * SMOOTH
 
 
 __all__ = ["at_rest_at_the_end", "sweep_frf"]

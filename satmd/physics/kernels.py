@@ -1,24 +1,35 @@
 """NumPy kernels of the closed-form solve of `model.py`, for the batched driver `model.frf`.
 
 `model.terms` writes Z's entries and `model.solve` the closed form, once, for
-every backend. The two kernels here evaluate that closed form on NumPy chunks:
+every backend. The kernels here evaluate that closed form on NumPy chunks:
 
 * `solve_into`: the values, the same operations in the same order as
   `model.solve` (so the same bits), with every (batch, frequency) temporary in
   a scratch buffer reused from chunk to chunk and each channel written straight
   into the caller's output. Fewer allocations and passes over memory is what
   makes the NumPy path fast: most of its time is spent moving complex arrays.
+* `solve_plain_into`: `model.terms` and `solve_into` fused for the model without
+  effects (no hooks to call): Z's entries written from the real products `terms`
+  multiplies out to, straight into the buffers the solve reads. The same bits.
 * `solve_with_tangents`: the values and the Jacobian, tangents pushed through
-  the closed form, dx/dθ = -Z⁻¹ (dZ/dθ) x, written out for the eliminated system.
+  the closed form, dx/dθ = -Z⁻¹ (dZ/dθ) x, written out for the eliminated system;
+  `plain_dual_terms` gives it the plain model's terms and their tangents in the
+  usual free parameters without dual arithmetic on whole arrays.
+
+Where the time goes (10⁴ rigs x 60 frequencies, issue 36): the two complex
+divisions (numpy's Smith loop, a third of a chunk), the passes over complex
+arrays, and the kernel's page faults on fresh output memory: the outputs are one
+allocation (`model.frf`), mapped in huge pages, not one per channel.
 """
 from __future__ import annotations
 
 import math
+from types import SimpleNamespace
 from typing import Any, Sequence
 
 import numpy as np
 
-from ..conventions import ACCEL_CHANNELS
+from ..conventions import ACCEL_CHANNELS, DEFAULT_FREE
 from . import dual
 
 
@@ -57,6 +68,82 @@ def solve_into(t, out: dict, work: "Workspace") -> None:
         np.multiply(work.full("g2", mw2 if t.s2 is None else mw2 * t.s2, shape), u2, out=out["a2"])
 
 
+def solve_plain_into(omega, rig, out: dict, work: "Workspace") -> None:
+    """`model.solve` of `model.terms` without effects, fused and in place; bit for bit the same.
+
+    ``rig`` is a mapping of the rig's fields (scalars or arrays of shape (rows, 1)). Z's entries are not
+    formed as complex arrays of their own: each is written from the real products `terms` multiplies
+    out to (iω (R + iωL) = -ω(ωL) + iωR exactly, and so on), straight into the real or imaginary part
+    of the buffer the solve reads, and frequency-only factors are kept broadcast across chunks.
+    """
+    shape = next(iter(out.values())).shape
+
+    def dest(name):
+        return out[name] if name in out else work.get(name, shape)
+
+    w2 = omega * omega
+    Cp = rig["Cp"]
+    Z33 = work.get("Z33", shape)  # 1/Cp + iω (R + iωL) = (1/Cp - ω (ωL)) + i ωR
+    wL = np.multiply(omega, rig["L"], out=work.get("wL", shape, float))
+    np.subtract(1.0 / Cp, np.multiply(work.full("w", omega, shape, float), wL, out=wL), out=Z33.real)
+    np.multiply(omega, rig["R"], out=Z33.imag)
+    b = rig["e"] / Cp
+    bz = np.divide(b, Z33, out=work.get("bz", shape))
+    K = np.multiply(b, bz, out=work.get("K", shape))
+    np.subtract(rig["kp"], K.real, out=K.real)  # K = (kp + iω cp) - b bz
+    np.subtract(work.full("wcp", omega * rig["cp"], shape, float), K.imag, out=K.imag)
+    M2 = work.get("M2 (real)", shape)  # only its real part is ever written: a real m2 ω² the complex products take
+    np.multiply(rig["m2"], w2, out=M2.real)
+    KmM = np.subtract(K, M2, out=work.get("KmM", shape))
+    K1 = rig["k1"] - rig["m1"] * w2 + 1j * omega * rig["c1"]
+    inv = np.multiply(work.full("K1", K1, shape), KmM, out=work.get("inv", shape))
+    np.subtract(inv, np.multiply(K, M2, out=work.get("tmp", shape)), out=inv)
+    np.divide(rig["F0"], inv, out=inv)  # inv = F0 / (K1 KmM - K M2)
+    u1: Any = np.multiply(KmM, inv, out=dest("u1")) if "u1" in out or "a1" in out else None
+    u2: Any = np.multiply(K, inv, out=dest("u2")) if "u2" in out or "a2" in out else None
+    if "q" in out:
+        np.multiply(np.multiply(bz, M2, out=work.get("tmp", shape)), inv, out=out["q"])
+    if "a1" in out or "a2" in out:
+        mw2 = work.full("g", -w2, shape)
+        for ch, u in (("a1", u1), ("a2", u2)):
+            if ch in out:
+                np.multiply(mw2, u, out=out[ch])
+
+
+#: rig fields whose tangents `plain_dual_terms` writes itself (the model's usual free parameters)
+PLAIN_WRT = frozenset(DEFAULT_FREE)
+
+
+def plain_dual_terms(omega, rig, wrt: Sequence[str], work: "Workspace") -> SimpleNamespace:
+    """`model.terms` of the plain model (no effects) with duals seeded on ``wrt`` (names from `PLAIN_WRT`),
+    bit for bit: the values written in place as `solve_plain_into` writes them, the tangents those the
+    duals carry through `model.terms` (dKp/dkp = 1, dZ33/dR = iω, dZ33/dL = -ω², d(m2 ω²)/dm2 = ω²), with
+    none of the dual arithmetic on (rows, frequency) arrays, and b / Z33 and K = Kp - b bz (``bz_K``) as
+    `solve_plain_into` writes them. ``rig`` maps the rig's fields to scalars or arrays of shape (rows, 1).
+    For `solve_with_tangents`."""
+    shape = np.broadcast_shapes(omega.shape, *(np.shape(v) for v in rig.values()))
+    w2 = omega * omega
+    Cp = rig["Cp"]
+    Z33 = work.get("Z33", shape)  # as in solve_plain_into
+    wL = np.multiply(omega, rig["L"], out=work.get("wL", shape, float))
+    np.subtract(1.0 / Cp, np.multiply(work.full("w", omega, shape, float), wL, out=wL), out=Z33.real)
+    np.multiply(omega, rig["R"], out=Z33.imag)
+    b = rig["e"] / Cp
+    bz = np.divide(b, Z33, out=work.get("bz", shape))
+    K = np.multiply(b, bz, out=work.get("K", shape))  # Kp - b bz with Kp = kp + iω cp = (kp, ω cp) exactly
+    np.subtract(rig["kp"], K.real, out=K.real)
+    np.subtract(work.full("wcp", omega * rig["cp"], shape, float), K.imag, out=K.imag)
+    M2 = work.get("M2 (real)", shape)  # complex with a zero imaginary part, as the solve casts it
+    np.multiply(rig["m2"], w2, out=M2.real)
+    iw = 1j * omega
+    dZ33 = {"R": 1.0 * iw, "L": (1.0 * iw) * iw}  # what the duals of R and L come out of `terms` with
+    return SimpleNamespace(
+        omega=omega, K1=rig["k1"] - rig["m1"] * w2 + 1j * omega * rig["c1"], b=b, F0=rig["F0"],
+        Kp=dual.Dual(None, {"kp": 1.0} if "kp" in wrt else {}),  # its value is in bz_K: K = Kp - b bz
+        Z33=dual.Dual(Z33, {n: dZ33[n] for n in ("R", "L") if n in wrt}), bz_K=(bz, K),
+        M2=dual.Dual(M2, {"m2": 1.0 * w2}) if "m2" in wrt else M2, s1=None, s2=None)
+
+
 class Workspace:
     """Scratch buffers of one worker thread, kept across chunks."""
 
@@ -65,19 +152,20 @@ class Workspace:
         self._views = {}
         self._tiles = {}
 
-    def get(self, name, shape):
-        """The complex scratch array ``name`` of ``shape`` (its contents are whatever was left there)."""
+    def get(self, name, shape, dtype=complex):
+        """The scratch array ``name`` of ``shape`` (its contents are whatever was left there; a new
+        buffer starts as zeros, so a complex one of which only ``.real`` is ever written stays real)."""
         view = self._views.get((name, shape))
         if view is None:
             size = math.prod(shape)
             buf = self._buffers.get(name)
             if buf is None or buf.size < size:
-                buf = self._buffers[name] = np.empty(size, dtype=complex)
+                buf = self._buffers[name] = np.zeros(size, dtype=dtype)
             view = self._views[name, shape] = buf[:size].reshape(shape)
         return view
 
-    def full(self, name, x, shape):
-        """``x`` as a complex array of the chunk's ``shape``. A quantity that
+    def full(self, name, x, shape, dtype=complex):
+        """``x`` as an array of the chunk's ``shape``. A quantity that
         varies along frequency only (the same in every chunk) is broadcast once
         and kept while it does not change: operations on whole contiguous
         arrays run several times faster than on broadcast ones. Exact."""
@@ -86,7 +174,7 @@ class Workspace:
         key = x.tobytes()  # ~1 KB: cheaper to compare than anything else
         cached = self._tiles.get((name, shape))
         if cached is None or cached[0] != key:
-            cached = self._tiles[name, shape] = (key, self.get(name, shape))
+            cached = self._tiles[name, shape] = (key, self.get(name, shape, dtype))
             cached[1][...] = x
         return cached[1]
 
@@ -101,24 +189,36 @@ def solve_with_tangents(t, wrt: Sequence[str], outputs: Sequence[str], out_value
     intermediates (K, m2 ω², K1, F0, b, Z33, sensor factors), so the
     coefficient d(output)/d(intermediate) is computed once and shared by all
     parameters: a 4-parameter Jacobian costs a few FRFs, not four. ``work``
-    keeps frequency-only tangents (d(m2 ω²)/dm2 = ω², ...) broadcast across chunks.
+    keeps frequency-only tangents (d(m2 ω²)/dm2 = ω², ...) broadcast across chunks,
+    and every (rows, F) intermediate in a scratch buffer reused from chunk to chunk
+    (the same operations in the same order as without it: the same bits).
     """
     shape = next(iter(out_values.values())).shape
 
     def full(key, x):
         return x if work is None else work.full(key, x, shape)
 
+    def buf(name):  # a scratch array for ``out=`` (None: a new array)
+        return None if work is None else work.get("tangents " + name, shape)
+
     v = {k: dual.value(getattr(t, k)) for k in ("omega", "K1", "Kp", "b", "Z33", "M2", "F0", "s1", "s2")}
     K1, b, Z33, M2, F0 = full("K1", v["K1"]), v["b"], v["Z33"], v["M2"], v["F0"]
     if isinstance(M2, np.ndarray) and M2.dtype.kind == "f":  # cast once (exact), not in each product
-        M2 = M2.astype(complex)
-    bz = b / Z33
-    K = v["Kp"] - b * bz
-    KmM = K - M2
-    rdet = 1.0 / (K1 * KmM - K * M2)
-    inv = F0 * rdet
-    u = {"u1": np.multiply(KmM, inv, **_into(out_values, "u1")), "u2": np.multiply(K, inv, **_into(out_values, "u2"))}
-    q: Any = np.multiply(bz * M2, inv, **_into(out_values, "q")) if "q" in outputs else None
+        M2c = M2.astype(complex) if work is None else buf("M2")
+        M2c[...] = M2
+        M2 = M2c
+    if getattr(t, "bz_K", None) is not None:  # b / Z33 and Kp - b bz, written in place (`plain_dual_terms`)
+        bz, K = t.bz_K
+    else:
+        bz = np.divide(b, Z33, out=buf("bz"))
+        K = np.subtract(v["Kp"], np.multiply(b, bz, out=buf("K")), out=buf("K"))  # Kp - b bz
+    KmM = np.subtract(K, M2, out=buf("KmM"))
+    rdet = np.multiply(K1, KmM, out=buf("rdet"))
+    rdet = np.divide(1.0, np.subtract(rdet, np.multiply(K, M2, out=buf("x")), out=rdet), out=rdet)
+    inv = np.multiply(F0, rdet, out=buf("inv"))
+    u = {ch: np.multiply(a, inv, out=out_values[ch] if ch in out_values else buf(ch))
+         for ch, a in (("u1", KmM), ("u2", K))}
+    q: Any = np.multiply(np.multiply(bz, M2, out=buf("x")), inv, **_into(out_values, "q")) if "q" in outputs else None
     mw2 = -(v["omega"] * v["omega"])
     gain = {"a1": full("g1", mw2 if v["s1"] is None else mw2 * v["s1"]),
             "a2": full("g2", mw2 if v["s2"] is None else mw2 * v["s2"])}
@@ -129,23 +229,26 @@ def solve_with_tangents(t, wrt: Sequence[str], outputs: Sequence[str], out_value
 
     def bz_times(k):
         if k not in shared:
-            shared[k] = (-2.0 * bz) if k == -2.0 else (bz * bz)
+            shared[k] = np.multiply(-2.0, bz, out=buf("-2 bz")) if k == -2.0 else np.multiply(bz, bz, out=buf("bz2"))
         return shared[k]
 
     base = {}  # d(u1, u2)/d(intermediate)
 
     def du(key):
         if key not in base:
+            d1, d2 = buf(f"d{key}/1"), buf(f"d{key}/2")
             if key == "K":
-                T = (K1 - M2) * rdet
-                base[key] = (inv - u["u1"] * T, inv - u["u2"] * T)
+                T = np.multiply(np.subtract(K1, M2, out=buf("T")), rdet, out=buf("T"))  # T, S: one buffer
+                base[key] = (np.subtract(inv, np.multiply(u["u1"], T, out=d1), out=d1),
+                             np.subtract(inv, np.multiply(u["u2"], T, out=d2), out=d2))
             elif key == "M2":
-                S = (K1 + K) * rdet
-                base[key] = (u["u1"] * S - inv, u["u2"] * S)
+                S = np.multiply(np.add(K1, K, out=buf("T")), rdet, out=buf("T"))
+                base[key] = (np.subtract(np.multiply(u["u1"], S, out=d1), inv, out=d1), np.multiply(u["u2"], S, out=d2))
             elif key == "K1":
-                base[key] = (-u["u1"] * KmM * rdet, -u["u2"] * KmM * rdet)
+                base[key] = tuple(np.multiply(np.multiply(np.negative(u[c], out=d), KmM, out=d), rdet, out=d)
+                                  for c, d in (("u1", d1), ("u2", d2)))
             else:  # F0
-                base[key] = (KmM * rdet, K * rdet)
+                base[key] = (np.multiply(KmM, rdet, out=d1), np.multiply(K, rdet, out=d2))
         return base[key]
 
     coefs = {}  # d(channel)/d(intermediate)
@@ -154,9 +257,10 @@ def solve_with_tangents(t, wrt: Sequence[str], outputs: Sequence[str], out_value
         if (key, ch) not in coefs:
             d1, d2 = du(key)
             if ch == "q":
-                coefs[key, ch] = -bz * (d1 - d2)
+                diff = np.subtract(d1, d2, out=buf(f"c{key}/q"))
+                coefs[key, ch] = np.multiply(np.negative(bz, out=buf("x")), diff, out=diff)
             elif ch in ACCEL_CHANNELS:
-                coefs[key, ch] = gain[ch] * (d1 if ch == "a1" else d2)
+                coefs[key, ch] = np.multiply(gain[ch], d1 if ch == "a1" else d2, out=buf(f"c{key}/{ch}"))
             else:
                 coefs[key, ch] = d1 if ch == "u1" else d2
         return coefs[key, ch]
@@ -173,8 +277,17 @@ def solve_with_tangents(t, wrt: Sequence[str], outputs: Sequence[str], out_value
         moves = [(key, dx) for key, dx in (("K", dK), ("M2", d["M2"]), ("K1", d["K1"]), ("F0", d["F0"])) if dx is not None]
         params.append((d, moves))
     for ch in outputs:
-        cols = []
-        for d, moves in params:
+        for j, (d, moves) in enumerate(params):
+            column = out_jac[ch][..., j]
+            extra = (ch == "q" and (d["b"] is not None or d["Z33"] is not None)) or (
+                ch in ACCEL_CHANNELS and d["s" + ch[1]] is not None)
+            if len(moves) == 1 and not extra:  # one product, written straight into the Jacobian's column
+                c, dx = coef(moves[0][0], ch), moves[0][1]
+                if _is_one(dx):
+                    column[...] = c
+                else:
+                    np.multiply(c, dx, out=column)
+                continue
             col = None
             for key, dx in moves:
                 c = coef(key, ch)
@@ -186,9 +299,7 @@ def solve_with_tangents(t, wrt: Sequence[str], outputs: Sequence[str], out_value
                     col = _acc(col, (-q / Z33) * d["Z33"])
             elif ch in ACCEL_CHANNELS and d["s" + ch[1]] is not None:
                 col = _acc(col, (mw2 * d["s" + ch[1]]) * u["u" + ch[1]])
-            cols.append(col)
-        for j, col in enumerate(cols):  # the columns back to back: the chunk's (rows, F, P) block stays in cache
-            out_jac[ch][..., j] = 0.0 if col is None else col
+            column[...] = 0.0 if col is None else col
 
 
 def _into(out: dict, ch: str) -> dict:

@@ -32,12 +32,13 @@ from ..errors import DataError  # a ValueError: user-facing, one line
 
 from . import dual
 from .effects import Effect
-from .kernels import Workspace, solve_into, solve_with_tangents
+from .kernels import PLAIN_WRT, Workspace, plain_dual_terms, solve_into, solve_plain_into, solve_with_tangents
 from .rig import Rig
 
 STATES = ("u1", "u2", "q")
 CHANNELS = ("u1", "u2", "q", "a1", "a2")
-# complex elements per chunk: keeps the working set (about 16 arrays) in a 2 MB L2 cache
+# complex elements per chunk: keeps the working set (about 16 arrays) within 2 MB of cache; a Jacobian's
+# chunks are twice as long (its Python work per chunk is several times a plain solve's)
 _CHUNK_ELEMENTS = 8192
 # below this many (batch x frequency) points threads cost more than they give
 _THREADED_POINTS = 100_000
@@ -135,7 +136,9 @@ class Response:
     Each of ``u1, u2, q, a1, a2`` is complex with shape ``(*batch, n_freq)``.
     ``a1, a2`` are what the sensors report (sensor effects applied);
     ``u1, u2, q`` are the physical states. When a Jacobian was asked for,
-    ``jac[channel]`` has shape ``(*batch, n_freq, len(wrt))``.
+    ``jac[channel]`` has shape ``(*batch, n_freq, len(wrt))``. The channels' arrays
+    (and the Jacobians') are slabs of one allocation each: a channel kept alone keeps
+    the memory of the others.
     """
 
     freq_hz: np.ndarray
@@ -214,7 +217,8 @@ def frf(
     Parameters
     ----------
     freq_hz : array_like, shape (n_freq,)
-        Frequencies in Hz (> 0 not required; 0 gives the static solution).
+        Frequencies in Hz (> 0 not required; 0 gives the static solution). Complex values evaluate the
+        model at ``s = 2πi f`` off the imaginary axis (``f − iσ/2π`` is ``H(iω + σ)``).
     rig : Rig
         Parameters; fields may be arrays that broadcast to a batch shape.
     effects : sequence of Effect
@@ -226,8 +230,8 @@ def frf(
     outputs : sequence of str
         Channels to return (and differentiate).
     threads : int, optional
-        Worker threads for large batches (default: all cores, one for small
-        problems).
+        Worker threads for large batches (default: `default_threads`: all
+        cores up to 8 on more than two, else one).
     validate : bool
         Check the rig for impossible values (fitting loops that keep the
         parameters inside bounds switch this off).
@@ -239,7 +243,8 @@ def frf(
     rig = Rig() if rig is None else rig
     if validate:
         rig.validate()
-    freq = np.asarray(freq_hz, dtype=float)
+    freq = np.asarray(freq_hz)  # complex: the model off the axis, at s = 2πi f (an exponential window's data)
+    freq = freq.astype(complex if np.iscomplexobj(freq) else float)
     if freq.ndim != 1:
         raise DataError(f"freq_hz must be 1-D, got shape {freq.shape}")
     if not np.all(np.isfinite(freq)):
@@ -264,14 +269,28 @@ def frf(
     n_freq = freq.size
     omega = 2.0 * np.pi * freq
 
-    out = {ch: np.empty((n_rows, n_freq), dtype=complex) for ch in outputs}
-    jac = {ch: np.empty((n_rows, n_freq, len(wrt)), dtype=complex) for ch in outputs} if wrt else {}
-    step = max(1, _CHUNK_ELEMENTS // max(n_freq, 1))
+    # each channel's array is one slab of a single allocation: one large block is mapped in huge pages,
+    # several blocks of a few MB each cost the kernel 4 kB page faults that took as long as a third of the solve
+    block = np.empty((len(outputs), n_rows, n_freq), dtype=complex)
+    out = dict(zip(outputs, block))
+    jac = dict(zip(outputs, np.empty((len(outputs), n_rows, n_freq, len(wrt)), dtype=complex))) if wrt else {}
+    step = max(1, (_CHUNK_ELEMENTS * (2 if wrt else 1)) // max(n_freq, 1))  # a Jacobian's chunks: more work per call
     flat_rig = {n: _flatten(getattr(rig, n), batch) for n in Rig.names()}
     rig_arrays = [n for n, v in flat_rig.items() if isinstance(v, np.ndarray)]
     flat_eff = [{p: _flatten(eff.params[p], batch) for p in eff.parameter_names} for eff in effects]
 
+    plain = not effects and np.isrealobj(omega)  # no hooks to call: Z's entries are written in place
+    in_place = plain and set(wrt) <= PLAIN_WRT  # with a Jacobian in the usual parameters: its tangents too
+
     def run(sl, work):
+        if in_place:
+            rig_rows = {**flat_rig, **{n: flat_rig[n][sl, None] for n in rig_arrays}}
+            if wrt:
+                solve_with_tangents(plain_dual_terms(omega, rig_rows, wrt, work), wrt, outputs,
+                                    {ch: out[ch][sl] for ch in outputs}, {ch: jac[ch][sl] for ch in outputs}, work)
+            else:
+                solve_plain_into(omega, rig_rows, {ch: out[ch][sl] for ch in outputs}, work)
+            return
         rig_c = Rig(**{**flat_rig, **{n: flat_rig[n][sl, None] for n in rig_arrays}})
         effs_c = [eff.replace(**{p: _rows(v, sl) for p, v in fp.items()}) for eff, fp in zip(effects, flat_eff)]
         if wrt:
@@ -316,12 +335,19 @@ def frf(
     return res
 
 
+def default_threads(n_points: int) -> int:
+    """Worker threads `frf` uses for ``n_points`` (batch x frequency) points when not told: one for small
+    problems (below 100 000 points) and on two cores or fewer, else all cores up to 8. On two cores the
+    workers contend for the cores with each other and with anything else running (10⁴ rigs x 60
+    frequencies, issue 36: at best 10 % faster than one thread on a quiet machine, 1.4x slower on a busy one).
+    """
+    cores = os.cpu_count() or 1
+    return 1 if n_points < _THREADED_POINTS or cores <= 2 else min(cores, 8)
+
+
 def _threads(requested, n_points, n_chunks):
-    if requested is not None:
-        return max(1, min(int(requested), n_chunks))
-    if n_points < _THREADED_POINTS:
-        return 1
-    return max(1, min(os.cpu_count() or 1, 8, n_chunks))
+    wanted = default_threads(n_points) if requested is None else int(requested)
+    return max(1, min(wanted, n_chunks))
 
 
 def _seed_duals(rig, effects, wrt, targets):

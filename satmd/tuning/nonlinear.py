@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import time
 from dataclasses import dataclass, field
+from numbers import Integral, Real
 from typing import cast
 
 import numpy as np
@@ -27,6 +28,8 @@ from ..errors import DataError
 from ..physics import Rig, frf
 from ..physics.nonlinear import equivalent_rig, integrate
 from ..physics.nonlinear.excitation import random_force
+from ..validation import Band, Interval, Options, validate_params
+from ..conventions import PAPER_BAND_HZ
 
 
 @dataclass(frozen=True)
@@ -141,7 +144,10 @@ def _db(x):
     return 20 * np.log10(x)
 
 
-def tune_nonlinear(rig: Rig, elements, levels, band_hz=(20.0, 200.0), output: str = "u1",
+@validate_params({"rig": [Rig], "band_hz": [Band()], "output": [Options(("u1", "a1"))],
+                  "duration_s": [Interval(Real, 0, open="lo")], "fs_hz": [Interval(Real, 0, open="lo")],
+                  "seed": [Interval(Integral, 0)]})
+def tune_nonlinear(rig: Rig, elements, levels, band_hz=PAPER_BAND_HZ, output: str = "u1",
                    duration_s: float = 40.0, fs_hz: float = 1024.0, seed: int = 0,
                    bounds=((0.1, 1000.0), (1e-3, 5.0))) -> NonlinearTuneResult:
     """R, L that keep the peak of |output/F| lowest over a range of drive levels (see the module docstring).
@@ -164,8 +170,6 @@ def tune_nonlinear(rig: Rig, elements, levels, band_hz=(20.0, 200.0), output: st
     levels = [float(x) for x in levels]
     if not levels or min(levels) <= 0:
         raise DataError("tune across levels needs at least one drive level > 0")
-    if output not in ("u1", "a1"):
-        raise DataError(f"output must be u1 or a1, got {output!r}")
     lo = np.log([bounds[0][0], bounds[1][0]])
     hi = np.log([bounds[0][1], bounds[1][1]])
 

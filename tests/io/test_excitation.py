@@ -286,6 +286,24 @@ def test_one_hit_per_file_is_one_test_of_repeats():
     assert rep.nonlinear is None or not rep.nonlinear.detected
 
 
+def test_an_exponential_window_is_modelled_exactly_and_not_taken_for_damping():
+    """Files cut while the rig still rings: the window e^(-t/τ) makes the estimate H(iω + 1/τ) exactly; the
+    fit evaluates its model there, so the nominal rig fits (no damping, no physics) and its std is calibrated."""
+    from satmd import discover
+    from satmd.identification import identify
+
+    n = int(0.7 * FS)  # the rig rings for seconds: half a second after the hit is cut mid-ring
+    recs = [_record(_hits([0.2], n, heights=[h]), noise=0.005, seed=s) for s, h in enumerate((1.0, 0.8, 1.2, 0.9, 1.1))]
+    data = estimate_frf(recs[0])  # one file alone
+    tau = data.estimator["window_decay_s"]
+    assert "exponential_window" in [m["name"] for m in data.estimator["measurement"]]
+    exact = frf(data.freq_hz - 1j / (2 * np.pi * tau), Rig())  # the model at s = iω + 1/τ
+    z = np.concatenate([((data[c] - exact.channel(c)) / data.std[c]) for c in data.channels])
+    assert 0.7 < np.sqrt(np.mean(np.abs(z) ** 2) / 2) < 1.4
+    assert identify(data).model_adequate
+    rep = discover(recs)
+    assert rep.effect_names == [] and rep.model_adequate
+
 def test_csv_as_a_lab_writes_it(tmp_path):
     rec = _record(_multisine(1000, 4))
     t = np.arange(rec.n_samples) / FS * 1e3

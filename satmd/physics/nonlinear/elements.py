@@ -13,7 +13,6 @@ from ...conventions import TINY
 import math
 
 import numpy as np
-from scipy.special import erfcx
 
 from ..effects.base import Parameter
 from .base import NonlinearElement, gaussian_mean
@@ -180,6 +179,8 @@ class InductorSaturation(NonlinearElement):
 
     def equivalent_value(self, rig, rms):
         # E[L0 / (1 + (i/a)²)] for i ~ N(0, s²) = L0 √(π/2) (a/s) erfcx(a / (√2 s)), with s the true current's RMS
+        from scipy.special import erfcx  # on first use: scipy.special costs a CLI start-up a third of a second
+
         a = self.params["isat"]
         s = np.maximum(np.asarray(rms["i"], float), TINY)
         r = a / s

@@ -22,11 +22,14 @@ FRF of `satmd.physics.frf`.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from numbers import Real
 
 import numpy as np
 
 from ...conventions import ACCEL_CHANNELS
 from ...errors import DataError
+from ...validation import NAMES, Interval, Options, validate_params
+from ..rig import Rig
 from . import kernel
 from .statespace import Modal, discretise, read_rows, slowest_decay, system
 
@@ -136,6 +139,8 @@ def upsample(force, k: int, pad: int = 2048) -> np.ndarray:
     return up[..., pad * k:(pad + n) * k]
 
 
+@validate_params({"rig": [Rig], "fs_hz": [Interval(Real, 0, open="lo")], "outputs": [NAMES],
+                  "hold": [Options(("bandlimited", "linear"))], "backend": [Options(("auto", "numba", "numpy"))]})
 def integrate(rig, force, fs_hz: float, elements=(), outputs=ACCEL_CHANNELS, segments="auto",
               warmup_s="auto", memory_tol: float = 1e-7, corrections: int = 3,
               hold: str = "bandlimited", backend: str = "auto", oversample: int = 1) -> NonlinearResponse:
@@ -178,22 +183,16 @@ def integrate(rig, force, fs_hz: float, elements=(), outputs=ACCEL_CHANNELS, seg
     force = np.asarray(force, float)
     if force.ndim not in (1, 2) or force.shape[-1] < 2 or not np.all(np.isfinite(force)):
         raise DataError("integrate: force must be finite samples, shape (N,) or (batch, N)")
-    if not np.isfinite(fs_hz) or fs_hz <= 0:
-        raise DataError(f"integrate: fs_hz must be > 0, got {fs_hz}")
     batched = force.ndim == 2 or any(np.ndim(v) for v in rig.as_dict().values()) or any(
         np.ndim(v) for el in elements for v in el.params.values())
     P = _batch_size(rig, elements, force)
     n_samples = force.shape[-1]
-    if hold not in ("bandlimited", "linear"):
-        raise DataError(f"integrate: hold must be 'bandlimited' or 'linear', got {hold!r}")
     drive = band_limited(force, fs_hz) if hold == "bandlimited" else force
     F = np.broadcast_to(drive, (P, n_samples))
     A, B = system(rig, elements, P)
     dt = 1.0 / fs_hz
     phi, g0, g1 = discretise(A, B, dt)
     m = len(elements)
-    if backend not in ("auto", "numba", "numpy"):
-        raise DataError(f"integrate: backend must be auto, numba or numpy, got {backend!r}")
     if backend == "numba" and not kernel.available:
         raise DataError("integrate: backend='numba' needs numba (pip install numba)")
     if backend != "numpy" and kernel.available and all(el.kernel_law is not None for el in elements):

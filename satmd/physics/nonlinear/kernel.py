@@ -8,7 +8,8 @@ a 90 s record at 2048 Hz takes a few milliseconds per parameter set.
 Each element's law is its class's ``force``/``slope`` written for the compiler: the
 class declares ``kernel_law`` (0 cubic in its reading, 1 regularised Coulomb, 2
 velocity-squared, 3 saturating inductor) and ``kernel_parameters()``; a test holds the
-two forms equal. Without numba, `available` is False and `integrate` uses NumPy.
+two forms equal. Without numba, `available` is False and `integrate` uses NumPy (numba is
+imported when `available` is first asked).
 """
 from __future__ import annotations
 
@@ -16,13 +17,28 @@ import math
 
 import numpy as np
 
-try:  # optional: `pip install numba` makes the integrator ~100x faster
-    import numba
 
-    available = True
-except ImportError:  # pragma: no cover - exercised where numba is absent
-    numba = None  # type: ignore[assignment]  # the NumPy fallback runs
-    available = False
+def _load() -> bool:
+    """Import numba (optional: `pip install numba` makes the integrator ~100x faster) and compile the pass,
+    on first use: numba's import alone costs a CLI start-up a third of a second. False: the NumPy path runs."""
+    global _law, _run
+    if "available" not in globals():
+        try:
+            import numba
+        except ImportError:  # pragma: no cover - exercised where numba is absent
+            globals()["available"] = False
+        else:
+            _law = numba.njit(cache=True, fastmath=False)(_law)  # _run calls it by this name
+            _run = numba.njit(cache=True, fastmath=False)(_run)
+            globals()["available"] = True
+    return globals()["available"]
+
+
+def __getattr__(name):
+    """``available``: whether the compiled pass runs (numba imported on this first question)."""
+    if name == "available":
+        return _load()
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
 HALF_PI = 0.999 * math.pi / 2
 
@@ -101,10 +117,6 @@ def _run(phi, g0, g1, C, D, out_rows, out_direct, drive, force, codes, prm, rd, 
             f_prev = fk
 
 
-if available:
-    _law = numba.njit(cache=True, fastmath=False)(_law)
-    _run = numba.njit(cache=True, fastmath=False)(_run)
-
 
 def run(phi, g0, g1, C, D, out_rows, out_direct, drive, force, codes, prm, rd, corrections):
     """Outputs (P, o, N) and element forces (P, m, N) by the compiled sequential pass.
@@ -122,6 +134,7 @@ def run(phi, g0, g1, C, D, out_rows, out_direct, drive, force, codes, prm, rd, c
     -------
     (ndarray, ndarray)
     """
+    _load()
     P, N = drive.shape
     out = np.empty((P, out_rows.shape[1], N))
     gout = np.empty((P, len(codes), N))

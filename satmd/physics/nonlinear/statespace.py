@@ -18,8 +18,6 @@ by `scipy.signal.lfilter` over the whole record.
 from __future__ import annotations
 
 import numpy as np
-from scipy.linalg import expm
-from scipy.signal import lfilter
 
 from ...errors import DataError
 
@@ -103,6 +101,8 @@ def discretise(A, B, dt: float):
     M[:, :n, :n] = A * dt
     M[:, :n, n:n + p] = B * dt
     M[:, n:n + p, n + p:] = np.eye(p)
+    from scipy.linalg import expm  # on first use: the package loads without scipy's linear algebra
+
     E = expm(M)
     phi, g1, g2 = E[:, :n, :n], E[:, :n, n:n + p], E[:, :n, n + p:]
     return phi, g1 - g2, g2
@@ -150,6 +150,8 @@ class Modal:
         shifted = np.zeros_like(u)
         shifted[:, 1:] = u[:, :-1]
         drive = self.w0[:, cols] @ shifted + self.w1[:, cols] @ u  # c'_k = W0 u_{k-1} + W1 u_k
+        from scipy.signal import lfilter  # on first use: scipy.signal alone costs a CLI start-up
+
         eta = np.empty(drive.shape, complex)
         for j in range(self.lam.size):
             eta[j] = lfilter([1.0], [1.0, -self.lam[j]], drive[j])
