@@ -73,11 +73,14 @@ MATCH = 0.04
 
 
 def plan(n_per_joint: int, seed0: int) -> list:
-    """(seed, joint, excitation, levels) per rig: excitations alternate, level counts cycle."""
+    """(seed, joint, excitation, levels) per rig: excitations alternate, level counts cycle; a part (``seed0``
+    a multiple of 100) continues the cycle where the part before it, of as many rigs, left it, so that parts of
+    3 rigs still meet every (force, level count) pair: periodic forces at 2 and 5 levels, random ones at 3."""
     out = []
     for a, joint in enumerate(sim.JOINTS):
         for i in range(n_per_joint):
-            out.append((seed0 + 1000 * (a + 1) + i, joint, EXCITATIONS[i % 2], LEVEL_COUNTS[i % 3]))
+            k = i + n_per_joint * (seed0 // 100)
+            out.append((seed0 + 1000 * (a + 1) + i, joint, EXCITATIONS[k % 2], LEVEL_COUNTS[k % 3]))
     return out
 
 

@@ -1,7 +1,7 @@
 """Small numerical routines more than one package needs, written once (issue 25).
 
 At the floor of the import graph (numpy only): the pick of distinct best starts of a multistart
-search, and the lag-1 autocorrelation of residual series.
+search, the lag-1 autocorrelation of residual series, and every least-squares fit's covariance.
 """
 from __future__ import annotations
 
@@ -59,3 +59,36 @@ def lag1_autocorrelation(series) -> float:
     z = np.atleast_2d(series)
     den = float(np.sum(z * z))
     return float(np.sum(z[:, 1:] * z[:, :-1]) / den) if den > 0 and z.shape[1] > 2 else 0.0
+
+
+def jacobian_covariance(jac, noise_variance: float = 1.0) -> np.ndarray:
+    """``noise_variance · (JᵀJ)⁻¹`` of a least-squares fit from its Jacobian: every fit's covariance, written once.
+
+    Columns are scaled to unit norm first (well conditioned whatever the parameters' units); a Jacobian
+    that is numerically rank deficient gives NaN (no interval), never a pseudo-inverse's arbitrary one.
+
+    Parameters
+    ----------
+    jac : (n, p) Jacobian of the (weighted) residuals
+    noise_variance : the residuals' variance (1 for residuals already divided by their std)
+
+    Returns
+    -------
+    ndarray (p, p)
+    """
+    J = np.asarray(jac)
+    J = J.astype(complex if np.iscomplexobj(J) else float)  # complex: (JᴴJ)⁻¹ of complex parameters
+    norm = np.linalg.norm(J, axis=0)
+    sc = np.where(norm > 0, 1.0 / np.where(norm > 0, norm, 1.0), 1.0)
+    A, _ = inverse_gram(J * sc)
+    if not np.all(np.isfinite(A)) or not np.all(norm > 0):
+        return np.full((J.shape[1], J.shape[1]), np.nan)
+    return A * np.outer(sc, sc) * noise_variance
+
+
+def inverse_gram(Js):
+    """(JᵀJ)⁻¹ through the SVD (all inf when J is numerically rank deficient), and the singular values."""
+    _, sv, vt = np.linalg.svd(Js, full_matrices=False)
+    if sv[-1] <= sv[0] * 1e-14:
+        return np.full((sv.size, sv.size), np.inf), sv
+    return (vt.conj().T / sv**2) @ vt, sv

@@ -16,7 +16,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..conventions import TINY
-from ..identification.covariance import jacobian_covariance
+from ..numerics import jacobian_covariance
 
 MAX_DEGREE = 12
 

@@ -3,7 +3,7 @@
 When several levels of one structure are judged and the SATMD model is not adequate for them, no
 SATMD element may be named: a joint SATMD fit would turn any change into one of its own parameters.
 The finding is ``nonlinear_unexplained`` with ``modes``: the modes of every level from a multi-mode
-fit (`satmd.modal.fit_modes`), followed over the levels (`satmd.modal.track_modes`); a resonance is
+fit (`satmd.modal.fit_modes`), fitted level by level from one set of modes (`satmd.modal.follow_modes`); a resonance is
 listed when its frequency or damping moves beyond its uncertainty, and the level-dependence bands are
 put where those resonances move.
 """
@@ -11,14 +11,14 @@ from __future__ import annotations
 
 from dataclasses import replace
 
-from ..modal import fit_modes, track_modes
+from ..modal import follow_modes
 from .nonlinear import UNEXPLAINED_NL
 
 NOT_SATMD = "the SATMD model does not describe these data, so no SATMD element is named"
 
 
-def level_modes(freq_hz, frfs, stds, levels, alpha: float = 0.05) -> list:
-    """The modes of every level followed over the levels (`satmd.modal.track_modes`).
+def level_modes(freq_hz, frfs, stds, levels, alpha: float = 0.05, dof=None) -> list:
+    """The modes of every level followed over the levels (`satmd.modal.follow_modes`).
 
     Parameters
     ----------
@@ -27,6 +27,7 @@ def level_modes(freq_hz, frfs, stds, levels, alpha: float = 0.05) -> list:
     stds : per level {channel: (M,) std} or None
     levels : one level figure per FRF
     alpha : family-wise level of the trend tests
+    dof : degrees of freedom of the stds (their estimator's ``noise_dof``; None: many)
 
     Returns
     -------
@@ -34,10 +35,9 @@ def level_modes(freq_hz, frfs, stds, levels, alpha: float = 0.05) -> list:
         Empty when a level has too few frequencies for a modal fit.
     """
     try:
-        fits = [fit_modes(freq_hz, h, s) for h, s in zip(frfs, stds)]
+        return follow_modes(freq_hz, frfs, stds, levels, alpha, dof=dof)
     except ValueError:  # too few frequencies for a modal fit
         return []
-    return track_modes(fits, levels, alpha)
 
 
 def modal_finding(datas, levels, unit: str | None = None, alpha: float = 0.05) -> tuple:
@@ -55,8 +55,9 @@ def modal_finding(datas, levels, unit: str | None = None, alpha: float = 0.05) -
     (dict, list)
         The finding and ``[[lo, hi], ...]`` Hz around each resonance that moves.
     """
+    dofs = [float(d.estimator["noise_dof"]) for d in datas if d.estimator.get("noise_dof")]
     tracks = level_modes(datas[0].freq_hz, [d.channels for d in datas],
-                         [d.std if d.has_std else None for d in datas], levels, alpha)
+                         [d.std if d.has_std else None for d in datas], levels, alpha, min(dofs) if dofs else None)
     moving = [t for t in tracks if t.moves]
     stay = [t for t in tracks if not t.moves]
     span = _span(levels, unit)

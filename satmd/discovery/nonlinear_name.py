@@ -20,7 +20,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..identification.covariance import jacobian_covariance
+from ..numerics import jacobian_covariance
 from ..physics import frf
 from ..physics.nonlinear import NONLINEAR, response_rms
 

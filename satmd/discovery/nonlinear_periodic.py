@@ -151,7 +151,7 @@ def one_mode_fit(freq, H, std, band=None) -> dict:
     """
     from scipy.optimize import least_squares
 
-    from ..identification.covariance import jacobian_covariance
+    from ..numerics import jacobian_covariance
 
     freq, H, std = np.asarray(freq, float), np.asarray(H, complex), np.asarray(std, float)
     fpk = float(freq[np.argmax(np.abs(H))])

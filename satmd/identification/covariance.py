@@ -7,6 +7,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..numerics import inverse_gram, jacobian_covariance  # noqa: F401 - re-exported: the fits' covariance
+
 
 def parameter_covariance(J, r, scales, free, weighted):
     """Covariance of the parameters and the condition number of the scaled JᵀJ.
@@ -42,36 +44,3 @@ def naive_variance(J, scales, free, noise_factor) -> np.ndarray:
         gram_inv, _ = inverse_gram(J[:, free] * sc)
         out[free] = np.diag(gram_inv) * sc**2 * noise_factor
     return out
-
-
-def jacobian_covariance(jac, noise_variance: float = 1.0) -> np.ndarray:
-    """``noise_variance · (JᵀJ)⁻¹`` of a least-squares fit from its Jacobian: every fit's covariance, written once.
-
-    Columns are scaled to unit norm first (well conditioned whatever the parameters' units); a Jacobian
-    that is numerically rank deficient gives NaN (no interval), never a pseudo-inverse's arbitrary one.
-
-    Parameters
-    ----------
-    jac : (n, p) Jacobian of the (weighted) residuals
-    noise_variance : the residuals' variance (1 for residuals already divided by their std)
-
-    Returns
-    -------
-    ndarray (p, p)
-    """
-    J = np.asarray(jac)
-    J = J.astype(complex if np.iscomplexobj(J) else float)  # complex: (JᴴJ)⁻¹ of complex parameters
-    norm = np.linalg.norm(J, axis=0)
-    sc = np.where(norm > 0, 1.0 / np.where(norm > 0, norm, 1.0), 1.0)
-    A, _ = inverse_gram(J * sc)
-    if not np.all(np.isfinite(A)) or not np.all(norm > 0):
-        return np.full((J.shape[1], J.shape[1]), np.nan)
-    return A * np.outer(sc, sc) * noise_variance
-
-
-def inverse_gram(Js):
-    """(JᵀJ)⁻¹ through the SVD (all inf when J is numerically rank deficient), and the singular values."""
-    _, sv, vt = np.linalg.svd(Js, full_matrices=False)
-    if sv[-1] <= sv[0] * 1e-14:
-        return np.full((sv.size, sv.size), np.inf), sv
-    return (vt.conj().T / sv**2) @ vt, sv

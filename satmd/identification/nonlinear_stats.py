@@ -5,7 +5,7 @@ import math
 
 import numpy as np
 
-from .covariance import jacobian_covariance
+from ..numerics import jacobian_covariance
 from .nonlinear_signal import band_gain
 
 

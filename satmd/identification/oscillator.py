@@ -29,7 +29,7 @@ from scipy import signal
 from scipy.optimize import least_squares
 
 from ..errors import DataError
-from .covariance import jacobian_covariance
+from ..numerics import jacobian_covariance
 from ..physics.oscillator import PolynomialOscillator, fine_input, rk4_batch, segment_windows
 
 T95 = 1.959963984540054

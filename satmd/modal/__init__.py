@@ -23,7 +23,9 @@
    std leaves a misfit (χ²_red > 1: the data hold more than noise). A mode whose removal raises χ²
    (in those units) by less than the BIC penalty is dropped, weakest first.
 
-`track_modes` matches the modes of fits at several levels (nearest frequency, within a half-power
+`follow_modes` fits several levels of one structure from one set of modes, each level started from the
+one below (a resonance that the joint damps away or splits at the top level is still followed), and
+reads the trends; `track_modes` matches the modes of fits at several levels (nearest frequency, within a half-power
 width) and reads per mode whether its frequency and damping move: the change from the lowest to
 the highest level against its combined std, two-sided, at ``alpha`` for all modes and both
 quantities together (Bonferroni).
@@ -31,7 +33,9 @@ quantities together (Bonferroni).
 from __future__ import annotations
 
 from .fit import ModalFit, Mode, fit_modes
+from .levels import follow_modes
 from .poles import stable_poles
-from .tracking import TrackedMode, track_modes
+from .tracking import TrackedMode, read_trends, track_modes
 
-__all__ = ["fit_modes", "track_modes", "stable_poles", "Mode", "ModalFit", "TrackedMode"]
+__all__ = ["fit_modes", "track_modes", "follow_modes", "read_trends", "stable_poles", "Mode", "ModalFit",
+           "TrackedMode"]

@@ -17,6 +17,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..numerics import jacobian_covariance
 from .poles import stable_poles
 
 Z95 = 1.959963984540054  # two-sided 95 % normal quantile
@@ -100,7 +101,7 @@ class ModalFit:
                 "weighted": self.weighted, "modes": [m.to_dict() for m in self.modes]}
 
 
-def fit_modes(freq_hz, frf, std=None, band=None, n_modes=None, max_order=None) -> ModalFit:
+def fit_modes(freq_hz, frf, std=None, band=None, n_modes=None, max_order=None, start=None) -> ModalFit:
     """Natural frequencies and damping ratios of every mode in a band, with 95 % intervals.
 
     Parameters
@@ -111,6 +112,8 @@ def fit_modes(freq_hz, frf, std=None, band=None, n_modes=None, max_order=None) -
     band : (lo, hi) Hz to fit (default: all of ``freq_hz``)
     n_modes : keep the strongest ``n_modes`` of the modes found, without the BIC test (default: those BIC keeps)
     max_order : highest denominator order of the pole search (default 60, fewer for short data)
+    start : [(f_hz, zeta), ...] poles to refine instead of searching (e.g. another level's modes); every one
+        is kept unless the fit pushes it out of the band, to a damping bound or onto another
 
     Returns
     -------
@@ -121,10 +124,11 @@ def fit_modes(freq_hz, frf, std=None, band=None, n_modes=None, max_order=None) -
     band_hz = (float(freq[0]), float(freq[-1]))
     order = int(min(max_order or DEFAULT_MAX_ORDER, freq.size - 2))
     with _one_blas_thread():
-        found = sorted(stable_poles(w, H, S, order), key=lambda c: c[0])
-        x0 = np.array([c[0] for c in found] + [c[1] for c in found])
+        found = sorted(stable_poles(w, H, S, order) if start is None else start, key=lambda c: c[0])
+        x0 = np.array([c[0] for c in found] + [c[1] for c in found], float)
         x, cost, jac = _refine(w, H, S, x0, band_hz)
-        x, cost, jac = _prune(w, H, S, x, cost, jac, band_hz, weighted, n_modes)
+        if start is None:
+            x, cost, jac = _prune(w, H, S, x, cost, jac, band_hz, weighted, n_modes)
         return _result(w, H, S, x, cost, jac, band_hz, names, weighted)
 
 
@@ -317,10 +321,10 @@ def _result(w, H, S, x, cost, jac, band_hz, names, weighted) -> ModalFit:
     n_res = jac.shape[0] if k else 2 * H.size
     dof_scale = _scale(cost, n_res, _n_params(k, len(names)), weighted)
     sd = np.full(2 * k, np.inf)
-    if k:
-        JtJ = jac.T @ jac
-        if np.all(np.isfinite(JtJ)) and np.linalg.matrix_rank(JtJ) == 2 * k:
-            sd = np.sqrt(np.abs(np.diag(np.linalg.inv(JtJ))) * dof_scale)
+    if k and np.all(np.isfinite(jac)):
+        cov = jacobian_covariance(jac, dof_scale)
+        if np.all(np.isfinite(cov)):  # rank deficient: no interval (inf), the mode is not determined
+            sd = np.sqrt(np.abs(np.diag(cov)))
     _, coefs, _ = _Poles(w, H, S, band_hz).solve(x)
     coefficients = dict(zip(names, coefs))
     found = []

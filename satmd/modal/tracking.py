@@ -76,8 +76,6 @@ def track_modes(fits, levels=None, alpha: float = 0.05) -> list:
         level. A mode is matched to the nearest one at the next level up, when they lie within the
         larger half-power width plus the 95 % uncertainty of their difference.
     """
-    from scipy.stats import norm
-
     order = list(np.argsort(levels, kind="stable")) if levels is not None else list(range(len(fits)))
     # a mode whose uncertainty the fit cannot give is not followed: nothing could be said of its change
     known = [[m for m in fit.modes if np.isfinite(m.f_std) and np.isfinite(m.zeta_std)] for fit in fits]
@@ -94,11 +92,32 @@ def track_modes(fits, levels=None, alpha: float = 0.05) -> list:
                 taken_t.add(a)
                 taken_m.add(b)
         tracks = [tracks[a] for a in sorted(taken_t)]
-    threshold = norm.isf(alpha / (4 * max(len(tracks), 1)))  # two-sided, 2 quantities per mode
+    return read_trends([[t[order.index(j)] for j in range(len(fits))] for t in tracks], levels, alpha)
+
+
+def read_trends(tracks, levels=None, alpha: float = 0.05, dof=None) -> list:
+    """TrackedMode of each mode followed over the levels: its trends, lowest to highest level.
+
+    Parameters
+    ----------
+    tracks : list (per mode) of lists (per level, in the order of ``levels``) of `Mode`
+    levels : one level figure per fit (default: the order given is increasing)
+    alpha : family-wise level of the trend tests (Bonferroni over modes and both quantities)
+    dof : degrees of freedom of the std that weighted the fits: the tests read Student's t there (None: normal)
+
+    Returns
+    -------
+    list of TrackedMode, by frequency at the lowest level
+    """
+    from scipy.stats import norm, t as student
+
+    n = len(tracks[0]) if tracks else 0
+    order = list(np.argsort(levels, kind="stable")) if levels is not None else list(range(n))
+    tail = alpha / (4 * max(len(tracks), 1))  # two-sided, 2 quantities per mode
+    threshold = norm.isf(tail) if dof is None or not np.isfinite(dof) else student.isf(tail, dof)
     out = []
-    for t in tracks:
-        given = [t[order.index(j)] for j in range(len(fits))]
-        lo, hi = t[0], t[-1]
+    for given in sorted(tracks, key=lambda t: t[order[0]].f_hz):
+        lo, hi = given[order[0]], given[order[-1]]
         out.append(TrackedMode(tuple(m.f_hz for m in given), tuple(m.f_std for m in given),
                                tuple(m.zeta for m in given), tuple(m.zeta_std for m in given),
                                _direction(hi.f_hz - lo.f_hz, lo.f_std, hi.f_std, threshold, "hardening", "softening"),

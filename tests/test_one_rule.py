@@ -1,0 +1,51 @@
+"""Rules written once (issue 36): a fit's covariance comes from `satmd.numerics.jacobian_covariance`, never from
+an inverse of JᵀJ written again beside it."""
+from __future__ import annotations
+
+import re
+from pathlib import Path
+
+import numpy as np
+
+SRC = Path(__file__).resolve().parents[1] / "satmd"
+INVERSE = re.compile(r"linalg\.p?inv\(")
+# matrix inverses that are no fit's covariance, each with its reason
+NOT_A_COVARIANCE = {
+    "satmd/physics/nonlinear/statespace.py": "the modal matrix's eigenvectors (a change of basis)",
+    "satmd/io/lpm.py": "the local polynomial method's own regression (Pintelon et al. 2010)",
+    "satmd/io/sweepfrf.py": "the same local fit on a sweep's windows",
+}
+
+
+def test_no_covariance_written_again_beside_the_shared_one():
+    found = [f"{p.relative_to(SRC.parent)}:{i}" for p in SRC.rglob("*.py")
+             if p.name not in ("covariance.py", "numerics.py") and str(p.relative_to(SRC.parent)) not in NOT_A_COVARIANCE
+             for i, line in enumerate(p.read_text().splitlines(), 1) if INVERSE.search(line)]
+    assert not found, f"inv(JᵀJ) by hand (use satmd.numerics.jacobian_covariance): {found}"
+
+
+def test_jacobian_covariance_is_the_textbook_one_and_says_when_there_is_none():
+    from satmd.numerics import jacobian_covariance
+
+    rng = np.random.default_rng(0)
+    J = rng.standard_normal((50, 3)) * np.array([1e-4, 1.0, 1e5])  # units apart by 9 decades
+    np.testing.assert_allclose(jacobian_covariance(J, 2.0), 2.0 * np.linalg.inv(J.T @ J), rtol=1e-9)
+    Jc = J + 1j * rng.standard_normal(J.shape) * np.array([1e-4, 1.0, 1e5])  # complex parameters: (JᴴJ)⁻¹
+    np.testing.assert_allclose(jacobian_covariance(Jc), np.linalg.inv(Jc.conj().T @ Jc), rtol=1e-9)
+    J[:, 2] = 3.0 * J[:, 1]  # two columns that cannot be told apart
+    assert np.isnan(jacobian_covariance(J)).all()
+
+
+def test_the_paper_band_is_written_once():
+    literal = re.compile(r"\(20(\.0)?, 200(\.0)?\)")
+    found = [f"{p.relative_to(SRC.parent)}:{i}" for p in SRC.rglob("*.py") if p.name != "conventions.py"
+             for i, line in enumerate(p.read_text().splitlines(), 1)
+             if literal.search(line) and not line.lstrip().startswith(">>>")]
+    assert not found, f"the paper's band as a literal (use satmd.conventions.PAPER_BAND_HZ): {found}"
+
+
+def test_the_band_scan_is_written_once():
+    """Every band scan (the linear fit's mismatch, the nonlinear tests) goes through `locate.scan_bands`."""
+    windowing = re.compile(r"np\.convolve\([^)]*np\.ones\(w\)")
+    where = sorted(str(p.relative_to(SRC.parent)) for p in SRC.rglob("*.py") if windowing.search(p.read_text()))
+    assert where == ["satmd/discovery/locate.py"], where
