@@ -17,8 +17,11 @@ ROOT = Path(__file__).resolve().parents[2]
 
 def _satmd(args, cwd):
     env = {**os.environ, "PYTHONPATH": str(ROOT), "MPLBACKEND": "Agg"}
+    # a runner started in the background (nohup, `&`) hands its children SIGINT ignored, and Python then
+    # installs no handler: the child gets SIGINT's default back, as a terminal would give it
     return subprocess.Popen([sys.executable, "-m", "satmd", *args], cwd=cwd, env=env, stdout=subprocess.PIPE,
-                            stderr=subprocess.PIPE, text=True)
+                            stderr=subprocess.PIPE, text=True,
+                            preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
 
 
 def _interrupted(p, delay, presses=1, gap=0.05):
