@@ -8,20 +8,15 @@ from satmd.modal import fit_modes, follow_modes, track_modes
 from satmd.modal.fit import Mode, ModalFit
 from satmd.modal.levels import assign, determined, mode_set, reach
 
+from ..test_modal import modal_frf  # the closed-form modal FRFs, written once
+
 FREQ = np.linspace(8.0, 64.0, 400)
 
 
 def accelerance(freq, modes):
-    """Closed-form accelerances of two channels: Σ_r iω² [A_r / (iω − λ_r) + conjugate]; ``modes``:
-    (f_hz, zeta, residue of a1, residue of a2) of a receptance."""
-    iw = 2j * np.pi * np.asarray(freq)
-    out = {"a1": np.zeros(iw.size, complex), "a2": np.zeros(iw.size, complex)}
-    for f, zeta, *residues in modes:
-        wn = 2 * np.pi * f
-        lam = -zeta * wn + 1j * wn * np.sqrt(1 - zeta ** 2)
-        for c, A in zip(out, residues):
-            out[c] += iw ** 2 * (A / (iw - lam) + np.conj(A) / (iw - np.conj(lam)))
-    return out
+    """Closed-form accelerances of two channels (``tests/test_modal.modal_frf``); ``modes``: (f_hz, zeta,
+    residue of a1, residue of a2) of a receptance."""
+    return modal_frf(freq, modes, "accelerance")
 
 
 def noisy(H, share, rng):
