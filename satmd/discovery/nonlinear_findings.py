@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..conventions import ACCEL_CHANNELS, DEFAULT_FREE, TINY
+from ..conventions import ACCEL_CHANNELS, DEFAULT_FREE, MIN_DELTA_BIC, TINY
 from .nonlinear import (
     EXPERIMENT_LEVEL,
     EXPERIMENT_MULTISINE,
@@ -151,37 +151,46 @@ def _hypotheses(datas, rig, free, levels) -> dict:
 
 
 def _name_from_levels(datas, rig, free, levels, recordings, cmp=None) -> dict:
-    """The finding for a significant level dependence: moving parameter, direction, element, strength."""
-    from .nonlinear_name import element_for, fit_strength
+    """The finding for a significant level dependence: moving parameter, direction, element, strength.
+
+    The element is the one whose equivalent linearisation's trend with level fits best (BIC over every
+    registered element that moves that parameter that way, `rank_elements`); those within
+    ``MIN_DELTA_BIC`` of it, and the elements of equally good moving parameters, are its equivalents.
+    """
+    from .nonlinear_name import candidates, element_for, rank_elements
 
     cmp = cmp or _hypotheses(datas, rig, free, levels)
     p, direction = cmp["best"], cmp["direction"]
     fit = cmp["fits"][p]
     eq_lin = {p: [float(v) for v in fit.per_record]}
-    cls = element_for(p, direction)
+    found = candidates(p, direction)
     others = []
     for q in cmp["equivalent"]:
         c = element_for(q, "up" if np.diff(np.asarray(cmp["fits"][q].per_record)[cmp["order"]]).sum() > 0 else "down")
         others.append(c.name if c else f"{UNEXPLAINED_NL} ({q})")
     change = fit.per_record[cmp["order"][-1]] / fit.per_record[cmp["order"][0]] - 1
     moved = f"{p} {100 * change:+.1f} % from the lowest to the highest level ({abs(cmp['z']):.0f} σ)"
-    if cls is None:
+    if not found:
         return {"name": UNEXPLAINED_NL, "parameters": {}, "ci95": {}, "equivalent": others,
                 "equivalent_linear": eq_lin,
                 "explanation": f"the rig changes with level, but no element explains it: {moved}"}
     if recordings is None:
-        return {"name": cls.name, "parameters": {}, "ci95": {}, "equivalent": others, "equivalent_linear": eq_lin,
-                "explanation": f"{cls.description}; measured: {moved} (FRFs only: no force level, no strength)",
+        return {"name": found[0].name, "parameters": {}, "ci95": {}, "equivalent": [c.name for c in found[1:]] + others,
+                "equivalent_linear": eq_lin,
+                "explanation": f"{found[0].description}; measured: {moved} (FRFs only: no force level, no strength)",
                 "moving": p, "direction": direction}
+    ranked = rank_elements(found, fit.per_record, fit.per_record_std, fit.rigs, [r["force"] for r in recordings],
+                           [r.fs_hz for r in recordings], fit.chi2, fit.n_data)
+    cls = ranked[0]["cls"] if ranked else found[0]
+    others = [r["cls"].name for r in ranked[1:] if r["bic"] - ranked[0]["bic"] < MIN_DELTA_BIC] + others
     nominal = float(fit.per_record[cmp["order"][0]])  # the lowest level's value, until the strength fit says
-    try:
-        el, ci, nominal, rms = fit_strength(cls, fit.per_record, fit.per_record_std, fit.rigs,
-                                            [r["force"] for r in recordings], [r.fs_hz for r in recordings])
-        params = {k: float(v) for k, v in el.params.items()}
-        text = f"{el.explain(rig.replace(**{p: nominal}))}; measured: {moved}"
-    except Exception as exc:  # noqa: BLE001 - the name stands even when the strength cannot be fitted
+    if ranked:
+        sf = ranked[0]["fit"]
+        params, ci, nominal = {k: float(v) for k, v in sf.element.params.items()}, sf.ci95, sf.nominal
+        text = f"{sf.element.explain(rig.replace(**{p: nominal}))}; measured: {moved}"
+    else:  # the name stands even when the strength cannot be fitted
         params, ci = {}, {}
-        text = f"{cls.description}; measured: {moved} (strength not fitted: {exc})"
+        text = f"{cls.description}; measured: {moved} (strength not fitted)"
     strength = _time_domain_strength(recordings, cls.name, rig)
     if strength is not None:  # the time-domain fit's coefficient and interval: they cover (issue 36 item 7)
         params, ci, fitted = strength

@@ -16,7 +16,9 @@ from __future__ import annotations
 
 from ..conventions import MIN_DELTA_BIC, TINY
 
+import itertools
 from dataclasses import dataclass, field
+from typing import Any, NamedTuple
 
 import numpy as np
 
@@ -61,6 +63,27 @@ def _stack(datas, channels):
             s = d.std[c]
             ws.append(1.0 / np.concatenate([s, s]))
     return np.concatenate(ys), np.concatenate(ws)
+
+
+class StrengthFit(NamedTuple):
+    """An element fitted to the trend of its equivalent value with level (`fit_strength`).
+
+    Attributes
+    ----------
+    element : the element with its fitted strength (and other fitted parameters)
+    ci95 : {strength: [lo, hi]}
+    nominal : the small-signal value of the linear parameter it moves
+    rms : the read signal's RMS per recording
+    chi2 : the trend's χ²
+    n_fitted : parameters fitted (the nominal value included)
+    """
+
+    element: Any
+    ci95: dict
+    nominal: float
+    rms: list
+    chi2: float
+    n_fitted: int
 
 
 def joint_fit(datas, rig, free, channels, moving, start: dict, moving_start=None) -> JointFit:
@@ -195,7 +218,10 @@ def parameter_test(cmp: dict, alpha: float = 1e-3):
 
 
 def element_for(parameter: str, direction: str):
-    """The element class whose equivalent linearisation moves ``parameter`` that way (None if none does).
+    """The first registered element class whose equivalent linearisation moves ``parameter`` that way.
+
+    Naming ranks every such element by its trend (`rank_elements`); this is the FRF-only answer, where
+    no level's signals are known.
 
     Parameters
     ----------
@@ -206,30 +232,61 @@ def element_for(parameter: str, direction: str):
     -------
     type or None
     """
-    for cls in NONLINEAR.values():
-        if cls.linear_parameter != parameter:
+    found = candidates(parameter, direction)
+    return found[0] if found else None
+
+
+def candidates(parameter: str, direction: str) -> list:
+    """Every registered element class that moves ``parameter`` in ``direction`` with level (its ``moves``).
+
+    Parameters
+    ----------
+    parameter : kp, k1, cp or L
+    direction : "up" or "down"
+
+    Returns
+    -------
+    list of type
+    """
+    return [cls for cls in NONLINEAR.values()
+            if cls.linear_parameter == parameter and cls.moves in (direction, "either")]
+
+
+def rank_elements(classes, values, stds, rigs, forces, fs_hz, joint_chi2: float, n_data: int) -> list:
+    """Each candidate's trend fit (`fit_strength`) ranked by BIC: the joint fit's χ² plus the trend's.
+
+    A level's equivalent value is the element's equivalent linearisation at that level's RMS; an element
+    whose law bends the trend the wrong way leaves a χ² the others do not. Candidates whose strength cannot
+    be fitted are left out.
+
+    Parameters
+    ----------
+    classes : candidate element classes.
+    values, stds, rigs, forces, fs_hz : as `fit_strength`.
+    joint_chi2 : χ² of the joint fit that gave ``values``.
+    n_data : number of data in that fit (BIC's log n).
+
+    Returns
+    -------
+    list of dict
+        {"cls", "bic", "fit": a `StrengthFit`}, best first (registration order breaks ties).
+    """
+    out = []
+    for order, cls in enumerate(classes):
+        try:
+            fit = fit_strength(cls, values, stds, rigs, forces, fs_hz)
+        except (ArithmeticError, ValueError, np.linalg.LinAlgError):
             continue
-        probe = _probe_direction(cls)
-        if probe in (direction, "either"):
-            return cls
-    return None
-
-
-def _probe_direction(cls) -> str:
-    """Which way the element's equivalent value moves with level at a typical strength ("either": sign of k3)."""
-    if cls.strength == "k3":
-        return "either"
-    from ..physics import Rig
-
-    rig = Rig()
-    el = cls(**{cls.strength: cls.parameter_specs[0].starts[-1] if cls.strength != "isat" else 0.01})
-    lo = el.equivalent_value(rig, {s: 1e-3 for s in cls.reads})
-    hi = el.equivalent_value(rig, {s: 1e-2 for s in cls.reads})
-    return "up" if float(hi) > float(lo) else "down"
+        out.append({"cls": cls, "fit": fit, "order": order,
+                    "bic": joint_chi2 + fit.chi2 + fit.n_fitted * np.log(max(n_data, 2))})
+    return sorted(out, key=lambda r: (r["bic"], r["order"]))
 
 
 def fit_strength(cls, values, stds, rigs, forces, fs_hz):
     """The element's strength (and small-signal value) from its equivalent value at each level.
+
+    The strength and, where the levels leave a degree of freedom for each, the element's other parameters
+    (those it does not hold fixed, `trend_fixed`) are fitted in the element's own coordinates.
 
     Parameters
     ----------
@@ -241,57 +298,49 @@ def fit_strength(cls, values, stds, rigs, forces, fs_hz):
 
     Returns
     -------
-    (element, ci95, nominal, rms) : the element with its fitted strength,
-    {strength: [lo, hi]}, the small-signal value of the parameter, and the
-    read signal's RMS per recording.
+    StrengthFit
     """
     from scipy.optimize import least_squares
 
     rms = [response_rms(rg, force=f, fs_hz=fs) for rg, f, fs in zip(rigs, forces, fs_hz)]
     values, stds = np.asarray(values, float), np.maximum(np.asarray(stds, float), 1e-12 * np.abs(values).max())
     p = cls.linear_parameter
-    extra = {}
-    if cls.strength == "Fc":  # v0 well below the slowest level's velocity: Coulomb-like, as a rub is
-        extra["v0"] = 0.05 * min(float(r["v"]) for r in rms)
     base_rig = rigs[0]
-    positive = cls.strength != "k3"  # k3 takes either sign; Fc, c2, isat are fitted on a log scale
+    top = rms[int(np.argmax([float(r[cls.reads[0]]) for r in rms]))]
+    probe = cls.at_rest(base_rig)
+    fixed = probe.trend_fixed(rms)
+    probe = probe.replace(**fixed)
+    coords = [c for c in probe.coordinates(base_rig, top) if c.name not in fixed]
+    if len(values) < 2 + len(coords):  # too few levels for every parameter: the strength alone
+        coords = [c for c in coords if c.name == cls.strength]
+    nominal0 = float(values.min() if p != "L" else values.max())
+    scale = abs(nominal0) or 1.0
 
-    def strength(raw):
-        return float(np.exp(raw)) if positive else float(raw)
+    def element_at(theta):
+        return probe.replace(**{c.name: float(c.decode(x)) for c, x in zip(coords, theta[1:])})
 
     def model(theta):
-        rig0 = base_rig.replace(**{p: theta[0]})
-        el = cls(**{cls.strength: strength(theta[1])}, **extra)
-        return np.array([float(el.equivalent_value(rig0, r)) for r in rms])
+        rig0 = base_rig.replace(**{p: theta[0] * scale})
+        el = element_at(theta)
+        return np.array([float(np.mean(el.equivalent_value(rig0, r))) for r in rms])
 
+    lo_b = [1e-6] + [c.bounds[0] for c in coords]
+    hi_b = [1e3] + [c.bounds[1] for c in coords]
     best = None
-    nominal0 = float(values.min() if p != "L" else values.max())
-    for s0 in _strength_starts(cls, rms, values):
-        raw0 = np.log(max(s0, TINY)) if positive else s0
-        lo_b = [1e-6 * abs(nominal0), np.log(1e-10) if positive else -np.inf]
-        hi_b = [1e3 * abs(nominal0), np.log(1e10) if positive else np.inf]
-        raw0 = float(np.clip(raw0, lo_b[1] + 1, hi_b[1] - 1))
-        sol = least_squares(lambda t: (model(t) - values) / stds, [nominal0, raw0], bounds=(lo_b, hi_b),
-                            x_scale="jac", max_nfev=400)
+    for start in itertools.product(*(c.starts for c in coords)):
+        x0 = np.clip([nominal0 / scale, *start], np.array(lo_b) + 1e-9, np.array(hi_b) - 1e-9)
+        with np.errstate(all="ignore"):
+            sol = least_squares(lambda t: (model(t) - values) / stds, x0, bounds=(lo_b, hi_b), x_scale="jac",
+                                max_nfev=400)
         if best is None or sol.cost < best.cost:
             best = sol
-    sd = float(np.sqrt(max(jacobian_covariance(best.jac)[1, 1], 0.0)))  # NaN stays NaN: max(nan, 0) is nan
-    raw = float(best.x[1])
-    el = cls(**{cls.strength: strength(raw)}, **extra)
-    ci = [strength(raw - 1.96 * sd), strength(raw + 1.96 * sd)]
+    if best is None or not np.isfinite(best.cost):
+        raise ValueError(f"{cls.name}: no strength fits the trend")
+    el = element_at(best.x)
+    i = 1 + [c.name for c in coords].index(cls.strength)
+    sd = float(np.sqrt(max(jacobian_covariance(best.jac)[i, i], 0.0)))  # NaN stays NaN: max(nan, 0) is nan
+    c = coords[i - 1]
+    ends = sorted(float(c.decode(best.x[i] + z * sd)) for z in (-1.96, 1.96))
     sig = cls.reads[0]
-    return el, {cls.strength: ci}, float(best.x[0]), [float(r[sig]) for r in rms]
-
-
-def _strength_starts(cls, rms, values):
-    """A few starting strengths from the change between the extreme levels."""
-    sig = cls.reads[0]
-    r = np.array([float(x[sig]) for x in rms])
-    dv = values[np.argmax(r)] - values[np.argmin(r)]
-    if cls.strength == "k3":
-        return [dv / (3 * max(r.max() ** 2 - r.min() ** 2, TINY))]
-    if cls.strength == "c2":
-        return [max(dv / (np.sqrt(8 / np.pi) * max(r.max() - r.min(), TINY)), 1e-6)]
-    if cls.strength == "Fc":
-        return [max(-dv / (np.sqrt(2 / np.pi) * max(1 / r.min() - 1 / r.max(), TINY)), 1e-6)]
-    return [r.max() * f for f in (1.0, 2.0, 4.0, 10.0, 30.0)]
+    return StrengthFit(el, {cls.strength: ends}, float(best.x[0] * scale), [float(r[sig]) for r in rms],
+                       2 * float(best.cost), 1 + len(coords))

@@ -75,87 +75,39 @@ def prepare(rec, seconds=None, band_hz=None) -> dict:
 
 
 class _Coordinates:
-    """x <-> (rig, element): logs of the linear parameters, the element's strength scaled by its effect."""
+    """x <-> (rig, element): logs of the linear parameters, then the element's own coordinates."""
 
     def __init__(self, rig, free, el, rms_top):
         self.rig, self.free, self.el = rig, tuple(free), el
         self.oversample = 1
-        self.el_names, self.kind = [], None
-        if el is not None:
-            self.kind = el.name
-            if el.name == "cubic_absorber_spring":
-                self.K = 0.1 * float(rig.kp) / (3 * rms_top["d"] ** 2)
-            elif el.name == "cubic_host_spring":
-                self.K = 0.1 * float(rig.k1) / (3 * rms_top["u1"] ** 2)
-            elif el.name == "quadratic_damping":
-                self.K = 1.0 / (math.sqrt(8 / math.pi) * rms_top["v"])
-            elif el.name == "absorber_friction":
-                self.K, self.V = rms_top["v"] * math.sqrt(math.pi / 2), rms_top["v"]
-            elif el.name == "inductor_saturation":
-                self.K = rms_top["i"]
-            else:
-                raise DataError(f"fit_nonlinear: no scaling for element {el.name!r}")
-            self.el_names = list(el.parameter_names)
+        self.coords = el.coordinates(rig, rms_top) if el is not None else ()
+        self.el_names = [c.name for c in self.coords]
 
     @property
     def names(self):
         return list(self.free) + self.el_names
 
     def bounds(self):
-        lo = [math.log(1e-4)] * len(self.free)
-        hi = [math.log(1e7)] * len(self.free)
-        k = self.kind
-        if k in ("cubic_absorber_spring", "cubic_host_spring"):
-            lo, hi = lo + [-20.0], hi + [20.0]
-        elif k == "quadratic_damping":
-            lo, hi = lo + [0.0], hi + [200.0]
-        elif k == "absorber_friction":
-            lo, hi = lo + [0.0, math.log(1e-4)], hi + [200.0, math.log(3.0)]
-        elif k == "inductor_saturation":
-            lo, hi = lo + [math.log(0.2)], hi + [math.log(1e4)]
+        lo = [math.log(1e-4)] * len(self.free) + [c.bounds[0] for c in self.coords]
+        hi = [math.log(1e7)] * len(self.free) + [c.bounds[1] for c in self.coords]
         return np.array(lo), np.array(hi)
 
     def starts(self):
         """Element coordinates to scan (one list per start)."""
-        k = self.kind
-        if k in ("cubic_absorber_spring", "cubic_host_spring"):
-            return [[v] for v in (-2.0, -1.0, -0.3, 0.0, 0.3, 1.0, 2.0, 4.0)]
-        if k == "quadratic_damping":
-            return [[v] for v in (0.0, 0.3, 1.0, 2.0, 4.0, 8.0)]
-        if k == "absorber_friction":
-            return [[v, math.log(w)] for v in (0.3, 1.0, 2.0, 4.0, 8.0) for w in (0.03, 0.3)]
-        if k == "inductor_saturation":
-            return [[math.log(v)] for v in (1.2, 1.6, 2.2, 3.0, 5.0, 10.0, 30.0)]
-        return [[]]
+        return self.el.coordinate_starts(self.rig, None, self.coords) if self.el is not None else [[]]
 
     def encode(self, rig, el) -> np.ndarray:
         x = [math.log(float(getattr(rig, p))) for p in self.free]
-        if self.kind in ("cubic_absorber_spring", "cubic_host_spring"):
-            x.append(float(el.params["k3"]) / self.K)
-        elif self.kind == "quadratic_damping":
-            x.append(float(el.params["c2"]) / self.K)
-        elif self.kind == "absorber_friction":
-            x += [float(el.params["Fc"]) / self.K, math.log(float(el.params["v0"]) / self.V)]
-        elif self.kind == "inductor_saturation":
-            x.append(math.log(float(el.params["isat"]) / self.K))
-        return np.array(x)
+        return np.array(x + [c.encode(el.params[c.name]) for c in self.coords])
 
     def decode(self, X):
         """(rig, [element]) for X (p,) or a batch (P, p)."""
         X = np.atleast_2d(X)
         rig = self.rig.replace(**{p: np.exp(X[:, i]) for i, p in enumerate(self.free)})
-        j = len(self.free)
-        if self.kind is None:
+        if self.el is None:
             return rig, []
-        if self.kind in ("cubic_absorber_spring", "cubic_host_spring"):
-            params = {"k3": X[:, j] * self.K}
-        elif self.kind == "quadratic_damping":
-            params = {"c2": np.maximum(X[:, j], 0.0) * self.K}
-        elif self.kind == "absorber_friction":
-            params = {"Fc": np.maximum(X[:, j], 0.0) * self.K, "v0": np.exp(X[:, j + 1]) * self.V}
-        else:
-            params = {"isat": np.exp(X[:, j]) * self.K}
-        return rig, [self.el.replace(**params)]
+        j = len(self.free)
+        return rig, [self.el.replace(**{c.name: c.decode(X[:, j + i]) for i, c in enumerate(self.coords)})]
 
     def physical(self, x) -> dict:
         rig, els = self.decode(x)

@@ -14,7 +14,8 @@ declared `Parameter`s (unit, default, neutral, hard/search ranges, starts)::
 
 Build one with ``element("cubic_absorber_spring", k3=2e9)`` (or the class);
 ``NONLINEAR`` maps names to classes, ``nonlinear_names()`` lists them,
-``register_nonlinear`` adds one. They are *not* in the linear vocabulary
+``register_nonlinear`` adds one (a class with its ``law``: nothing else is edited;
+see ``tests/discovery/test_new_element.py``), ``unregister_nonlinear`` removes it. They are *not* in the linear vocabulary
 (`satmd.physics.effects.VOCABULARY`): discovery never fits them as linear effects.
 
 Interface of an element ``el`` (stable; see `NonlinearElement`):
@@ -24,7 +25,11 @@ Interface of an element ``el`` (stable; see `NonlinearElement`):
 - ``el.acts`` (``absorber``/``host``/``shunt``), ``el.reads`` (signals from
   ``d, v, u1, v1, i``), ``el.linear_parameter`` (``kp``/``k1``/``cp``/``L``),
   ``el.strength`` (the parameter that sets its size);
-- ``el.force(y, rig)``: force law beyond the linear model (used by the integrator);
+- ``el.law(p0, p1, y) -> (force, slope)`` with ``el.kernel_parameters()``: the force law
+  beyond the linear model, once (NumPy functions: arrays and the compiled integrator);
+  ``el.force(y, rig)``, ``el.slope(y, rig)`` apply it to readings;
+- ``el.moves``: which way ``linear_parameter`` moves with level (``up``/``down``/``either``);
+  ``el.coordinates(rig, rms)``: how a fit moves its parameters;
 - ``el.equivalent_linear(rig, rms) -> EquivalentLinear`` (``.parameter``, ``.nominal``,
   ``.value``, ``.direction`` "up"/"down", ``.relative_change``) for Gaussian
   signals with the given RMS ({"d": ..} etc.);
@@ -76,6 +81,22 @@ def register_nonlinear(cls: type[NonlinearElement]) -> type[NonlinearElement]:
     return cls
 
 
+def unregister_nonlinear(name: str) -> None:
+    """Remove an element added with `register_nonlinear`.
+
+    Parameters
+    ----------
+    name : its registered name.
+
+    Returns
+    -------
+    None
+    """
+    if name not in NONLINEAR:
+        raise DataError(f"no nonlinear element {name!r} is registered")
+    NONLINEAR.pop(name)
+
+
 def nonlinear_names() -> tuple[str, ...]:
     """Names of the registered nonlinear elements, in registration order.
 
@@ -112,7 +133,7 @@ from .integrate import NonlinearResponse, integrate  # noqa: E402
 
 __all__ = [
     "NonlinearElement", "EquivalentLinear", "CubicAbsorberSpring", "CubicHostSpring", "AbsorberFriction",
-    "QuadraticDamping", "InductorSaturation", "NONLINEAR", "NONLINEAR_UNEXPLAINED", "register_nonlinear",
+    "QuadraticDamping", "InductorSaturation", "NONLINEAR", "NONLINEAR_UNEXPLAINED", "register_nonlinear", "unregister_nonlinear",
     "nonlinear_names", "element", "gaussian_mean", "equivalent_rig", "response_rms", "integrate",
     "NonlinearResponse",
 ]

@@ -2,14 +2,20 @@
 
 A nonlinear element is the same kind of object as a linear effect (it *is* an
 `Effect`: declared `Parameter`s, ``params``, ``replace``, ``bounds``, ``starts``,
-``explain``), with three more things:
+``explain``), and it carries everything else about itself, so that every consumer
+(integrator, discovery, fit, tuning) is generic:
 
 - where it acts and what it reads (``acts``, ``reads``), which the one
   time-domain integrator turns into an input column and output rows;
-- its force law, ``force(y, rig)``: the part of the element's force beyond the
-  linear model of SPEC §2 (the linear part, e.g. ``kp d``, stays in the model);
+- its force law, once: ``law(p0, p1, y) -> (force, slope)``, written with NumPy
+  functions so that the same code runs on arrays (``force``, ``slope``) and is
+  compiled for the integrator's sequential pass (`kernel`); ``kernel_parameters()``
+  gives (p0, p1). The force is the part beyond the linear model of SPEC §2 (the
+  linear part, e.g. ``kp d``, stays in the model);
 - its statistical (Gaussian) equivalent linearisation, ``equivalent_linear(rig,
-  rms)``: the linear parameter it moves at a level and which way.
+  rms)`` (numerical by default: nominal + E[slope], Stein's lemma): the linear
+  parameter it moves (``linear_parameter``) and which way with level (``moves``);
+- how a fit moves its parameters (``coordinates(rig, rms)``: scale, bounds, starts).
 
 Its linear hooks are all identity: in a FRF the element is absent (its
 small-signal limit), which is what the linear model of a rig at low level is.
@@ -18,8 +24,10 @@ from __future__ import annotations
 
 from ...conventions import TINY
 
+import itertools
+import math
 from dataclasses import asdict, dataclass
-from typing import Any, ClassVar, cast
+from typing import Any, Callable, ClassVar, cast
 
 import numpy as np
 
@@ -113,6 +121,36 @@ class EquivalentLinear:
         return f"{self.element}: {self.parameter} {self.nominal:.4g} -> {float(np.mean(self.value)):.4g} ({rel:+.1f} %)"
 
 
+@dataclass(frozen=True)
+class Coordinate:
+    """How a fit moves one of an element's parameters: in units of ``scale`` where it matters.
+
+    ``kind``: ``linear`` (x = value / scale, either sign), ``positive`` (the same, value = max(x, 0) scale)
+    or ``log`` (x = log(value / scale)). ``bounds`` and ``starts`` are in x.
+    """
+
+    name: str
+    scale: float
+    kind: str
+    bounds: tuple
+    starts: tuple
+
+    def encode(self, value) -> float:
+        """x of a parameter value."""
+        v = float(value) / self.scale
+        return math.log(v) if self.kind == "log" else v
+
+    def decode(self, x):
+        """Parameter value(s) of x (array-friendly)."""
+        if self.kind == "log":
+            return np.exp(x) * self.scale
+        return (np.maximum(x, 0.0) if self.kind == "positive" else x) * self.scale
+
+
+SIGNED_STARTS = (-2.0, -1.0, -0.3, 0.0, 0.3, 1.0, 2.0, 4.0)  # strength in units of its reference effect
+POSITIVE_STARTS = (0.0, 0.3, 1.0, 2.0, 4.0, 8.0)
+
+
 class NonlinearElement(Effect):
     """Base class of the SPEC §8b elements (see the module docstring).
 
@@ -120,8 +158,9 @@ class NonlinearElement(Effect):
     (``absorber``: equal and opposite on u1 and u2, positive on u2; ``host``: on
     u1; ``shunt``: the shunt current), ``reads`` (a tuple from ``d = u2 - u1``,
     ``v = d'``, ``u1``, ``v1``, ``i``; one signal, so that the integrator's Newton
-    step is scalar), ``linear_parameter`` and implement ``force``, ``slope`` and
-    ``equivalent_value``.
+    step is scalar), ``linear_parameter``, ``strength``, ``moves`` and ``law``, and
+    implement ``kernel_parameters``. Closed forms of ``equivalent_value`` and
+    ``strength_scale`` are optional (the defaults are numerical).
     """
 
     acts_on: ClassVar[str] = "nonlinear"
@@ -129,10 +168,12 @@ class NonlinearElement(Effect):
     reads: ClassVar[tuple[str, ...]] = ()
     linear_parameter: ClassVar[str] = ""
     strength: ClassVar[str] = ""  # the parameter that sets the element's size (k3, Fc, c2, isat)
-    kernel_law: ClassVar[int | None] = None  # the compiled integrator's form of `force` (see `kernel`)
+    moves: ClassVar[str] = ""  # which way linear_parameter moves with level: "up", "down", "either" (sign of strength)
+    law: ClassVar[Callable]  # staticmethod (p0, p1, y) -> (force, slope), NumPy functions only (see the module)
+    law_width: ClassVar[float | None] = None  # a feature of the law narrower than the signal (quadrature hint)
 
     def kernel_parameters(self) -> tuple:
-        """(p0, p1) of ``kernel_law`` (the compiled integrator's form of `force`).
+        """(p0, p1) of ``law`` for this element's parameter values.
 
         Returns
         -------
@@ -155,7 +196,8 @@ class NonlinearElement(Effect):
             the equation of motion, positive on u2 for the absorber); for ``shunt``:
             the true current minus the small-signal current [A].
         """
-        raise NotImplementedError
+        p0, p1 = self.kernel_parameters()
+        return type(self).law(p0, p1, y[self.reads[0]])[0]
 
     def slope(self, y: dict, rig):
         """Derivative of `force` with respect to the (single) signal the element reads.
@@ -170,7 +212,8 @@ class NonlinearElement(Effect):
         ndarray
             d force / d reading (used by the integrator's Newton step on the implicit force).
         """
-        raise NotImplementedError
+        p0, p1 = self.kernel_parameters()
+        return type(self).law(p0, p1, y[self.reads[0]])[1]
 
     def equivalent_value(self, rig, rms: dict):
         """Equivalent value of ``linear_parameter`` when the read signals have RMS ``rms``.
@@ -183,8 +226,94 @@ class NonlinearElement(Effect):
         Returns
         -------
         float or ndarray
+            By default nominal + E[slope(x)], x ~ N(0, rms²): E[f(x) x] / E[x²] by Stein's lemma, the
+            stiffness (or damping) a linear fit sees; a shunt element must say its own.
         """
-        raise NotImplementedError
+        if self.acts == "shunt":
+            raise NotImplementedError(f"{self.name}: a shunt element gives its own equivalent_value")
+        p0, p1 = self.kernel_parameters()
+        sig = self.reads[0]
+        law = type(self).law
+        mean = gaussian_mean(lambda x: law(p0, p1, x)[1], np.asarray(rms[sig], float), width=self.law_width)
+        return getattr(rig, self.linear_parameter) + mean
+
+    def strength_scale(self, rig, rms: dict) -> float:
+        """The strength that moves ``linear_parameter`` by a tenth of its value at these RMS (a fit's unit).
+
+        Numerical by default (the equivalent value is taken as proportional to the strength, as it is for
+        every force law linear in its strength).
+
+        Parameters
+        ----------
+        rig : Rig.
+        rms : {signal: RMS} of the read signals.
+
+        Returns
+        -------
+        float
+        """
+        spec = next(p for p in self.parameter_specs if p.name == self.strength)
+        probe = float(max(abs(s) for s in spec.starts) if spec.starts else 1.0)
+        nominal = float(getattr(rig, self.linear_parameter))
+        moved = float(np.mean(self.replace(**{self.strength: probe}).equivalent_value(rig, rms))) - nominal
+        return probe * 0.1 * abs(nominal) / abs(moved) if moved else probe
+
+    def coordinates(self, rig, rms: dict) -> tuple:
+        """How a fit moves this element's parameters at a level with these RMS (one `Coordinate` each).
+
+        The strength in units of `strength_scale` (either sign where its hard range allows, else
+        positive), the others on a log scale about their present values.
+
+        Parameters
+        ----------
+        rig : Rig.
+        rms : {signal: RMS} of the read signals (e.g. at the highest level).
+
+        Returns
+        -------
+        tuple of Coordinate
+        """
+        out = []
+        for spec in self.parameter_specs:
+            if spec.name == self.strength:
+                scale = self.strength_scale(rig, rms)
+                if spec.hard[0] < 0:
+                    out.append(Coordinate(spec.name, scale, "linear", (-20.0, 20.0), SIGNED_STARTS))
+                else:
+                    out.append(Coordinate(spec.name, scale, "positive", (0.0, 200.0), POSITIVE_STARTS))
+            else:
+                value = float(np.mean(self.params[spec.name]))
+                lo, hi = (max(float(b), TINY) for b in (spec.search or spec.hard))
+                out.append(Coordinate(spec.name, value, "log", (math.log(lo / value), math.log(hi / value)), (0.0,)))
+        return tuple(out)
+
+    def coordinate_starts(self, rig, rms: dict, coordinates=None) -> list:
+        """Every combination of the coordinates' starts (a fit's scan), in x.
+
+        Parameters
+        ----------
+        rig, rms : as `coordinates`.
+        coordinates : the coordinates already made (else made from rig and rms).
+
+        Returns
+        -------
+        list of lists
+        """
+        coords = coordinates if coordinates is not None else self.coordinates(rig, rms)
+        return [list(x) for x in itertools.product(*(c.starts for c in coords))]
+
+    def trend_fixed(self, rms_levels: list) -> dict:
+        """Parameters held fixed when only the equivalent values' trend with level is known (none by default).
+
+        Parameters
+        ----------
+        rms_levels : the read signals' RMS at each level ({signal: RMS} each).
+
+        Returns
+        -------
+        dict
+        """
+        return {}
 
     def equivalent_linear(self, rig, rms: dict) -> EquivalentLinear:
         """The linear parameter this element moves at a level, its value, and which way.

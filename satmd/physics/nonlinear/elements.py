@@ -15,10 +15,35 @@ import math
 import numpy as np
 
 from ..effects.base import Parameter
-from .base import NonlinearElement, gaussian_mean
+from .base import Coordinate, NonlinearElement, gaussian_mean
 
 _INF = math.inf
 SQRT_8_OVER_PI = math.sqrt(8.0 / math.pi)
+HALF_PI = 0.999 * math.pi / 2  # the saturating inductor's flux limit, kept short of the pole
+
+
+# The force laws, (p0, p1, y) -> (force, slope): NumPy functions only, so that one definition serves arrays
+# (`NonlinearElement.force`) and the compiled integrator (`kernel`).
+def cubic_law(p0, p1, y):
+    """p0 y³."""
+    return p0 * y * y * y, 3.0 * p0 * y * y
+
+
+def coulomb_law(p0, p1, y):
+    """p0 tanh(y / p1): regularised Coulomb friction."""
+    t = np.tanh(y / p1)
+    return p0 * t, p0 / p1 * (1.0 - t * t)
+
+
+def velocity_squared_law(p0, p1, y):
+    """p0 |y| y."""
+    return p0 * np.abs(y) * y, 2.0 * p0 * np.abs(y)
+
+
+def saturation_law(p0, p1, y):
+    """p0 tan(y / p0) - y: the true current beyond the small-signal one (flux clipped short of its limit)."""
+    t = np.tan(np.minimum(np.maximum(y / p0, -HALF_PI), HALF_PI))
+    return p0 * t - y, t * t
 
 
 def _pct(x) -> str:
@@ -30,21 +55,17 @@ class CubicAbsorberSpring(NonlinearElement):
     parameter_specs = (Parameter("k3", "N/m³", default=0.0, neutral=0.0, hard=(-_INF, _INF),
                                  search=(-1e16, 1e16), starts=(1e9, 1e11, 1e13)),)
     description = "cubic absorber spring: restoring force kp d + k3 d³ (k3 > 0 hardening, < 0 softening)"
-    acts, reads, linear_parameter, strength = "absorber", ("d",), "kp", "k3"
-    kernel_law = 0  # p0 y³
+    acts, reads, linear_parameter, strength, moves = "absorber", ("d",), "kp", "k3", "either"
+    law = staticmethod(cubic_law)
 
     def kernel_parameters(self):
         return (self.params["k3"], 0.0)
 
-    def force(self, y, rig):
-        d = y["d"]
-        return self.params["k3"] * d * d * d
-
-    def slope(self, y, rig):
-        return 3.0 * self.params["k3"] * y["d"] ** 2
-
     def equivalent_value(self, rig, rms):
         return rig.kp + 3.0 * self.params["k3"] * np.asarray(rms["d"], float) ** 2
+
+    def strength_scale(self, rig, rms):
+        return 0.1 * float(rig.kp) / (3 * rms["d"] ** 2)
 
     def explain(self, rig) -> str:
         k3 = float(self.params["k3"])
@@ -61,21 +82,17 @@ class CubicHostSpring(NonlinearElement):
     parameter_specs = (Parameter("k3", "N/m³", default=0.0, neutral=0.0, hard=(-_INF, _INF),
                                  search=(-1e17, 1e17), starts=(1e9, 1e11, 1e13)),)
     description = "cubic host spring: k1 u1 + k3 u1³ on the primary mass"
-    acts, reads, linear_parameter, strength = "host", ("u1",), "k1", "k3"
-    kernel_law = 0  # p0 y³
+    acts, reads, linear_parameter, strength, moves = "host", ("u1",), "k1", "k3", "either"
+    law = staticmethod(cubic_law)
 
     def kernel_parameters(self):
         return (self.params["k3"], 0.0)
 
-    def force(self, y, rig):
-        u = y["u1"]
-        return self.params["k3"] * u * u * u
-
-    def slope(self, y, rig):
-        return 3.0 * self.params["k3"] * y["u1"] ** 2
-
     def equivalent_value(self, rig, rms):
         return rig.k1 + 3.0 * self.params["k3"] * np.asarray(rms["u1"], float) ** 2
+
+    def strength_scale(self, rig, rms):
+        return 0.1 * float(rig.k1) / (3 * rms["u1"] ** 2)
 
     def explain(self, rig) -> str:
         k3 = float(self.params["k3"])
@@ -94,18 +111,20 @@ class AbsorberFriction(NonlinearElement):
         Parameter("v0", "m/s", default=1e-3, hard=(1e-12, _INF), search=(1e-5, 0.1), starts=(1e-3,)),
     )
     description = "friction in the absorber's guide: Fc tanh(v / v0) (regularised Coulomb)"
-    acts, reads, linear_parameter, strength = "absorber", ("v",), "cp", "Fc"
-    kernel_law = 1  # p0 tanh(y / p1)
+    acts, reads, linear_parameter, strength, moves = "absorber", ("v",), "cp", "Fc", "down"
+    law = staticmethod(coulomb_law)
 
     def kernel_parameters(self):
         return (self.params["Fc"], self.params["v0"])
 
-    def force(self, y, rig):
-        return self.params["Fc"] * np.tanh(y["v"] / self.params["v0"])
+    def coordinates(self, rig, rms):
+        v = rms["v"]  # Fc in units of the Coulomb limit's damping at this level, v0 of the velocity
+        return (Coordinate("Fc", v * math.sqrt(math.pi / 2), "positive", (0.0, 200.0), (0.3, 1.0, 2.0, 4.0, 8.0)),
+                Coordinate("v0", v, "log", (math.log(1e-4), math.log(3.0)), (math.log(0.03), math.log(0.3))))
 
-    def slope(self, y, rig):
-        v0 = self.params["v0"]
-        return self.params["Fc"] / v0 / np.cosh(np.clip(y["v"] / v0, -350, 350)) ** 2
+    def trend_fixed(self, rms_levels):
+        # v0 well below the slowest level's velocity: Coulomb-like, as a rub is (a trend cannot tell v0)
+        return {"v0": 0.05 * min(float(r["v"]) for r in rms_levels)}
 
     def equivalent_value(self, rig, rms):
         fc, v0 = self.params["Fc"], self.params["v0"]
@@ -127,21 +146,17 @@ class QuadraticDamping(NonlinearElement):
     parameter_specs = (Parameter("c2", "N·s²/m²", default=0.0, neutral=0.0, hard=(0.0, _INF), search=(0.0, 1e5),
                                  starts=(10.0, 100.0, 1000.0)),)
     description = "velocity-squared damping on the absorber: c2 |v| v"
-    acts, reads, linear_parameter, strength = "absorber", ("v",), "cp", "c2"
-    kernel_law = 2  # p0 |y| y
+    acts, reads, linear_parameter, strength, moves = "absorber", ("v",), "cp", "c2", "up"
+    law = staticmethod(velocity_squared_law)
 
     def kernel_parameters(self):
         return (self.params["c2"], 0.0)
 
-    def force(self, y, rig):
-        v = y["v"]
-        return self.params["c2"] * np.abs(v) * v
-
-    def slope(self, y, rig):
-        return 2.0 * self.params["c2"] * np.abs(y["v"])
-
     def equivalent_value(self, rig, rms):
         return rig.cp + self.params["c2"] * SQRT_8_OVER_PI * np.asarray(rms["v"], float)
+
+    def strength_scale(self, rig, rms):
+        return 1.0 / (math.sqrt(8 / math.pi) * rms["v"])  # x = 1: cp + 1 N·s/m
 
     def explain(self, rig) -> str:
         c2 = float(self.params["c2"])
@@ -162,20 +177,15 @@ class InductorSaturation(NonlinearElement):
     name = "inductor_saturation"
     parameter_specs = (Parameter("isat", "A", hard=(1e-12, _INF), search=(1e-4, 100.0), starts=(0.01, 0.1, 1.0)),)
     description = "a saturating shunt inductor: incremental inductance L0 / (1 + (i / isat)²)"
-    acts, reads, linear_parameter, strength = "shunt", ("i",), "L", "isat"
-    kernel_law = 3  # p0 tan(y / p0) - y
+    acts, reads, linear_parameter, strength, moves = "shunt", ("i",), "L", "isat", "down"
+    law = staticmethod(saturation_law)
 
     def kernel_parameters(self):
         return (self.params["isat"], 0.0)
 
-    def force(self, y, rig):
-        a = self.params["isat"]
-        x = np.clip(y["i"] / a, -0.999 * math.pi / 2, 0.999 * math.pi / 2)
-        return a * np.tan(x) - y["i"]
-
-    def slope(self, y, rig):
-        a = self.params["isat"]
-        return np.tan(np.clip(y["i"] / a, -0.999 * math.pi / 2, 0.999 * math.pi / 2)) ** 2
+    def coordinates(self, rig, rms):
+        return (Coordinate("isat", rms["i"], "log", (math.log(0.2), math.log(1e4)),
+                           tuple(math.log(v) for v in (1.2, 1.6, 2.2, 3.0, 5.0, 10.0, 30.0))),)
 
     def equivalent_value(self, rig, rms):
         # E[L0 / (1 + (i/a)²)] for i ~ N(0, s²) = L0 √(π/2) (a/s) erfcx(a / (√2 s)), with s the true current's RMS

@@ -195,7 +195,7 @@ def integrate(rig, force, fs_hz: float, elements=(), outputs=ACCEL_CHANNELS, seg
     m = len(elements)
     if backend == "numba" and not kernel.available:
         raise DataError("integrate: backend='numba' needs numba (pip install numba)")
-    if backend != "numpy" and kernel.available and all(el.kernel_law is not None for el in elements):
+    if backend != "numpy" and kernel.available:
         out = _compiled(elements, F, np.broadcast_to(force, (P, n_samples)), A, B, phi, g0, g1, outputs, corrections)
         if not batched:
             out = {k: v[0] for k, v in out.items()}
@@ -236,7 +236,7 @@ def _compiled(elements, drive, force, A, B, phi, g0, g1, outputs, corrections) -
         prm[:, j, 0], prm[:, j, 1] = np.broadcast_to(np.ravel(p0), (P,)), np.broadcast_to(np.ravel(p1), (P,))
     rows, direct, names = _output_rows(A, B, elements, outputs)
     y, g = kernel.run(phi, g0, g1, C, D, rows, direct, np.ascontiguousarray(drive, float),
-                      np.ascontiguousarray(force, float), [el.kernel_law for el in elements], prm, rd, corrections)
+                      np.ascontiguousarray(force, float), [type(el).law for el in elements], prm, rd, corrections)
     out = {name: y[:, r] for r, name in enumerate(names)}
     for j, el in enumerate(elements):
         out[f"g:{el.name}"] = g[:, j]

@@ -5,31 +5,39 @@ forces ``g_k`` are solved at every sample by Newton steps from a linear extrapol
 exactly as the NumPy path does, but over the whole record (no segments, no warm-up):
 a 90 s record at 2048 Hz takes a few milliseconds per parameter set.
 
-Each element's law is its class's ``force``/``slope`` written for the compiler: the
-class declares ``kernel_law`` (0 cubic in its reading, 1 regularised Coulomb, 2
-velocity-squared, 3 saturating inductor) and ``kernel_parameters()``; a test holds the
-two forms equal. Without numba, `available` is False and `integrate` uses NumPy (numba is
-imported when `available` is first asked).
+Each element's law is its class's one ``law(p0, p1, y) -> (force, slope)`` (NumPy
+functions, which numba compiles), with ``kernel_parameters()``. The built-in laws are
+compiled into one cached pass; an element defined elsewhere gets a pass of its own,
+compiled once per process for each set of laws (`laws_pass`). Without numba, `available`
+is False and `integrate` uses NumPy (numba is imported when `available` is first asked).
 """
 from __future__ import annotations
 
-import math
+import types
 
 import numpy as np
+
+from .elements import coulomb_law, cubic_law, saturation_law, velocity_squared_law
+
+BUILTIN_LAWS = (cubic_law, coulomb_law, velocity_squared_law, saturation_law)  # codes 0..3 of `_law`
+_PASSES: dict = {}  # laws -> (compiled pass, codes) for elements defined outside the package
 
 
 def _load() -> bool:
     """Import numba (optional: `pip install numba` makes the integrator ~100x faster) and compile the pass,
     on first use: numba's import alone costs a CLI start-up a third of a second. False: the NumPy path runs."""
-    global _law, _run
+    global _law, _run, cubic_law, coulomb_law, velocity_squared_law, saturation_law
     if "available" not in globals():
         try:
             import numba
         except ImportError:  # pragma: no cover - exercised where numba is absent
             globals()["available"] = False
         else:
-            _law = numba.njit(cache=True, fastmath=False)(_law)  # _run calls it by this name
-            _run = numba.njit(cache=True, fastmath=False)(_run)
+            jit = numba.njit(cache=True, fastmath=False)
+            cubic_law, coulomb_law = jit(cubic_law), jit(coulomb_law)  # _law calls them by these names
+            velocity_squared_law, saturation_law = jit(velocity_squared_law), jit(saturation_law)
+            _law = jit(_law)  # _run calls it by this name
+            _run = jit(_run)
             globals()["available"] = True
     return globals()["available"]
 
@@ -40,21 +48,47 @@ def __getattr__(name):
         return _load()
     raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
-HALF_PI = 0.999 * math.pi / 2
-
 
 def _law(code, p0, p1, y):
-    """(force, slope) of law ``code`` with parameters p0, p1 at reading y (scalar)."""
+    """(force, slope) of built-in law ``code`` (its index in `BUILTIN_LAWS`) at reading y (scalar)."""
     if code == 0:
-        return p0 * y * y * y, 3.0 * p0 * y * y
+        return cubic_law(p0, p1, y)
     if code == 1:
-        t = math.tanh(y / p1)
-        return p0 * t, p0 / p1 * (1.0 - t * t)
+        return coulomb_law(p0, p1, y)
     if code == 2:
-        return p0 * abs(y) * y, 2.0 * p0 * abs(y)
-    x = min(max(y / p0, -HALF_PI), HALF_PI)
-    t = math.tan(x)
-    return p0 * t - y, t * t
+        return velocity_squared_law(p0, p1, y)
+    return saturation_law(p0, p1, y)
+
+
+def laws_pass(laws: tuple):
+    """(compiled pass, codes): the cached pass for built-in laws, else one compiled for these laws.
+
+    Parameters
+    ----------
+    laws : each element's ``law`` (Python functions).
+
+    Returns
+    -------
+    (callable, list of int)
+    """
+    _load()
+    py = list(_BUILTIN_PY)
+    if all(f in py for f in laws):
+        return _run, [py.index(f) for f in laws]
+    distinct = tuple(dict.fromkeys(laws))
+    if distinct not in _PASSES:
+        import numba
+
+        jit = numba.njit(fastmath=False)
+        names = {f"law{i}": jit(f) for i, f in enumerate(distinct)}
+        src = "def dispatch(code, p0, p1, y):\n" + "".join(
+            f"    if code == {i}:\n        return law{i}(p0, p1, y)\n" for i in range(len(distinct) - 1))
+        src += f"    return law{len(distinct) - 1}(p0, p1, y)\n"
+        exec(src, names)  # a dispatcher over exactly these laws (numba cannot index a tuple of functions)
+        py_run = getattr(_run, "py_func", _run)
+        run_ = types.FunctionType(py_run.__code__, dict(py_run.__globals__, _law=jit(names["dispatch"])))
+        _PASSES[distinct] = jit(run_)
+    return _PASSES[distinct], [distinct.index(f) for f in laws]
 
 
 def _run(phi, g0, g1, C, D, out_rows, out_direct, drive, force, codes, prm, rd, corrections, out, gout):
@@ -118,7 +152,10 @@ def _run(phi, g0, g1, C, D, out_rows, out_direct, drive, force, codes, prm, rd, 
 
 
 
-def run(phi, g0, g1, C, D, out_rows, out_direct, drive, force, codes, prm, rd, corrections):
+_BUILTIN_PY = BUILTIN_LAWS  # the Python functions, before `_load` compiles the module's names
+
+
+def run(phi, g0, g1, C, D, out_rows, out_direct, drive, force, laws, prm, rd, corrections):
     """Outputs (P, o, N) and element forces (P, m, N) by the compiled sequential pass.
 
     Parameters
@@ -127,18 +164,18 @@ def run(phi, g0, g1, C, D, out_rows, out_direct, drive, force, codes, prm, rd, c
     C : (r, n) rows of the read signals; D : (P, r, m) = C @ G1 (element columns).
     out_rows, out_direct : (P, o, n), (P, o, 1 + m) output rows and feed-through.
     drive : (P, N) force fed to the state (band-limited correction applied); force : (P, N) raw samples.
-    codes : (m,) element laws; prm : (P, m, 2) their parameters; rd : (m,) the signal each reads.
+    laws : (m,) each element's ``law``; prm : (P, m, 2) their parameters; rd : (m,) the signal each reads.
     corrections : Newton steps per sample.
 
     Returns
     -------
     (ndarray, ndarray)
     """
-    _load()
+    pass_, codes = laws_pass(tuple(laws))
     P, N = drive.shape
     out = np.empty((P, out_rows.shape[1], N))
     gout = np.empty((P, len(codes), N))
     f = np.ascontiguousarray
-    _run(f(phi), f(g0), f(g1), f(C), f(D), f(out_rows), f(out_direct), f(drive), f(force),
+    pass_(f(phi), f(g0), f(g1), f(C), f(D), f(out_rows), f(out_direct), f(drive), f(force),
          f(np.asarray(codes, np.int64)), f(prm), f(np.asarray(rd, np.int64)), int(corrections), out, gout)
     return out, gout
