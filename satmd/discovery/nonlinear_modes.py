@@ -14,6 +14,7 @@ from dataclasses import replace
 from ..modal import follow_modes
 from .nonlinear import UNEXPLAINED_NL
 
+MODES_ALPHA = 0.05  # family-wise level of the trend tests once a test has detected a level dependence
 NOT_SATMD = "the SATMD model does not describe these data, so no SATMD element is named"
 
 
@@ -77,6 +78,10 @@ def modal_finding(datas, levels, unit: str | None = None, alpha: float = 0.05) -
 def unexplained_by_modes(report, datas, unit: str | None = None):
     """``report`` (a `NonlinearReport` that detected a level dependence) with its finding told per resonance.
 
+    The trends are read at ``MODES_ALPHA`` when a test other than the SATMD-parameter one (which says
+    nothing about another structure) detected the level dependence; otherwise a resonance that moves is the
+    only evidence, and it is read at the tests' own level.
+
     Parameters
     ----------
     report : NonlinearReport of the levels
@@ -89,10 +94,13 @@ def unexplained_by_modes(report, datas, unit: str | None = None):
         One ``nonlinear_unexplained`` finding with ``modes``; the level-dependence tests' bands put
         where resonances move (unchanged when none does).
     """
-    finding, bands = modal_finding(datas, report.levels, unit)
     # the SATMD-parameter test says nothing about a structure the SATMD model cannot describe: left out
-    tests = [replace(t, bands_hz=bands) if bands and t.name.startswith("level_dependence") else t
-             for t in report.tests if t.name != "level_dependence_parameters"]
+    kept = [t for t in report.tests if t.name != "level_dependence_parameters"]
+    # where no test that stays detected anything, a resonance that moves is the detection: at the tests' level
+    confirmed = any(t.significant for t in kept)
+    alpha = MODES_ALPHA if confirmed else min([t.alpha for t in report.tests] + [MODES_ALPHA])
+    finding, bands = modal_finding(datas, report.levels, unit, alpha)
+    tests = [replace(t, bands_hz=bands) if bands and t.name.startswith("level_dependence") else t for t in kept]
     return replace(report, tests=tests, findings=[finding],
                    detected=any(t.significant for t in tests) or bool(finding.get("modes")))
 

@@ -76,3 +76,35 @@ def test_an_adequate_satmd_rig_keeps_its_named_element():
     assert rep.model_adequate
     (finding,) = rep.nonlinear.to_dict()["findings"]
     assert finding["name"] == "cubic_absorber_spring" and "modes" not in finding
+
+
+class _NoNoise:
+    def standard_normal(self, n):
+        return np.zeros(n)
+
+
+def test_a_resonance_that_moves_is_read_at_the_detections_level_when_it_is_the_only_evidence():
+    """Null rigs of `benchmarks/structures_levels.py` (1 in 34) were reported moving at the trend tests' 5 %:
+    when only the SATMD-parameter test (which says nothing about another structure) detected anything, a
+    resonance's move is the detection itself and is read at the tests' level (1e-3)."""
+    from satmd.discovery.nonlinear import NonlinearReport
+    from satmd.discovery.nonlinear_modes import unexplained_by_modes
+    from satmd.discovery.nonlinear_stats import NonlinearTest
+    from satmd.modal import follow_modes
+
+    f0, _ = chain_modes()
+    zeta = [0.01, 0.012, 0.008, 0.01]
+    base = chain_frf(f0, zeta, _NoNoise(), 10.0)
+    sd = follow_modes(FREQ, [base.channels] * 2, [base.std] * 2, [1.0, 2.0])[1].f_std[0]
+    shift = 3.3 * np.sqrt(2) * sd  # between the 5 % and the 1e-3 family-wise thresholds (4 modes: z 2.7 and 4.1)
+    moved = chain_frf([f0[0], f0[1] + shift, f0[2], f0[3]], zeta, _NoNoise(), 40.0)
+    param = NonlinearTest("level_dependence_parameters", 1e-6, [], 1e-3, {})
+
+    def report(level_p):
+        tests = [NonlinearTest("level_dependence", level_p, [], 1e-3, {}), param]
+        return NonlinearReport(True, tests, [], levels=[10.0, 40.0])
+
+    alone = unexplained_by_modes(report(0.5), [base, moved], "N RMS")
+    assert not alone.detected and alone.findings[0]["modes"] == []
+    confirmed = unexplained_by_modes(report(1e-5), [base, moved], "N RMS")
+    assert confirmed.detected and [m["trend"] for m in confirmed.findings[0]["modes"]] == ["hardening"]
