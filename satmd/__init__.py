@@ -16,31 +16,36 @@ from .version import __version__  # noqa: F401  (re-exported: satmd.__version__)
 
 # public name -> the module that defines it (imported when the name is first used)
 _EXPORTS = {
-    **dict.fromkeys(("DataError", "DataWarning", "FormatError", "IdentifiabilityWarning", "PinnedParameterWarning",
+    **dict.fromkeys(("DataError", "DataTypeError", "DataWarning", "FormatError", "IdentifiabilityWarning", "PinnedParameterWarning",
                      "PoorFitWarning", "SatmdError"), ".errors"),
-    **dict.fromkeys(("FRFData", "load_frf", "save_frf"), ".io"),
+    **dict.fromkeys(("FRFData", "load_frf", "save_frf", "Recording", "load_recording", "save_recording",
+                     "estimate_frf"), ".io"),
     **dict.fromkeys(("PAPER_GRID_HZ", "DielectricLoss", "Effect", "ExtraMode", "ParameterOffset", "Rig", "SensorGain",
                      "ShuntCapacitance", "StructuralDamping", "TimeDelay", "effect", "frf", "NonlinearElement",
-                     "integrate", "nonlinear_element"), ".physics"),
+                     "integrate", "nonlinear_element", "register_nonlinear"), ".physics"),
     "simulate": ".simulation",
-    **dict.fromkeys(("FitResult", "identify", "identify_many"), ".identification"),
+    **dict.fromkeys(("FitResult", "identify", "identify_many", "fit_nonlinear", "NonlinearFit"), ".identification"),
+    **dict.fromkeys(("fit_modes", "follow_modes"), ".modal"),
     **dict.fromkeys(("DiscoveryReport", "discover", "discover_many"), ".discovery"),
     **dict.fromkeys(("TuneResult", "retune", "tune"), ".tuning"),
+    "tune_nonlinear": ".tuning.nonlinear",
     "InverseModel": ".inverse",  # torch is optional: it loads only when the model is used
 }
 
 if TYPE_CHECKING:  # what type checkers and editors see; at run time `__getattr__` imports on first use
     from .discovery import DiscoveryReport, discover, discover_many
-    from .errors import (DataError, DataWarning, FormatError, IdentifiabilityWarning, PinnedParameterWarning,
-                         PoorFitWarning, SatmdError)
-    from .identification import FitResult, identify, identify_many
+    from .errors import (DataError, DataTypeError, DataWarning, FormatError, IdentifiabilityWarning,
+                         PinnedParameterWarning, PoorFitWarning, SatmdError)
+    from .identification import FitResult, NonlinearFit, fit_nonlinear, identify, identify_many
     from .inverse import InverseModel
-    from .io import FRFData, load_frf, save_frf
+    from .io import FRFData, Recording, estimate_frf, load_frf, load_recording, save_frf, save_recording
+    from .modal import fit_modes, follow_modes
     from .physics import (PAPER_GRID_HZ, DielectricLoss, Effect, ExtraMode, NonlinearElement, ParameterOffset, Rig,
                           SensorGain, ShuntCapacitance, StructuralDamping, TimeDelay, effect, frf, integrate,
-                          nonlinear_element)
+                          nonlinear_element, register_nonlinear)
     from .simulation import simulate
     from .tuning import TuneResult, retune, tune
+    from .tuning.nonlinear import tune_nonlinear
 
 
 def __getattr__(name):
@@ -71,5 +76,7 @@ __all__ = [
     "ParameterOffset", "SatmdError", "DataError", "FormatError", "DataWarning", "PoorFitWarning",
     "PinnedParameterWarning", "IdentifiabilityWarning", "identify", "identify_many", "FitResult",
     "discover", "discover_many", "DiscoveryReport", "InverseModel", "tune", "TuneResult", "retune",
-    "NonlinearElement", "nonlinear_element", "integrate",
+    "NonlinearElement", "nonlinear_element", "integrate", "register_nonlinear", "DataTypeError",
+    "Recording", "load_recording", "save_recording", "estimate_frf", "fit_nonlinear", "NonlinearFit",
+    "tune_nonlinear", "fit_modes", "follow_modes",
 ]

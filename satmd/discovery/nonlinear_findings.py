@@ -24,11 +24,20 @@ from .nonlinear import (
 )
 from .nonlinear_stats import NonlinearTest, level_dependence
 
-_REGRESSOR_HINT = {"u1:cube": "u1³ of the host's displacement (a host spring?)",
-                   "d:cube": "d³ of the absorber's stroke (its spring, or the shunt's inductor?)",
-                   "v:cube": "v³ of the absorber's relative velocity (a damping that grows with level?)",
-                   "v:absv": "|v|v of the absorber's relative velocity (velocity-squared damping?)",
-                   "v:sign": "sign(v) of the absorber's relative velocity (friction?)"}
+_REGRESSOR_WORDS = {"u1:cube": "u1³ of the host's displacement", "d:cube": "d³ of the absorber's stroke",
+                    "v:cube": "v³ of the absorber's relative velocity (a damping that grows with level?)",
+                    "v:absv": "|v|v of the absorber's relative velocity", "v:sign": "sign(v) of the absorber's relative velocity"}
+
+
+def regressor_hint(regressor: str) -> str | None:
+    """The regressor in words, with the registered elements that it stands for (their ``regressor``)."""
+    from ..physics.nonlinear import NONLINEAR
+
+    words = _REGRESSOR_WORDS.get(regressor)
+    if words is None:
+        return None
+    elements = [name for name, cls in NONLINEAR.items() if cls.regressor == regressor]
+    return f"{words} ({', '.join(elements)}?)" if elements else words
 
 
 def force_levels(recordings) -> list:
@@ -76,8 +85,9 @@ def _hint(test: NonlinearTest) -> str:
     chans = ", ".join(f"{c} {100 * v:.0f} %" for c, v in expl.items())
     text = f"distortion at {where}; nonlinear functions of the responses explain {chans} of the local residual"
     regs = test.details.get("regressors") or []
-    if test.details.get("per_regressor") and regs and regs[0] in _REGRESSOR_HINT:
-        text += f"; the regressor that holds it best is {_REGRESSOR_HINT[regs[0]]} (a hint, not a name)"
+    hint = regressor_hint(regs[0]) if test.details.get("per_regressor") and regs else None
+    if hint:
+        text += f"; the regressor that holds it best is {hint} (a hint, not a name)"
     return text
 
 

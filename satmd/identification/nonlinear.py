@@ -256,7 +256,9 @@ def _result(coords, x, cov_x, data, sims, skip, cost, nfev, wall, settings) -> N
             rms = response_rms(rig, force=d["force"], fs_hz=d["fs"])
             vals.append(float(np.ravel(el.equivalent_linear(rig, rms).value)[0]))
         eq[el.linear_parameter] = vals
-    return NonlinearFit(el, rig, values, std, ci, [d["level"] for d in data], rel, eq, cost, nfev, wall, settings)
+    overall = float(np.sqrt(np.mean(np.square([e for per in rel.values() for e in per.values()] or [np.nan]))))
+    return NonlinearFit(el, rig, values, std, ci, [d["level"] for d in data], overall, rel, eq, cost, nfev, wall,
+                        settings)
 
 
 def predict(fit: NonlinearFit, recording, seconds: float | None = None, skip_s: float = 2.0) -> dict:

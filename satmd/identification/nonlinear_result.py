@@ -23,7 +23,9 @@ class NonlinearFit:
     std : {name: standard deviation} (sandwich covariance: residual colour allowed).
     ci95 : {name: [lo, hi]} 95 % intervals.
     levels : force RMS [N] of each recording, in the order given.
-    rel_error : {level index: {"a1", "a2"}: RMS(residual) / RMS(measured)} after the fit.
+    rel_error : RMS over recordings and channels of RMS(residual) / RMS(measured) after the fit (one
+        figure, as `FitResult.rel_error`).
+    rel_error_per_level : {level index: {"a1", "a2"}: RMS(residual) / RMS(measured)}.
     equivalent_linear : {linear parameter: [value per recording]} from the fitted element.
     cost : final ½ Σ r² (weighted residuals).
     nfev : model evaluations (each a batched simulation of every recording).
@@ -37,7 +39,8 @@ class NonlinearFit:
     std: dict
     ci95: dict
     levels: list
-    rel_error: dict
+    rel_error: float
+    rel_error_per_level: dict
     equivalent_linear: dict
     cost: float
     nfev: int
@@ -67,7 +70,9 @@ class NonlinearFit:
                 "std": {k: float(v) for k, v in self.std.items()},
                 "ci95": {k: [float(x) for x in v] for k, v in self.ci95.items()},
                 "levels": [float(x) for x in self.levels],
-                "rel_error": {str(k): {c: float(e) for c, e in v.items()} for k, v in self.rel_error.items()},
+                "rel_error": float(self.rel_error),
+                "rel_error_per_level": {str(k): {c: float(e) for c, e in v.items()}
+                                        for k, v in self.rel_error_per_level.items()},
                 "equivalent_linear": {k: [float(x) for x in v] for k, v in self.equivalent_linear.items()},
                 "cost": float(self.cost), "nfev": int(self.nfev), "wall_time": float(self.wall_time),
                 "settings": dict(self.settings), "finding": self.finding()}
@@ -80,7 +85,7 @@ class NonlinearFit:
             lo, hi = self.ci95.get(k, (np.nan, np.nan))
             lines.append(f"  {k:>6s} = {v:.6g}   95 % [{lo:.6g}, {hi:.6g}]")
         for i, lev in enumerate(self.levels):
-            e = self.rel_error.get(i, {})
+            e = self.rel_error_per_level.get(i, {})
             lines.append(f"  level {lev:.3g} N: error a1 {100 * e.get('a1', np.nan):.2f} %, "
                          f"a2 {100 * e.get('a2', np.nan):.2f} %")
         if self.element is not None:

@@ -228,6 +228,11 @@ class FitResult:
         p = 0.5 + level / 2
         return float(stats.norm.ppf(p) if self.weighted else stats.t.ppf(p, self.dof))
 
+    @property
+    def ci95(self) -> dict:
+        """{name: [lo, hi]}: the 95 % Jacobian intervals, spelt as every other result spells them."""
+        return {n: [float(a), float(b)] for n, (a, b) in self.intervals(0.95).items()}
+
     def intervals(self, level: float = 0.95) -> dict:
         """Jacobian (Wald) intervals, value ± `quantile` · std.
 

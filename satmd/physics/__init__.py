@@ -39,6 +39,8 @@ from .nonlinear import (
     equivalent_rig,
     integrate,
     nonlinear_names,
+    register_nonlinear,
+    unregister_nonlinear,
 )
 from .nonlinear import element as nonlinear_element
 
@@ -49,4 +51,5 @@ __all__ = [
     "ParameterOffset", "Parameter", "MatchedFilter", "register", "unregister", "registered_names",
     "NONLINEAR", "NonlinearElement", "CubicAbsorberSpring", "CubicHostSpring", "AbsorberFriction",
     "QuadraticDamping", "InductorSaturation", "nonlinear_element", "nonlinear_names", "integrate", "equivalent_rig",
+    "register_nonlinear", "unregister_nonlinear",
 ]

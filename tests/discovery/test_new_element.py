@@ -40,6 +40,7 @@ class GapSpring(NonlinearElement):
     description = "a contact spring kg beyond a clearance gap in the absorber's stroke"
     acts, reads, linear_parameter, strength, moves = "absorber", ("d",), "kp", "kg", "up"
     law = staticmethod(gap_law)
+    regressor = "d:cube"  # the distortion test's regressor that stands for it
 
     @property
     def law_width(self):  # the slope steps at ±gap: quadrature with break points there
@@ -69,6 +70,9 @@ def test_new_element_law_written_once_serves_both_integrators(recordings):
     assert np.max(np.abs(compiled.a2 - plain.a2)) < 1e-6 * np.max(np.abs(plain.a2))
     eq = el.equivalent_linear(TRUTH, {"d": 1.5e-4})  # numerical by default: kp + kg P(|d| > gap)
     assert eq.value == pytest.approx(TRUTH.kp + KG * math.erfc(GAP / (math.sqrt(2) * 1.5e-4)), rel=1e-6)
+    from satmd.discovery.nonlinear_findings import regressor_hint
+
+    assert "test_gap_spring" in regressor_hint("d:cube")  # the distortion test's hint names it too
 
 
 def test_new_element_detected_named_fitted_and_tuned(recordings):

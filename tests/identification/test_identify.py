@@ -127,6 +127,15 @@ def test_confidence_intervals_match_jacobian(noisy_fit):
         assert (hi - v) / (1.96 * s) == pytest.approx(1.0, rel=0.25), name
 
 
+def test_results_spell_intervals_alike(noisy_fit):
+    """FitResult and NonlinearFit both give ci95 {name: [lo, hi]} and a one-figure rel_error (issue 36)."""
+    assert set(noisy_fit.ci95) == set(noisy_fit.names)
+    for name, (lo, hi) in noisy_fit.ci95.items():
+        a, b = noisy_fit.intervals(0.95)[name]
+        assert (lo, hi) == (a, b) and lo < noisy_fit.values[name] < hi
+    assert isinstance(noisy_fit.rel_error, float)
+
+
 # --- results as data and text ----------------------------------------------------------------
 def test_to_dict_is_json_serialisable(noisy_fit):
     d = noisy_fit.to_dict()

@@ -38,7 +38,9 @@ def test_cubic_spring_recovered_within_its_interval(cubic):
     assert abs(fit.values["k3"] - 2e11) < 2.0 * (hi - lo)  # within two interval widths (coverage: the benchmark)
     for p in ("m2", "kp", "R", "L"):
         assert abs(fit.values[p] / getattr(TRUE, p) - 1) < 2e-3
-    assert all(e["a1"] < 0.013 for e in fit.rel_error.values())  # down to the 1 % sensor noise
+    assert all(e["a1"] < 0.013 for e in fit.rel_error_per_level.values())  # down to the 1 % sensor noise
+    assert fit.rel_error == pytest.approx(np.sqrt(np.mean([e ** 2 for per in fit.rel_error_per_level.values()
+                                                           for e in per.values()])))  # one figure, as FitResult's
     kp_eq = fit.equivalent_linear["kp"]
     assert kp_eq[1] > kp_eq[0] > TRUE.kp  # hardening: kp up with level
     finding = fit.finding()

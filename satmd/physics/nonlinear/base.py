@@ -171,6 +171,7 @@ class NonlinearElement(Effect):
     moves: ClassVar[str] = ""  # which way linear_parameter moves with level: "up", "down", "either" (sign of strength)
     law: ClassVar[Callable]  # staticmethod (p0, p1, y) -> (force, slope), NumPy functions only (see the module)
     law_width: ClassVar[float | None] = None  # a feature of the law narrower than the signal (quadrature hint)
+    regressor: ClassVar[str] = ""  # the distortion test's regressor that stands for it ("d:cube", "v:sign", ...)
 
     def kernel_parameters(self) -> tuple:
         """(p0, p1) of ``law`` for this element's parameter values.

@@ -57,6 +57,7 @@ class CubicAbsorberSpring(NonlinearElement):
     description = "cubic absorber spring: restoring force kp d + k3 d³ (k3 > 0 hardening, < 0 softening)"
     acts, reads, linear_parameter, strength, moves = "absorber", ("d",), "kp", "k3", "either"
     law = staticmethod(cubic_law)
+    regressor = "d:cube"
 
     def kernel_parameters(self):
         return (self.params["k3"], 0.0)
@@ -84,6 +85,7 @@ class CubicHostSpring(NonlinearElement):
     description = "cubic host spring: k1 u1 + k3 u1³ on the primary mass"
     acts, reads, linear_parameter, strength, moves = "host", ("u1",), "k1", "k3", "either"
     law = staticmethod(cubic_law)
+    regressor = "u1:cube"
 
     def kernel_parameters(self):
         return (self.params["k3"], 0.0)
@@ -113,6 +115,7 @@ class AbsorberFriction(NonlinearElement):
     description = "friction in the absorber's guide: Fc tanh(v / v0) (regularised Coulomb)"
     acts, reads, linear_parameter, strength, moves = "absorber", ("v",), "cp", "Fc", "down"
     law = staticmethod(coulomb_law)
+    regressor = "v:sign"
 
     def kernel_parameters(self):
         return (self.params["Fc"], self.params["v0"])
@@ -148,6 +151,7 @@ class QuadraticDamping(NonlinearElement):
     description = "velocity-squared damping on the absorber: c2 |v| v"
     acts, reads, linear_parameter, strength, moves = "absorber", ("v",), "cp", "c2", "up"
     law = staticmethod(velocity_squared_law)
+    regressor = "v:absv"
 
     def kernel_parameters(self):
         return (self.params["c2"], 0.0)
@@ -179,6 +183,7 @@ class InductorSaturation(NonlinearElement):
     description = "a saturating shunt inductor: incremental inductance L0 / (1 + (i / isat)²)"
     acts, reads, linear_parameter, strength, moves = "shunt", ("i",), "L", "isat", "down"
     law = staticmethod(saturation_law)
+    regressor = "d:cube"
 
     def kernel_parameters(self):
         return (self.params["isat"], 0.0)
