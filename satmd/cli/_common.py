@@ -311,6 +311,21 @@ from ._recording import add_recording_options, load_recording_args  # noqa: E402
 from ._text import cli_text, one_line_warnings, safe_text, with_flags  # noqa: E402,F401 - shared by the commands
 
 
+def estimate_notes(args, estimator: dict, measurement) -> None:
+    """The stderr notes on FRFs estimated from a time recording: how, and what the chain did to them."""
+    from ..io.estimate import describe_estimate
+
+    if not estimator:
+        return
+    command = getattr(args, "command", None) or "satmd"
+    print(f"satmd {command}: note: {safe_text(args.data)} is a time recording: FRFs estimated by "
+          f"{describe_estimate(estimator)} (use `satmd estimate-frf` for control)", file=sys.stderr)
+    for finding in measurement:
+        if isinstance(finding, dict) and "remedy" in finding:
+            print(f"satmd {command}: measurement: {finding['explanation']}; remedy: {finding['remedy']}",
+                  file=sys.stderr)
+
+
 def load_data(args):
     """Load DATA with the --band, --map and --freq-axis options applied.
 
@@ -331,14 +346,9 @@ def load_data(args):
         if is_recording(args.data):
             rec = load_recording_args(args, args.data)
             data = estimate_frf(rec, band=(lo, hi))
-            from ..io.estimate import describe_estimate
 
             check_usable(args.data, data)
-            print(f"satmd {command}: note: {safe_text(args.data)} is a time recording: FRFs estimated by "
-                  f"{describe_estimate(data)} (use `satmd estimate-frf` for control)", file=sys.stderr)
-            for finding in data.estimator.get("measurement", []):
-                print(f"satmd {command}: measurement: {finding['explanation']}; remedy: {finding['remedy']}",
-                      file=sys.stderr)
+            estimate_notes(args, data.estimator, data.estimator.get("measurement", []))
             return data
         options = {}
         if getattr(args, "map", None):

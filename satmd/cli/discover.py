@@ -26,6 +26,8 @@ def register(sub):
 
 def run(args):
     from ..discovery import discover
+    from ..io import is_recording
+    from ._common import check_outputs, estimate_notes, load_recording_args, parse_band, plot_suffixes
 
     free = parse_list(args.free) or DEFAULT_FREE
     candidates = parse_names(args.candidates, registered_names(), "--candidates") if args.candidates else None
@@ -33,10 +35,16 @@ def run(args):
     if args.more:  # several recordings of one rig (issue 26)
         items = [_load_one(args, path) for path in (args.data, *args.more)]
         rep = discover(items, free=free, candidates=candidates, channels=channels, alpha=args.alpha)
+    elif is_recording(args.data):  # the library's own path: estimate, discover, test linearity
+        if args.plot:  # every output is checked before the first piece of work
+            check_outputs([("--plot", args.plot, plot_suffixes())], inputs=[args.data])
+        rec = load_recording_args(args, args.data)
+        lo, hi = parse_band(getattr(args, "band", None))
+        rep = discover(rec, free=free, candidates=candidates, channels=channels, alpha=args.alpha,
+                       band_hz=None if lo is None and hi is None else (lo, hi))
+        estimate_notes(args, rep.estimator, rep.estimator.get("measurement", []))
     else:
-        data = load_data(args)
-        rep = discover(data, free=free, candidates=candidates, channels=channels, alpha=args.alpha)
-        rep = _check_linearity(args, rep, free)
+        rep = discover(load_data(args), free=free, candidates=candidates, channels=channels, alpha=args.alpha)
     if args.plot:
         rep.plot(args.plot)
     if args.json:
@@ -56,14 +64,3 @@ def _load_one(args, path):
     lo, hi = parse_band(getattr(args, "band", None))
     data = load_frf(path)
     return data.band(lo, hi) if (lo is not None or hi is not None) else data
-
-
-def _check_linearity(args, rep, free):
-    """A single time recording is also tested for nonlinear distortion (the FRF path estimated it already)."""
-    from ..discovery.nonlinear_discover import check_one
-    from ..io import is_recording
-    from ._common import load_recording_args
-
-    if not is_recording(args.data):
-        return rep
-    return check_one(rep, load_recording_args(args, args.data), args.alpha, None, free)

@@ -57,6 +57,7 @@ def discover(
     channels: Sequence[str] | None = None,
     alpha: float = 1e-3,
     max_effects: int = 3,
+    band_hz=None,
 ) -> DiscoveryReport:
     """Find what physics the nominal model leaves out of ``data``.
 
@@ -77,6 +78,8 @@ def discover(
     channels : channels to fit (default a1, a2 when present, else all).
     alpha : level of the mismatch test (global and band-wise together).
     max_effects : most effects a model may hold.
+    band_hz : (lo, hi) Hz, either None for open: the band a recording's FRFs are estimated in (default:
+        the band the force excites); FRFData are cut to it.
 
     Returns
     -------
@@ -103,7 +106,9 @@ def discover(
 
         # the excitation is read once and travels with the recording: the FRF and the linearity test agree
         recording = data = with_excitation(data, detect_excitation(data))
-        data = estimate_frf(data)
+        data = estimate_frf(data, band=band_hz)
+    elif band_hz is not None:
+        data = data.band(*band_hz)
     report = _discover_frf(data, rig, free, candidates, channels, alpha, max_effects)
     if not data.estimator:
         return report

@@ -113,8 +113,9 @@ def estimate_frf(recording: Recording, nperseg: int | None = None, window=None, 
 
 
 def describe_estimate(data) -> str:
-    """One line on how FRFs were estimated from a recording (empty for other FRFs)."""
-    e = data.estimator
+    """One line on how FRFs were estimated from a recording (empty for other FRFs); ``data``: FRFData or its
+    ``estimator`` dict."""
+    e = data if isinstance(data, dict) else data.estimator
     if not e:
         return ""
     if e["method"] == "sweep":

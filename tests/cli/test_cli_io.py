@@ -127,3 +127,23 @@ def test_identify_takes_a_recording(capsys, recording):
 
     values = json.loads(out)
     assert values  # the identify command's own output; its content is tested with identify
+
+
+def test_discover_on_a_recording_is_the_librarys_discover(capsys, tmp_path):
+    """The CLI calls the library and nothing else (issue 36): one recording, one path, one report."""
+    import json
+
+    import satmd
+    from satmd.io import load_recording
+
+    from ._cli import run
+
+    path = tmp_path / "rec.csv"
+    assert run(capsys, "simulate", "--time", "--duration", "8", "--fs", "1024", "--seed", "3", "-o", path)[0] == 0
+    rc, out, err = run(capsys, "discover", path, "--json")
+    assert rc == 0 and "is a time recording: FRFs estimated by" in err
+    got = json.loads(out)
+    want = json.loads(json.dumps(satmd.discover(load_recording(path)).to_dict()))
+    for doc in (got, want):
+        doc.pop("wall_time_s", None)
+    assert got == want
