@@ -93,12 +93,9 @@ def discover(
     if isinstance(data, (list, tuple)):  # several recordings of one rig: judged together (issue 26)
         from .nonlinear_discover import discover_recordings
 
-        for j, part in enumerate(data):
-            require_data(part, f"data[{j}]", FRFData, Recording)
         data = [_with_excitation(part) for part in data]
         return discover_recordings(data, discover, rig=rig, free=free, alpha=alpha, candidates=candidates,
                                    channels=channels, max_effects=max_effects)
-    require_data(data, "data", FRFData, Recording)
     recording = data if isinstance(data, Recording) else None
     if recording is not None:
         from ..io.estimate import estimate_frf

@@ -27,7 +27,7 @@ import numpy as np
 
 from ..numerics import lag1_autocorrelation
 from .problem import SEARCH_RANGES, Problem
-from .statistics import POOR_REL_ERROR
+from .statistics import POOR_REL_ERROR, beyond_noise
 
 SCREEN_REL_ERROR = 0.6  # a reading (or a channel subset) is refitted only when a coarse design comes this near
 SCREEN_POINTS, SCREEN_DESIGN_LOG2 = 256, 10  # the screen's frequencies and design size (2^10 rigs)
@@ -170,9 +170,7 @@ def rel_error_beyond_noise(fit) -> float:
     n = 2 * sum(np.size(res[c]) for c in fit.channels)
     chi2 = sum(float(np.sum(np.abs(res[c] / sigma[c]) ** 2)) for c in fit.channels)
     power = sum(float(np.sum(np.abs(fit.data[c] / sigma[c]) ** 2)) for c in fit.channels)
-    if not (np.isfinite(chi2) and np.isfinite(power) and power > 2 * n):
-        return rel
-    return min(rel, float(np.sqrt(max(chi2 - n, 0.0) / (power - n))))
+    return beyond_noise(rel, chi2, n, power)
 
 
 def _beyond(fit, rel) -> str:

@@ -48,7 +48,11 @@ def build_result(problem, theta, nominal, nfev, wall, opt, reg) -> FitResult:
     for c, y, yh in zip(problem.channels, problem.target / peak, pred / peak):
         spread = _norm(y - y.mean())
         fit_pct[c] = float(100 * (1 - _norm(yh - y) / spread)) if spread > 0 else float("nan")
-    warnings = _fit_warnings(problem, theta, r, rel, chi2_red, dof, pinned)
+    beyond = rel
+    if problem.weighted and problem.pair is None:  # the poor-fit warning reads the error beyond the noise
+        power = float(np.sum(np.abs(problem.target / problem.sigma) ** 2))
+        beyond = beyond_noise(rel, chi2, 2 * problem.target.size, power)
+    warnings = _fit_warnings(problem, theta, r, beyond, chi2_red, dof, pinned)
     for i, nm in enumerate(names):
         if nm in pinned:
             continue
@@ -109,6 +113,27 @@ def _pinned(problem, theta, nominal) -> tuple:
                 out.append(p.name)
                 break
     return tuple(out)
+
+
+def beyond_noise(rel: float, chi2: float, n: int, power: float) -> float:
+    """The relative error on what the data carry above their noise (see `adequacy.rel_error_beyond_noise`).
+
+    Parameters
+    ----------
+    rel : the plain relative error.
+    chi2 : Σ |residual / σ|² over the n real numbers fitted.
+    n : their count (2 per complex point).
+    power : Σ |data / σ|².
+
+    Returns
+    -------
+    float
+        sqrt(max(χ² − n, 0) / (power − n)), or ``rel`` when smaller, when the data hold signal above their
+        noise (power > 2n); else ``rel``.
+    """
+    if not (np.isfinite(rel) and np.isfinite(chi2) and np.isfinite(power) and power > 2 * n):
+        return rel
+    return min(rel, float(np.sqrt(max(chi2 - n, 0.0) / (power - n))))
 
 
 def _lag1(r, n_series) -> float:

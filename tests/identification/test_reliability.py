@@ -259,3 +259,14 @@ def test_warnings_are_typed_records():
     again = pickle.loads(pickle.dumps(fit))  # identify_many sends results between processes
     assert [(str(w), w.category) for w in again.warnings] == [(str(w), w.category) for w in fit.warnings]
     assert issubclass(IdentifiabilityWarning, DataWarning)
+
+
+def test_poor_fit_warning_reads_the_error_beyond_the_noise():
+    """A true model on very noisy data with its std is no poor fit (issue 36: the warning read the plain error,
+    which noise alone takes past 0.5, while the adequacy verdict read the error beyond the noise)."""
+    rig = Rig()
+    data = simulate(PAPER_GRID_HZ, rig, noise=0.6, seed=11)
+    fit = identify(data, rig=rig, warn=False)
+    assert fit.rel_error > 0.5  # the plain error: mostly noise
+    assert not [w for w in fit.warnings if w.category is PoorFitWarning], fit.warnings
+    assert fit.chi2_reduced < 1.5
