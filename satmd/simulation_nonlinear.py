@@ -20,17 +20,10 @@ import numpy as np
 from .conventions import ACCEL_CHANNELS, PAPER_BAND_HZ
 from .errors import DataError
 from .io.recording import Recording
-from .io.timesim import log_sweep
 from .physics import Rig, integrate
-from .physics.nonlinear.excitation import odd_multisine, random_force
+from .physics.nonlinear.excitation import log_sweep, odd_multisine, random_force
 
 EXCITATIONS = ("random", "sweep", "multisine")
-
-
-def _sweep(n, fs_hz, lo, hi) -> np.ndarray:
-    """`log_sweep` at unit RMS (the drive level is the force's RMS)."""
-    x = log_sweep(n, fs_hz, lo, hi)
-    return x / np.sqrt(np.mean(x * x))
 
 
 def simulate_nonlinear_recording(rig: Rig | None = None, nonlinear: Sequence = (), level: float = 1.0,
@@ -91,7 +84,7 @@ def simulate_nonlinear_recording(rig: Rig | None = None, nonlinear: Sequence = (
     elif excitation == "random":
         forces = level * random_force(n, fs_hz, (lo, hi), rng)[None]
     else:
-        forces = level * _sweep(n, fs_hz, lo, hi)[None]
+        forces = level * log_sweep(n, fs_hz, lo, hi, unit_rms=True)[None]
     # each realisation from rest; 4x the rate inside, so the element forces' hold errs by < 0.1 % (not ~1 %)
     r = integrate(rig, forces, fs_hz, list(nonlinear), outputs=ACCEL_CHANNELS, oversample=4 if nonlinear else 1)
     clean = {"force": forces, "acc1": r.a1, "acc2": r.a2}

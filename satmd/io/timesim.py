@@ -46,6 +46,7 @@ import numpy as np
 from ..conventions import ACCEL_CHANNELS, PAPER_BAND_HZ, RECORDING_CHANNELS
 from ..errors import DataError
 from ..physics import Rig, frf
+from ..physics.nonlinear.excitation import log_sweep, random_force
 from .conditions import ForceSpectrum
 from .limits import check_memory
 from .recording import Recording
@@ -142,7 +143,7 @@ def simulate_recording(duration_s: float = 60.0, fs_hz: float = 1000.0, rig: Rig
         total = n + burn
         if excitation == "random":
             # the force goes on after the record ends: the anti-aliasing roll-off looks a few ms ahead
-            force = _random_force(total + int(fs_hz), fs_hz, lo, hi, rng, force_spectrum)
+            force = random_force(total + int(fs_hz), fs_hz, (lo, hi), rng, force_spectrum, unit_rms=False)
         else:
             force = log_sweep(total, fs_hz, lo, hi)
         clean = {"force": force, **_convolve(force, fs_hz, rig, effects, hi)}  # force: anti-aliased as recorded
@@ -174,35 +175,6 @@ def recording_memory(duration_s: float, fs_hz: float, burn_in_s: float = 0.0) ->
     """Bytes `simulate_recording` needs (measured): the impulse response is found on a 120 s grid at
     ``fs_hz`` (about 20 kB per Hz of sample rate), the force and its convolution take about 400 bytes a sample."""
     return 2.0e4 * fs_hz + 400.0 * ((duration_s + burn_in_s) * fs_hz + fs_hz)
-
-
-def _random_force(n, fs_hz, lo, hi, rng, shape=None) -> np.ndarray:
-    """Band-limited Gaussian noise, filtered on a record 4x longer and cut: not periodic in n samples.
-
-    ``shape`` (a `ForceSpectrum`) gives the shaker's amplitude response; default: flat, cut at lo and hi.
-    """
-    m = 4 * n
-    spectrum = np.fft.rfft(rng.standard_normal(m))
-    f = np.fft.rfftfreq(m, 1.0 / fs_hz)
-    if shape is None:
-        spectrum[(f < lo) | (f > hi)] = 0.0
-    else:
-        spectrum *= shape.amplitude(f, lo, hi)
-    start = int(rng.integers(0, m - n))
-    return np.fft.irfft(spectrum, m)[start:start + n]
-
-
-def log_sweep(n, fs_hz, lo, hi) -> np.ndarray:
-    """One logarithmic sine sweep lo -> hi over ``n`` samples at ``fs_hz``, tapered in and out (peak 1)."""
-    t = np.arange(n) / fs_hz
-    duration = n / fs_hz
-    rate = np.log(hi / lo)
-    x = np.sin(2 * np.pi * lo * duration / rate * (np.exp(t / duration * rate) - 1.0))
-    taper = max(1, int(0.05 * n))
-    ramp = 0.5 - 0.5 * np.cos(np.pi * np.arange(taper) / taper)
-    x[:taper] *= ramp
-    x[n - taper:] *= ramp[::-1]
-    return x
 
 
 def _convolve(force, fs_hz, rig, effects, pass_hz=0.0) -> dict:

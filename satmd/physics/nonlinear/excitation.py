@@ -15,8 +15,8 @@ import numpy as np
 from ...errors import DataError
 
 
-def random_force(n: int, fs_hz: float, band_hz, rng) -> np.ndarray:
-    """Band-limited Gaussian noise of unit RMS, filtered on a record 4x longer and cut (not periodic).
+def random_force(n: int, fs_hz: float, band_hz, rng, shape=None, unit_rms: bool = True) -> np.ndarray:
+    """Band-limited Gaussian noise, filtered on a record 4x longer and cut (not periodic in n samples).
 
     Parameters
     ----------
@@ -24,6 +24,9 @@ def random_force(n: int, fs_hz: float, band_hz, rng) -> np.ndarray:
     fs_hz : sample rate [Hz].
     band_hz : (lo, hi) [Hz].
     rng : numpy Generator.
+    shape : the shaker's amplitude response, an object with ``amplitude(f, lo, hi)`` (e.g.
+        `satmd.io.timesim.ForceSpectrum`); default flat, cut at lo and hi.
+    unit_rms : scale to unit RMS (else the filtered noise as it is).
 
     Returns
     -------
@@ -32,10 +35,38 @@ def random_force(n: int, fs_hz: float, band_hz, rng) -> np.ndarray:
     m = 4 * n
     spectrum = np.fft.rfft(rng.standard_normal(m))
     f = np.fft.rfftfreq(m, 1.0 / fs_hz)
-    spectrum[(f < band_hz[0]) | (f > band_hz[1])] = 0.0
+    if shape is None:
+        spectrum[(f < band_hz[0]) | (f > band_hz[1])] = 0.0
+    else:
+        spectrum *= shape.amplitude(f, band_hz[0], band_hz[1])
     start = int(rng.integers(0, m - n))
     x = np.fft.irfft(spectrum, m)[start:start + n]
-    return x / np.sqrt(np.mean(x * x))
+    return x / np.sqrt(np.mean(x * x)) if unit_rms else x
+
+
+def log_sweep(n: int, fs_hz: float, lo: float, hi: float, unit_rms: bool = False) -> np.ndarray:
+    """One logarithmic sine sweep lo -> hi over ``n`` samples at ``fs_hz``, tapered in and out.
+
+    Parameters
+    ----------
+    n : samples.
+    fs_hz : sample rate [Hz].
+    lo, hi : start and end frequencies [Hz].
+    unit_rms : scale to unit RMS (else peak 1).
+
+    Returns
+    -------
+    ndarray (n,)
+    """
+    t = np.arange(n) / fs_hz
+    duration = n / fs_hz
+    rate = np.log(hi / lo)
+    x = np.sin(2 * np.pi * lo * duration / rate * (np.exp(t / duration * rate) - 1.0))
+    taper = max(1, int(0.05 * n))
+    ramp = 0.5 - 0.5 * np.cos(np.pi * np.arange(taper) / taper)
+    x[:taper] *= ramp
+    x[n - taper:] *= ramp[::-1]
+    return x / np.sqrt(np.mean(x * x)) if unit_rms else x
 
 
 def odd_multisine_lines(period: int, fs_hz: float, band_hz, rng, group: int = 4) -> np.ndarray:
