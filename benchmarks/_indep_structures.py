@@ -51,6 +51,7 @@ FS = 256.0                 # Hz, the recording's sample rate
 OVER = 8                   # RK4 steps per sample
 BAND = (8.0, 64.0)         # Hz, the force's band (a ratio of 8: see structures_levels.py on why not wider)
 PERIOD = 4096              # samples of one multisine period (16 s at 256 Hz)
+SWEEP_MIN_S = 128.0        # a sweep's record: 96 s of sweep (~0.6 Hz/s over the band), 32 s of ring-down
 NMAX = 6                   # the largest number of coordinates
 JOINTS = ("hardening", "softening", "friction", "gap")
 BW_EXP = 2                 # Bouc–Wen exponent of the friction joint
@@ -179,7 +180,7 @@ def make_rig(seed: int, joint: str | None, excitation: str, n_levels: int, durat
     ----------
     seed : the rig's random stream
     joint : one of `JOINTS`, or None (the same structure without the joint: a null)
-    excitation : ``random`` or ``periodic``
+    excitation : ``random``, ``periodic`` or ``sweep`` (linear, up or down, then at rest)
     n_levels : how many force levels (geometric, the highest `SPAN` × the lowest)
     duration_s : record length (periodic: rounded to whole 16 s periods)
     structure : ``chain`` or ``beam`` (default: drawn)
@@ -227,6 +228,8 @@ def make_rig(seed: int, joint: str | None, excitation: str, n_levels: int, durat
         rig.levels = top * SPAN ** (np.linspace(0.0, 1.0, n_levels) - 1.0)
         if excitation == "periodic":
             rig.duration_s = PERIOD / FS * max(3, round(duration_s * FS / PERIOD))
+        elif excitation == "sweep":  # time for the sweep to pass each resonance slowly, and to ring down after
+            rig.duration_s = max(duration_s, SWEEP_MIN_S)
         force = forces(rig, rng_force(rig))[-1][::2 * OVER]        # the top level at the sample rate
         rig.sigma_top = float(np.std(_linear_delta(rig, force)))
         ok = _joint_strength(rig, rng, design, om[t], psi[t])
@@ -309,6 +312,14 @@ def forces(rig, rng):
         X[lines] = np.exp(2j * np.pi * rng.random(lines.sum()))
         one = np.fft.irfft(X, p)
         x = np.tile(one, nf // p + 1)[:nf]
+    elif rig.excitation == "sweep":
+        # a linear sine sweep over the first 3/4 of the record, up or down, tapered; then at rest (rings down)
+        t = np.arange(nf) / (FS * fine)
+        T = 0.75 * rig.duration_s
+        f0, f1 = (BAND[1], BAND[0]) if rng.random() < 0.5 else BAND
+        x = np.sin(2 * np.pi * (f0 * t + (f1 - f0) * t ** 2 / (2 * T))) * (t < T)
+        ramp = np.clip(np.minimum(t, T - t) / 0.5, 0.0, 1.0)
+        x *= 0.5 - 0.5 * np.cos(np.pi * ramp)
     else:
         freq = np.fft.rfftfreq(nf, 1 / (FS * fine))
         X = rng.standard_normal(freq.size) + 1j * rng.standard_normal(freq.size)

@@ -72,7 +72,7 @@ UNEXPLAINED = "nonlinear_unexplained"
 MATCH = 0.04
 
 
-def plan(n_per_joint: int, seed0: int) -> list:
+def plan(n_per_joint: int, seed0: int, excitations=EXCITATIONS) -> list:
     """(seed, joint, excitation, levels) per rig: excitations alternate, level counts cycle; a part (``seed0``
     a multiple of 100) continues the cycle where the part before it, of as many rigs, left it, so that parts of
     3 rigs still meet every (force, level count) pair: periodic forces at 2 and 5 levels, random ones at 3."""
@@ -80,7 +80,7 @@ def plan(n_per_joint: int, seed0: int) -> list:
     for a, joint in enumerate(sim.JOINTS):
         for i in range(n_per_joint):
             k = i + n_per_joint * (seed0 // 100)
-            out.append((seed0 + 1000 * (a + 1) + i, joint, EXCITATIONS[k % 2], LEVEL_COUNTS[k % 3]))
+            out.append((seed0 + 1000 * (a + 1) + i, joint, excitations[k % len(excitations)], LEVEL_COUNTS[k % 3]))
     return out
 
 
@@ -133,10 +133,11 @@ def judge(rig, recs) -> dict:
     return res
 
 
-def run(n_per_joint: int, seed0: int, duration_s: float, batch_rows: int = 96, log=print) -> list:
+def run(n_per_joint: int, seed0: int, duration_s: float, batch_rows: int = 96, log=print,
+        excitations=EXCITATIONS) -> list:
     """Every rig of the plan and its null: simulated in batches, judged one by one."""
     rigs = []
-    for seed, joint, exc, nl in plan(n_per_joint, seed0):
+    for seed, joint, exc, nl in plan(n_per_joint, seed0, excitations):
         rigs.append(sim.make_rig(seed, joint, exc, nl, duration_s))
         rigs.append(sim.make_rig(seed, None, exc, nl, duration_s, like=joint))
     cases = []
@@ -187,6 +188,7 @@ def summarise(cases) -> dict:
     """Rates per joint, per excitation and per level count; nulls."""
     joint = [c for c in cases if c["rig"]["joint"]]
     nulls = [c for c in cases if not c["rig"]["joint"]]
+    kinds = [e for e in ("random", "periodic", "sweep") if any(c["rig"]["excitation"] == e for c in cases)]
 
     def rates(sel):
         n = len(sel)
@@ -207,11 +209,11 @@ def summarise(cases) -> dict:
 
     out = {"joints": rates(joint), "nulls": null_rates(nulls),
            "per_joint": {j: rates([c for c in joint if c["rig"]["joint"] == j]) for j in sim.JOINTS},
-           "per_excitation": {e: rates([c for c in joint if c["rig"]["excitation"] == e]) for e in EXCITATIONS},
+           "per_excitation": {e: rates([c for c in joint if c["rig"]["excitation"] == e]) for e in kinds},
            "per_levels": {str(k): rates([c for c in joint if len(c["rig"]["levels_n_rms"]) == k])
                           for k in LEVEL_COUNTS},
            "nulls_per_excitation": {e: null_rates([c for c in nulls if c["rig"]["excitation"] == e])
-                                    for e in EXCITATIONS},
+                                    for e in kinds},
            "nulls_per_levels": {str(k): null_rates([c for c in nulls if len(c["rig"]["levels_n_rms"]) == k])
                                 for k in LEVEL_COUNTS},
            "seconds_per_discover_median": float(np.median([c["result"]["seconds"] for c in cases])) if cases else None}
@@ -252,18 +254,22 @@ def main(argv=None) -> int:
     ap.add_argument("--duration", type=float, default=64.0, help="record length [s] (periodic: whole periods)")
     ap.add_argument("--out", type=Path, default=OUT)
     ap.add_argument("--merge", nargs="+", default=None, help="merge these partial results into --out and stop")
+    ap.add_argument("--excitations", default=",".join(EXCITATIONS),
+                    help="forces the rigs cycle through: random, periodic, sweep (default random,periodic)")
     args = ap.parse_args(argv)
+    excitations = tuple(e.strip() for e in args.excitations.split(",") if e.strip())
     if args.merge:
         merge(args.merge, args.out)
         return 0
     info = machine(device="cpu", threads=1)
     t0 = time.perf_counter()
-    cases = run(args.rigs, args.seed0, args.duration)
+    cases = run(args.rigs, args.seed0, args.duration, excitations=excitations)
     info.update(load_after())
     result = {"summary": summarise(cases), "cases": cases, "benchmark_seconds": time.perf_counter() - t0,
               "machine": info, "settings": {"rigs_per_joint": args.rigs, "seed0": args.seed0,
                                             "duration_s": args.duration, "fs_hz": sim.FS, "oversampling": sim.OVER,
-                                            "band_hz": list(sim.BAND), "level_span": sim.SPAN}}
+                                            "band_hz": list(sim.BAND), "level_span": sim.SPAN,
+                                            "excitations": list(excitations)}}
     args.out.write_text(json.dumps(result, indent=1))
     print(line(result) + f" {describe(info)} -> {args.out}")
     return 0

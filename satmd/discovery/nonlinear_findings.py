@@ -36,8 +36,9 @@ def regressor_hint(regressor: str) -> str | None:
     words = _REGRESSOR_WORDS.get(regressor)
     if words is None:
         return None
-    elements = [name for name, cls in NONLINEAR.items() if cls.regressor == regressor]
-    return f"{words} ({', '.join(elements)}?)" if elements else words
+    elements = [f"{cls.description.split(':')[0]} ({name})" for name, cls in NONLINEAR.items()
+                if cls.regressor == regressor]
+    return f"{words} ({', or '.join(elements)}?)" if elements else words
 
 
 def force_levels(recordings) -> list:
@@ -47,9 +48,17 @@ def force_levels(recordings) -> list:
 
 def _distortion_tests(recordings, alpha):
     """One distortion test per recording at level alpha / k (Bonferroni), with its bands located."""
+    from ..io.excitation import detect_excitation
+
     k = len(recordings)
     tests = []
     for i, r in enumerate(recordings):
+        kind = detect_excitation(r).kind
+        if kind in ("impact", "sweep") and not is_multisine(r):  # no broadband force at every moment: says so
+            tests.append(NonlinearTest("distortion" if k == 1 else f"distortion#{i + 1}", 1.0, [], alpha / k,
+                                       {"reason": f"a{'n' if kind == 'impact' else ''} {kind} record: the distortion "
+                                                  "test needs a random or periodic force"}))
+            continue
         t = multisine_test(r, alpha / k) if is_multisine(r) else distortion_test(r, alpha=alpha / k)
         name = t.name if k == 1 else f"{t.name}#{i + 1}"
         p = min(1.0, t.p_value)

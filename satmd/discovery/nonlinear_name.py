@@ -22,6 +22,7 @@ from typing import Any, NamedTuple
 
 import numpy as np
 
+from ..errors import SatmdError
 from ..numerics import jacobian_covariance
 from ..physics import frf
 from ..physics.nonlinear import NONLINEAR, response_rms
@@ -275,8 +276,8 @@ def rank_elements(classes, values, stds, rigs, forces, fs_hz, joint_chi2: float,
     for order, cls in enumerate(classes):
         try:
             fit = fit_strength(cls, values, stds, rigs, forces, fs_hz)
-        except (ArithmeticError, ValueError, np.linalg.LinAlgError):
-            continue
+        except (SatmdError, ArithmeticError, ValueError, np.linalg.LinAlgError):
+            continue  # a candidate whose trend cannot be fitted is not ranked
         out.append({"cls": cls, "fit": fit, "order": order,
                     "bic": joint_chi2 + fit.chi2 + fit.n_fitted * np.log(max(n_data, 2))})
     return sorted(out, key=lambda r: (r["bic"], r["order"]))

@@ -184,3 +184,20 @@ def test_cli_takes_several_recordings(tmp_path, capsys):
     doc = json.loads(capsys.readouterr().out)
     assert doc["nonlinear"]["detected"] is False
     assert "level_dependence" in [t["name"] for t in doc["nonlinear"]["tests"]]
+
+
+def test_sweeps_at_several_levels_are_judged_not_refused():
+    """A sine sweep cannot carry the distortion test (no broadband force at each moment): with several levels
+    the test says it did not run and the levels are still compared (it refused, blaming the user for not
+    recording two levels, which they had)."""
+    import json
+
+    from satmd import discover, simulate
+
+    recs = [simulate(time=True, excitation="sweep", level=lv, duration_s=16.0, fs_hz=1024.0, noise=0.01, seed=i)
+            for i, lv in enumerate((1.0, 4.0))]
+    doc = json.loads(json.dumps(discover(recs).to_dict(), allow_nan=False))
+    tests = {t["name"]: t for t in doc["nonlinear"]["tests"]}
+    assert tests["distortion#1"]["p_value"] is None and "sweep" in tests["distortion#1"]["not_run"]
+    assert tests["level_dependence"]["p_value"] is not None
+    assert doc["nonlinear"]["detected"] is False and doc["effects"] == []

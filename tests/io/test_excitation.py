@@ -216,7 +216,8 @@ def test_a_fast_sweep_at_rest_at_both_ends_is_estimated_without_leakage():
     assert data.estimator["method"] == "sweep" and data.estimator["excitation"]["kind"] == "sweep"
     assert 0.8 < _calibration(data) < 1.25  # ~90 Hz/s through resonances a few Hz wide: no smearing
     rep = discover(rec)
-    assert rep.effect_names == [] and rep.nonlinear is None  # no distortion test for a sweep
+    assert rep.effect_names == [] and not rep.nonlinear.detected  # no distortion test for a sweep: it says so
+    assert "sweep" in rep.nonlinear.tests[0].not_run
 
 
 def test_a_log_sweep_is_recognised_with_its_law():
