@@ -11,6 +11,9 @@ Structures (linear part)
   superposition of its first 4 modes (unit-length shapes, mass-normalised with the beam's mass), with a
   support spring to ground at a point where the joint sits (δ = the beam's deflection there); force at
   one point, a1 there, a2 at another point.
+- ``plate``: a simply supported rectangular Kirchhoff plate (sides 1 and 0.55–0.85) by modal superposition
+  of its first 4 modes, with a point spring to ground where the joint sits; force at one point, a1 there,
+  a2 at another point.
 
 The linear spring at the joint stays in every structure (k_s); the joint acts in parallel with it.
 Damping is modal (0.5–2 % per mode of the small-amplitude structure: C = M Φ diag(2ζω) Φᵀ M). Every
@@ -153,6 +156,32 @@ def _shape(kind, r, x):
     return raw(x) / norm
 
 
+def _plate(rng):
+    """A simply supported rectangular plate (sides 1 and β), its first 4 modes; the joint a point spring to ground.
+
+    Kirchhoff plate: ω_mn ∝ m² + (n/β)², shapes 2 sin(mπx) sin(nπy/β) (unit mean square over the plate),
+    mass-normalised. β in 0.55–0.85 keeps the first modes apart (a square plate has double modes).
+    """
+    beta = rng.uniform(0.55, 0.85)
+    mass = rng.uniform(2.0, 10.0)
+    pairs = sorted(((m, n) for m in range(1, 5) for n in range(1, 5)), key=lambda mn: mn[0] ** 2 + (mn[1] / beta) ** 2)
+    pairs = pairs[:4]
+    omega = np.array([m ** 2 + (n / beta) ** 2 for m, n in pairs])
+    omega = omega / omega[0]
+
+    def phi(x, y):
+        return np.array([2.0 * np.sin(m * np.pi * x) * np.sin(n * np.pi * y) for m, n in pairs]) / np.sqrt(mass)
+
+    pts = rng.uniform(0.1, 0.9, (3, 2))
+    while np.hypot(*(pts[1] - pts[2])) < 0.15:
+        pts[2] = rng.uniform(0.1, 0.9, 2)
+    w = phi(*pts[0])
+    K = np.diag(omega ** 2)
+    k_s = rng.uniform(0.1, 0.6) * omega[0] ** 2 / max(w[0] ** 2, 1e-12) if abs(w[0]) > 1e-6 else 1.0
+    K = K + k_s * np.outer(w, w)
+    return "plate", np.eye(4), K, w, k_s, phi(*pts[1]), phi(*pts[1]), phi(*pts[2])
+
+
 def _beam(rng):
     kind = "ss" if rng.random() < 0.5 else "cant"
     nm = 4
@@ -183,7 +212,7 @@ def make_rig(seed: int, joint: str | None, excitation: str, n_levels: int, durat
     excitation : ``random``, ``periodic`` or ``sweep`` (linear, up or down, then at rest)
     n_levels : how many force levels (geometric, the highest `SPAN` × the lowest)
     duration_s : record length (periodic: rounded to whole 16 s periods)
-    structure : ``chain`` or ``beam`` (default: drawn)
+    structure : ``chain``, ``beam`` or ``plate`` (default: drawn)
     like : for a null (``joint`` None), the joint whose structure it copies (same seed: the same structure)
 
     Returns
@@ -193,8 +222,10 @@ def make_rig(seed: int, joint: str | None, excitation: str, n_levels: int, durat
     rng = np.random.default_rng(seed)
     design = joint or like or JOINTS[seed % 4]
     for _ in range(200):
-        kind = structure or ("beam" if rng.random() < 0.3 else "chain")
-        name, M, K, w, k_s, b, o1, o2 = _beam(rng) if kind == "beam" else _chain(rng, int(rng.integers(2, 7)))
+        draw = rng.random()
+        kind = structure or ("beam" if draw < 0.25 else "plate" if draw < 0.45 else "chain")
+        name, M, K, w, k_s, b, o1, o2 = (_beam(rng) if kind == "beam" else _plate(rng) if kind == "plate"
+                                         else _chain(rng, int(rng.integers(2, 7))))
         par = {}
         if design == "friction":
             par["kj"] = k_s * rng.uniform(0.3, 1.5)

@@ -1,7 +1,7 @@
 """Benchmark: how resonances move with level on structures the SATMD model cannot describe (issue 35).
 
 Recordings come from an independent simulator (`benchmarks/_indep_structures.py`, numpy/scipy only, no
-code shared with satmd): chains of 2–6 masses and beams (first 4 modes, modal superposition) with one
+code shared with satmd): chains of 2–6 masses, beams and plates (first 4 modes, modal superposition) with one
 nonlinear joint, simulated in time from rest (RK4 at 8× the sample rate, anti-alias filter, decimation,
 noise on every channel), measured at 2, 3 or 5 force levels spanning 20 dB, under a random
 (non-periodic) or a periodic multisine force. Each rig's recordings go through
