@@ -91,3 +91,21 @@ def test_simulate_checks_its_arguments():
         simulate(noise=(-0.1, 0.0))
     with pytest.raises(DataError, match="^simulate: level must be a number > 0"):
         simulate(time=True, level=0.0)
+
+
+def test_modal_and_retune_entry_points_validate_their_arguments():
+    """validate_params on every public entry point (issue 36): one line naming the argument."""
+    import numpy as np
+
+    from satmd import fit_modes, follow_modes, retune
+
+    f = np.linspace(10.0, 50.0, 200)
+    H = {"a1": 1.0 / (20.0 ** 2 - f ** 2 + 0.4j * f)}
+    with pytest.raises(DataError, match="^fit_modes: band must be"):
+        fit_modes(f, H, band=(50.0, 10.0))
+    with pytest.raises(DataError, match="^fit_modes: n_modes must be"):
+        fit_modes(f, H, n_modes=0)
+    with pytest.raises(DataError, match="^follow_modes: alpha must be"):
+        follow_modes(f, [H, H], alpha=1.5)
+    with pytest.raises(DataError, match="^retune: band must be"):
+        retune([], band=(200.0, 20.0))

@@ -17,6 +17,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..validation import Band, Interval, Whole, validate_params
+
 from ..numerics import jacobian_covariance
 from .poles import stable_poles
 
@@ -101,6 +103,8 @@ class ModalFit:
                 "weighted": self.weighted, "modes": [m.to_dict() for m in self.modes]}
 
 
+@validate_params({"band": [None, Band()], "n_modes": [None, Interval(Whole, 1)],
+                  "max_order": [None, Interval(Whole, 2)]})
 def fit_modes(freq_hz, frf, std=None, band=None, n_modes=None, max_order=None, start=None) -> ModalFit:
     """Natural frequencies and damping ratios of every mode in a band, with 95 % intervals.
 

@@ -19,7 +19,11 @@ An FRF's std from few periods (``dof`` below `MIN_STD_DOF`) is first averaged ov
 """
 from __future__ import annotations
 
+from numbers import Real
+
 import numpy as np
+
+from ..validation import Band, Interval, validate_params
 
 from .fit import Z95, Mode, fit_modes
 from .tracking import MAX_MOVE, MOVE_SHARE, read_trends
@@ -77,6 +81,8 @@ def smoothed_std(std, dof):
     return out, dof * n
 
 
+@validate_params({"alpha": [Interval(Real, 0, 1, open="both")], "band": [None, Band()],
+                  "dof": [None, Interval(Real, 0, open="lo")]})
 def follow_modes(freq_hz, frfs, stds=None, levels=None, alpha: float = 0.05, band=None, dof=None) -> list:
     """The modes of several levels of one structure, fitted from one set level by level, and their trends.
 

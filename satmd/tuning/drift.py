@@ -20,6 +20,7 @@ from ..physics.rig import Rig
 from .laws import OPEN_CIRCUIT_R
 from .objective import Objective
 from .result import clean, db
+from ..validation import NAMES, Band, validate_params
 
 
 @dataclass(frozen=True)
@@ -108,6 +109,8 @@ class RetuneResult:
         return fig if path is None else save(fig, path)
 
 
+@validate_params({"rig": [None, Rig], "free": [NAMES], "labels": [None, NAMES], "band": [Band()],
+                  "design": [NAMES]})
 def retune(
     series: Sequence,
     rig: Rig | None = None,
