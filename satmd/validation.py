@@ -153,8 +153,12 @@ class Grid:
         return "an increasing array of at least two positive frequencies"
 
 
+@dataclass(frozen=True)
 class Band:
-    """A frequency range ``(lo, hi)`` in Hz: two finite numbers with 0 < lo < hi."""
+    """A frequency range ``(lo, hi)`` in Hz: two finite numbers with 0 < lo < hi (``open_ends``: either may be
+    None, for "where the data say")."""
+
+    open_ends: bool = False
 
     def accepts(self, v) -> bool:
         """Whether ``v`` is such a pair.
@@ -167,13 +171,13 @@ class Band:
         -------
         bool
         """
-        if isinstance(v, (str, bytes)):
-            return False
         try:
-            lo, hi = (float(b) for b in v)
+            ends = [None if b is None and self.open_ends else float(b) for b in v] if not isinstance(v, (str, bytes)) else []
         except (TypeError, ValueError):
             return False
-        return math.isfinite(lo) and math.isfinite(hi) and 0 < lo < hi
+        lo, hi = (ends if len(ends) == 2 else [math.nan, math.nan])
+        ok = [b is None or (math.isfinite(b) and b > 0) for b in (lo, hi)]
+        return all(ok) and (lo is None or hi is None or lo < hi)
 
     def describe(self) -> str:
         """The constraint in words.
@@ -182,7 +186,7 @@ class Band:
         -------
         str
         """
-        return "a band (lo, hi) in Hz with 0 < lo < hi"
+        return "a band (lo, hi) in Hz with 0 < lo < hi" + (" (None: an open end)" if self.open_ends else "")
 
 
 @dataclass(frozen=True)

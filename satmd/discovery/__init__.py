@@ -26,7 +26,7 @@ from functools import partial
 from numbers import Real
 from typing import Sequence
 
-from ..validation import LOAD_HINT, NAMES, Interval, Whole, check_data, validate_params
+from ..validation import LOAD_HINT, NAMES, Band, Interval, Whole, check_data, validate_params
 from ..conventions import ACCEL_CHANNELS, DEFAULT_FREE
 from .._fleet import fleet_map
 from ..identification import identify
@@ -48,7 +48,8 @@ __all__ = ["discover", "discover_many", "DiscoveryReport", "EffectFinding", "Une
 
 
 @validate_params({"rig": [None, Rig], "free": [NAMES], "candidates": [None, NAMES], "channels": [None, NAMES],
-                  "alpha": [Interval(Real, 0, 1, "both")], "max_effects": [Interval(Whole, 0)]})
+                  "alpha": [Interval(Real, 0, 1, "both")], "max_effects": [Interval(Whole, 0)],
+                  "band_hz": [None, Band(open_ends=True)]})
 def discover(
     data,
     rig: Rig | None = None,
