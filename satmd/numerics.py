@@ -92,3 +92,40 @@ def inverse_gram(Js):
     if sv[-1] <= sv[0] * 1e-14:
         return np.full((sv.size, sv.size), np.inf), sv
     return (vt.conj().T / sv**2) @ vt, sv
+
+
+def batched_least_squares(residuals, x0, bounds, max_nfev: int, steps=None, rel_step: float = 1e-6, **tolerances):
+    """`scipy.optimize.least_squares` (trust region) for a model evaluated for many parameter sets at once.
+
+    The output-error fits (a simulation per parameter set, batched) share this: the residual at x is one
+    batched call, and so is the Jacobian (forward differences: x and x + h_i e_i in one batch).
+
+    Parameters
+    ----------
+    residuals : callable (P, p) -> (P, n), the residual vectors of P parameter sets.
+    x0 : (p,) start.
+    bounds : (lower, upper).
+    max_nfev : most iterations.
+    steps : fixed difference steps (p,) (default: ``rel_step`` · max(1, |x|) at each x).
+    rel_step : relative step where ``steps`` is None.
+    **tolerances : xtol, ftol, gtol of `least_squares` (default 1e-10 for xtol and ftol).
+
+    Returns
+    -------
+    (OptimizeResult, callable)
+        The solution, and the Jacobian function (for a covariance at the end).
+    """
+    from scipy.optimize import least_squares
+
+    def fun(x):
+        return residuals(x[None])[0]
+
+    def jac(x):
+        h = steps if steps is not None else rel_step * np.maximum(1.0, np.abs(x))
+        X = np.vstack([x] + [x + h[i] * np.eye(x.size)[i] for i in range(x.size)])
+        R = residuals(X)
+        return ((R[1:] - R[0]) / h[:, None]).T
+
+    opts = {"xtol": 1e-10, "ftol": 1e-10, **tolerances}
+    sol = least_squares(fun, x0, jac=jac, bounds=bounds, method="trf", x_scale="jac", max_nfev=max_nfev, **opts)
+    return sol, jac

@@ -23,11 +23,10 @@ import time
 from numbers import Integral, Real
 
 import numpy as np
-from scipy.optimize import least_squares
-
 from ..conventions import ACCEL_CHANNELS, DEFAULT_FREE
 from ..errors import DataError
 from ..io.estimate import estimate_frf
+from ..numerics import batched_least_squares
 from ..io.recording import Recording
 from ..physics import Rig, integrate
 from ..physics.nonlinear import NONLINEAR, NonlinearElement, element as make_element, response_rms
@@ -203,17 +202,10 @@ def fit_nonlinear(recordings, element=None, rig: Rig | None = None, free=LINEAR_
         x0 = X[int(np.argmin(cost))]
     nfev = 0
     for _ in range(max(1, passes)):
-        def fun(x):
-            return _residuals(simulate_batch(coords, x[None], data), data, weights, skip)[0]
+        def batch(X):  # the weights as they stand when called (the final Jacobian: the last pass's)
+            return _residuals(simulate_batch(coords, X, data), data, weights, skip)
 
-        def jac(x):
-            h = 1e-6 * np.maximum(1.0, np.abs(x))
-            X = np.vstack([x] + [x + h[i] * np.eye(x.size)[i] for i in range(x.size)])
-            R = _residuals(simulate_batch(coords, X, data), data, weights, skip)
-            return ((R[1:] - R[0]) / h[:, None]).T
-
-        sol = least_squares(fun, np.clip(x0, lo + 1e-9, hi - 1e-9), jac=jac, bounds=(lo, hi), method="trf",
-                            x_scale="jac", max_nfev=max_nfev, xtol=1e-10, ftol=1e-10)
+        sol, jac = batched_least_squares(batch, np.clip(x0, lo + 1e-9, hi - 1e-9), (lo, hi), max_nfev)
         nfev += sol.nfev
         x0 = sol.x
         sims = simulate_batch(coords, x0[None], data)

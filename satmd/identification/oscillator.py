@@ -29,7 +29,7 @@ from scipy import signal
 from scipy.optimize import least_squares
 
 from ..errors import DataError
-from ..numerics import jacobian_covariance
+from ..numerics import batched_least_squares, jacobian_covariance
 from ..physics.oscillator import PolynomialOscillator, fine_input, rk4_batch, segment_windows
 
 T95 = 1.959963984540054
@@ -242,20 +242,14 @@ class _Problem:
     def fit(self, p0, names, lower, upper, max_nfev):
         """least_squares on the scaled residual; returns (result, nfev)."""
         calls = {"n": 0}
-        steps = 1e-6 * np.maximum(1.0, np.abs(np.asarray(p0)))
 
-        def res(p):
-            calls["n"] += 1
-            return (self.simulate([p], names)[0] - self.target) / self.sy
+        def residuals(P):
+            calls["n"] += len(P)
+            return (self.simulate(list(P), names) - self.target) / self.sy
 
-        def jac(p):
-            sets = [p] + [p + np.eye(len(p))[i] * steps[i] for i in range(len(p))]
-            calls["n"] += len(sets)
-            sims = self.simulate(sets, names)
-            return ((sims[1:] - sims[0]) / steps[:, None]).T / self.sy
-
-        r = least_squares(res, p0, jac=jac, bounds=(lower, upper), x_scale="jac", max_nfev=max_nfev,
-                          xtol=1e-10, ftol=1e-10, gtol=1e-10)
+        steps = 1e-6 * np.maximum(1.0, np.abs(np.asarray(p0, float)))  # fixed at the start
+        r, _ = batched_least_squares(residuals, np.asarray(p0, float), (lower, upper), max_nfev, steps=steps,
+                                     gtol=1e-10)
         return r, calls["n"]
 
 
