@@ -59,3 +59,54 @@ class UnexplainedFinding(EffectFinding):
     bands_hz: list = field(default_factory=list)
     structured_fraction: float = 0.0
     n_terms: int = 0
+
+
+_NONLINEAR_KEYS = ("name", "parameters", "ci95", "equivalent", "equivalent_linear", "character", "modes",
+                   "explanation", "moving", "direction")
+
+
+@dataclass(frozen=True)
+class NonlinearFinding:
+    """One finding of the ``nonlinear`` block (SPEC §9): a named element, or ``nonlinear_unexplained``.
+
+    Parameters
+    ----------
+    name : an element's SPEC §8b name, or ``nonlinear_unexplained``.
+    parameters, ci95 : the element's fitted coefficients and their 95 % intervals.
+    equivalent : elements (or moving parameters) the data cannot tell from this one.
+    equivalent_linear : {linear parameter: value per level} (or a one-mode reading per level).
+    explanation : the finding in words.
+    moving, direction : the linear parameter that moves with level and which way (named elements).
+    character : hardening / softening / level-dependent damping (a generic system).
+    modes : per resonance, how it changes with level (a structure the SATMD model cannot describe).
+
+    Read access by the JSON keys (``finding["name"]``, ``finding.get("modes")``) is kept, as for
+    `EffectFinding`; the optional fields that are None are absent there.
+    """
+
+    name: str
+    parameters: dict = field(default_factory=dict)
+    ci95: dict = field(default_factory=dict)
+    equivalent: list = field(default_factory=list)
+    equivalent_linear: dict = field(default_factory=dict)
+    explanation: str = ""
+    moving: str | None = None
+    direction: str | None = None
+    character: str | None = None
+    modes: list | None = None
+
+    def to_dict(self) -> dict:
+        """The SPEC §9 entry (the optional fields when set)."""
+        return {k: getattr(self, k) for k in _NONLINEAR_KEYS if getattr(self, k) is not None}
+
+    def __getitem__(self, key: str):
+        if key not in _NONLINEAR_KEYS or getattr(self, key) is None:
+            raise KeyError(key)
+        return getattr(self, key)
+
+    def __contains__(self, key) -> bool:
+        return key in _NONLINEAR_KEYS and getattr(self, key) is not None
+
+    def get(self, key: str, default=None):
+        """The value of a JSON key, or ``default`` when it is absent."""
+        return self[key] if key in self else default

@@ -50,7 +50,8 @@ class NonlinearReport:
     ----------
     detected : whether any test rejects linearity at its level
     tests : list of `NonlinearTest`
-    findings : list of dicts: name, parameters, ci95, equivalent, equivalent_linear, explanation (and
+    findings : list of `NonlinearFinding` (read by the JSON keys too): name, parameters, ci95, equivalent,
+        equivalent_linear, explanation (and
         ``character`` or ``modes`` for a ``nonlinear_unexplained`` finding, SPEC §9)
     experiments : what to record next to settle what is open
     levels : one level figure per recording (force RMS), in the order given
@@ -68,7 +69,7 @@ class NonlinearReport:
         """The SPEC §9 ``nonlinear`` block (plus ``experiments``)."""
         keys = ("name", "parameters", "ci95", "equivalent", "equivalent_linear", "character", "modes", "explanation")
         out = {"detected": bool(self.detected), "tests": [t.to_dict() for t in self.tests],
-               "findings": [{k: f[k] for k in keys if k in f} for f in self.findings],
+               "findings": [{k: f[k] for k in keys if k in f} for f in self.findings],  # typed or plain dicts
                "experiments": list(self.experiments)}
         if self.set_aside:
             out["set_aside"] = list(self.set_aside)

@@ -22,6 +22,7 @@ from .nonlinear import (
     multisine_test,
     on_common_grid,
 )
+from .findings import NonlinearFinding
 from .nonlinear_stats import NonlinearTest, level_dependence
 
 _REGRESSOR_WORDS = {"u1:cube": "u1³ of the host's displacement", "d:cube": "d³ of the absorber's stroke",
@@ -149,9 +150,8 @@ def analyse_recordings(recordings, rig=None, free=DEFAULT_FREE, alpha: float = 1
         findings.append(_name_from_levels(datas, rig, free, levels, recordings, cmp))
     elif detected:
         worst = min(tests, key=lambda t: t.p_value)
-        findings.append({"name": UNEXPLAINED_NL, "parameters": {}, "ci95": {}, "equivalent": [],
-                         "equivalent_linear": {}, "explanation": _hint(worst) + "; one level cannot say which "
-                         "element (which linear parameter moves with level)"})
+        findings.append(NonlinearFinding(UNEXPLAINED_NL, explanation=_hint(worst) + "; one level cannot say which "
+                                         "element (which linear parameter moves with level)"))
         experiments.append(EXPERIMENT_LEVEL)
     if detected and not any(t.name.startswith("distortion_lines") for t in tests):
         experiments.append(EXPERIMENT_MULTISINE)
@@ -169,7 +169,7 @@ def _hypotheses(datas, rig, free, levels) -> dict:
     return compare_hypotheses(datas, rig, tuple(free), channels, dict(fit0.values), levels)
 
 
-def _name_from_levels(datas, rig, free, levels, recordings, cmp=None) -> dict:
+def _name_from_levels(datas, rig, free, levels, recordings, cmp=None) -> NonlinearFinding:
     """The finding for a significant level dependence: moving parameter, direction, element, strength.
 
     The element is the one whose equivalent linearisation's trend with level fits best (BIC over every
@@ -190,14 +190,13 @@ def _name_from_levels(datas, rig, free, levels, recordings, cmp=None) -> dict:
     change = fit.per_record[cmp["order"][-1]] / fit.per_record[cmp["order"][0]] - 1
     moved = f"{p} {100 * change:+.1f} % from the lowest to the highest level ({abs(cmp['z']):.0f} σ)"
     if not found:
-        return {"name": UNEXPLAINED_NL, "parameters": {}, "ci95": {}, "equivalent": others,
-                "equivalent_linear": eq_lin,
-                "explanation": f"the rig changes with level, but no element explains it: {moved}"}
+        return NonlinearFinding(UNEXPLAINED_NL, equivalent=others, equivalent_linear=eq_lin,
+                                explanation=f"the rig changes with level, but no element explains it: {moved}")
     if recordings is None:
-        return {"name": found[0].name, "parameters": {}, "ci95": {}, "equivalent": [c.name for c in found[1:]] + others,
-                "equivalent_linear": eq_lin,
-                "explanation": f"{found[0].description}; measured: {moved} (FRFs only: no force level, no strength)",
-                "moving": p, "direction": direction}
+        return NonlinearFinding(found[0].name, equivalent=[c.name for c in found[1:]] + others,
+                                equivalent_linear=eq_lin, moving=p, direction=direction,
+                                explanation=f"{found[0].description}; measured: {moved} (FRFs only: no force level, "
+                                            "no strength)")
     ranked = rank_elements(found, fit.per_record, fit.per_record_std, fit.rigs, [r["force"] for r in recordings],
                            [r.fs_hz for r in recordings], fit.chi2, fit.n_data)
     cls = ranked[0]["cls"] if ranked else found[0]
@@ -216,8 +215,7 @@ def _name_from_levels(datas, rig, free, levels, recordings, cmp=None) -> dict:
         text = f"{fitted.explain(rig.replace(**{p: nominal}))}; measured: {moved}" if params else text
     elif params:
         text += " (strength from the equivalent linearisation, whose own error the interval does not carry)"
-    return {"name": cls.name, "parameters": params, "ci95": ci, "equivalent": others,
-            "equivalent_linear": eq_lin, "explanation": text, "moving": p, "direction": direction}
+    return NonlinearFinding(cls.name, params, ci, others, eq_lin, text, moving=p, direction=direction)
 
 
 def _time_domain_strength(recordings, name, rig):
@@ -324,16 +322,15 @@ def analyse_generic(frfs: list, stds: list, freq, levels, tests=(), alpha: float
         from .nonlinear_modes import level_modes
 
         modes = [t.to_dict() for t in level_modes(freq, frfs, stds, levels) if t.moves]  # every resonance
-        findings.append({
-            "name": UNEXPLAINED_NL, "parameters": {}, "ci95": {}, "equivalent": [], "character": character,
-            "modes": modes, "equivalent_linear": {"f_n_hz": fn, "zeta": [m["zeta"] for m in fits], "peak_hz": peaks},
-            "explanation": (f"{character} at the resonance: a one-mode fit per level puts the natural frequency at "
-                            + ", ".join(f"{fn[i]:.2f}" for i in order) + " Hz (damping "
-                            + ", ".join(f"{100 * fits[i]['zeta']:.1f}" for i in order) + " %) from the lowest to "
-                            f"the highest level; the level dependence lies at {where}. Not a SATMD rig: no SATMD "
-                            "element is named (a Duffing-like stiffness fits this pattern)")})
+        findings.append(NonlinearFinding(
+            UNEXPLAINED_NL, character=character, modes=modes,
+            equivalent_linear={"f_n_hz": fn, "zeta": [m["zeta"] for m in fits], "peak_hz": peaks},
+            explanation=(f"{character} at the resonance: a one-mode fit per level puts the natural frequency at "
+                         + ", ".join(f"{fn[i]:.2f}" for i in order) + " Hz (damping "
+                         + ", ".join(f"{100 * fits[i]['zeta']:.1f}" for i in order) + " %) from the lowest to "
+                         f"the highest level; the level dependence lies at {where}. Not a SATMD rig: no SATMD "
+                         "element is named (a Duffing-like stiffness fits this pattern)")))
     elif detected:
-        findings.append({"name": UNEXPLAINED_NL, "parameters": {}, "ci95": {}, "equivalent": [],
-                         "equivalent_linear": {}, "explanation": _hint(min(tests, key=lambda t: t.p_value))})
+        findings.append(NonlinearFinding(UNEXPLAINED_NL, explanation=_hint(min(tests, key=lambda t: t.p_value))))
         experiments.append(EXPERIMENT_LEVEL)
     return NonlinearReport(detected, tests, findings, experiments, list(levels))

@@ -12,6 +12,7 @@ from __future__ import annotations
 from dataclasses import replace
 
 from ..modal import follow_modes
+from .findings import NonlinearFinding
 from .nonlinear import UNEXPLAINED_NL
 
 MODES_ALPHA = 0.05  # family-wise level of the trend tests once a test has detected a level dependence
@@ -53,7 +54,7 @@ def modal_finding(datas, levels, unit: str | None = None, alpha: float = 0.05) -
 
     Returns
     -------
-    (dict, list)
+    (NonlinearFinding, list)
         The finding and ``[[lo, hi], ...]`` Hz around each resonance that moves.
     """
     dofs = [float(d.estimator["noise_dof"]) for d in datas if d.estimator.get("noise_dof")]
@@ -105,9 +106,8 @@ def unexplained_by_modes(report, datas, unit: str | None = None):
                    detected=any(t.significant for t in tests) or bool(finding.get("modes")))
 
 
-def _finding(modes, explanation) -> dict:
-    return {"name": UNEXPLAINED_NL, "parameters": {}, "ci95": {}, "equivalent": [], "equivalent_linear": {},
-            "modes": modes, "explanation": explanation}
+def _finding(modes, explanation) -> NonlinearFinding:
+    return NonlinearFinding(UNEXPLAINED_NL, modes=modes, explanation=explanation)
 
 
 def _span(levels, unit) -> str:

@@ -201,3 +201,16 @@ def test_sweeps_at_several_levels_are_judged_not_refused():
     assert tests["distortion#1"]["p_value"] is None and "sweep" in tests["distortion#1"]["not_run"]
     assert tests["level_dependence"]["p_value"] is not None
     assert doc["nonlinear"]["detected"] is False and doc["effects"] == []
+
+
+def test_nonlinear_findings_are_typed_and_read_as_their_json():
+    """Nonlinear findings are typed (issue 36: untyped dicts beside the typed EffectFinding), read by their JSON
+    keys as before, and their JSON leaves out what a finding does not have."""
+    from satmd.discovery.findings import NonlinearFinding
+
+    f = NonlinearFinding("nonlinear_unexplained", modes=[{"trend": "softening"}], explanation="x")
+    assert f.modes == f["modes"] == f.get("modes") and "character" not in f and f.get("character") is None
+    assert f.to_dict() == {"name": "nonlinear_unexplained", "parameters": {}, "ci95": {}, "equivalent": [],
+                           "equivalent_linear": {}, "modes": [{"trend": "softening"}], "explanation": "x"}
+    with pytest.raises(KeyError):
+        f["moving"]
