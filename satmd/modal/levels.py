@@ -36,25 +36,30 @@ def determined(mode: Mode) -> bool:
             and mode.zeta - Z95 * mode.zeta_std > 0 and Z95 * mode.f_std < MAX_MOVE * mode.f_hz)
 
 
-def reach(f_hz: float, zeta: float, others) -> float:
+def reach(f_hz: float, zeta: float, others, steps: int = 1) -> float:
     """How far (Hz) a resonance at ``f_hz`` may move or split between levels and still be itself: its
     half-power width, or farther, `MOVE_SHARE` of the distance to the nearest other mode (``others``, Hz)
-    and at most `MAX_MOVE` of its frequency."""
+    and at most `MAX_MOVE` of its frequency per level ``steps`` apart."""
     gaps = [abs(g - f_hz) for g in others if g != f_hz]
-    return max(2.0 * zeta * f_hz, min([MOVE_SHARE * g for g in gaps] + [MAX_MOVE * f_hz]))
+    return max(2.0 * zeta * f_hz, min([MOVE_SHARE * g for g in gaps] + [MAX_MOVE * f_hz * steps]))
 
 
 def mode_set(fits) -> list:
     """[(f_hz, zeta), ...]: the determined modes of ``fits`` (lowest level first) that are not another's."""
+    return [(f, z) for f, z, _ in mode_origins(fits)]
+
+
+def mode_origins(fits) -> list:
+    """`mode_set` with the index in ``fits`` of the fit each mode was taken from: [(f_hz, zeta, index), ...]."""
     out: list = []
-    for fit in fits:
+    for j, fit in enumerate(fits):
         new = []
         for m in fit.modes:
             if not determined(m):
                 continue
-            fs = [f for f, _ in out]
-            if all(abs(m.f_hz - f) > reach(f, z, fs) for f, z in out):
-                new.append((m.f_hz, m.zeta))
+            fs = [f for f, _, _ in out]
+            if all(abs(m.f_hz - f) > reach(f, z, fs) for f, z, _ in out):
+                new.append((m.f_hz, m.zeta, j))
         out += new
     return sorted(out)
 
@@ -114,23 +119,29 @@ def follow_modes(freq_hz, frfs, stds=None, levels=None, alpha: float = 0.05, ban
     stds, dof = [p[0] for p in pairs], (pairs[0][1] if pairs else dof)
     order = list(np.argsort(levels, kind="stable")) if levels is not None else list(range(n))
     fits = [fit_modes(freq_hz, frfs[i], stds[i], band) for i in order]
-    current = mode_set(fits)
-    if not current:
+    origins = mode_origins(fits)
+    if not origins:
         return []
+    current = [(f, z) for f, z, _ in origins]
+    # a pole taken at a higher level (lightly damped, it was determined only there) is first met at a lower
+    # one it may lie several levels' moves from: its reach counts the levels between (`reach`'s steps)
+    since = [j for _, _, j in origins]
     per_level: dict = {}
-    for i in order:
+    for p, i in enumerate(order):
         fit = fit_modes(freq_hz, frfs[i], stds[i], band, start=current)
-        got = assign(fit.modes, current)
+        got = assign(fit.modes, current, [max(1, abs(j - p)) for j in since])
         per_level[i] = got
+        since = [p if m is not None and determined(m) else j for m, j in zip(got, since)]
         current = [(m.f_hz, m.zeta) if m is not None and determined(m) else c for m, c in zip(got, current)]
     tracks = [[per_level[i][k] for i in range(n)] for k in range(len(current))]
     kept = [t for t in tracks if all(m is not None and np.isfinite(m.f_std) and np.isfinite(m.zeta_std) for m in t)]
     return read_trends(kept, levels, alpha, dof if any(s is not None for s in stds) else None)
 
 
-def assign(modes, start) -> list:
+def assign(modes, start, steps=None) -> list:
     """The fitted ``modes`` in the order of the poles ``start`` they were started from (None for a pole the
-    fit dropped): the pairing nearest in frequency overall, each within the start's `reach`."""
+    fit dropped): the pairing nearest in frequency overall, each within the start's `reach` (over its
+    ``steps`` levels, one each by default)."""
     from scipy.optimize import linear_sum_assignment
 
     out: list = [None] * len(start)
@@ -140,6 +151,6 @@ def assign(modes, start) -> list:
     cost = np.array([[(m.f_hz - f) ** 2 for m in modes] for f, _ in start])
     for a, b in zip(*linear_sum_assignment(cost)):
         f, z = start[a]
-        if abs(modes[b].f_hz - f) <= reach(f, z, fs):
+        if abs(modes[b].f_hz - f) <= reach(f, z, fs, steps[a] if steps is not None else 1):
             out[a] = modes[b]
     return out

@@ -15,7 +15,7 @@ def test_the_finding_names_the_resonance_the_slipping_joint_moves_and_puts_its_b
     freq, frfs, stds, levels, target = simulated_levels("friction_chain4")
     datas = [FRFData(freq, h, s) for h, s in zip(frfs, stds)]
     finding, bands = modal_finding(datas, list(levels), "N RMS")
-    doc = json.loads(json.dumps(finding, allow_nan=False))  # every number finite
+    doc = json.loads(json.dumps(finding.to_dict(), allow_nan=False))  # every number finite
     assert doc["name"] == "nonlinear_unexplained" and NOT_SATMD in doc["explanation"]
     (mode,) = [m for m in doc["modes"] if abs(m["f_hz"][0] / target - 1) < 0.02]
     assert (mode["trend"], mode["damping_trend"]) == ("softening", "rising")
