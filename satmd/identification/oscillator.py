@@ -45,10 +45,11 @@ class OscillatorFit:
     ----------
     model, linear : PolynomialOscillator
         The nonlinear fit and the linear output-error fit it started from.
-    values, ci95 : dict
+    values, half_width95 : dict
         Physical parameters of ``model`` (k, c, k2, k3, gain, delay, output_offset, feedthrough,
         natural_frequency_hz, damping_ratio) and the half-widths of their 95 % intervals (from the
-        Jacobian; the residual's colour is ignored, so on real data they are optimistic).
+        Jacobian; the residual's colour is ignored, so on real data they are optimistic); ``ci95``
+        gives the intervals as {name: [lo, hi]}, as every other result does.
     fs : float
         Sampling frequency [Hz].
     rms_fit, rms_fit_linear : float
@@ -64,7 +65,7 @@ class OscillatorFit:
     model: PolynomialOscillator
     linear: PolynomialOscillator
     values: dict
-    ci95: dict
+    half_width95: dict
     fs: float
     rms_fit: float
     rms_fit_linear: float
@@ -72,6 +73,11 @@ class OscillatorFit:
     nfev: int
     seconds: float
     options: dict = field(default_factory=dict)
+
+    @property
+    def ci95(self) -> dict:
+        """{name: [lo, hi]}: the 95 % intervals."""
+        return {k: [self.values[k] - h, self.values[k] + h] for k, h in self.half_width95.items()}
 
     def predict(self, u, linear=False, segmented=False):
         """Simulate the fitted (or the linear) model on a new input record from rest.
@@ -98,7 +104,7 @@ class OscillatorFit:
     def to_dict(self) -> dict:
         """JSON-ready summary."""
         return {"model": self.model.to_dict(), "linear": self.linear.to_dict(), "values": dict(self.values),
-                "ci95": dict(self.ci95), "fs": self.fs, "rms_fit": self.rms_fit,
+                "ci95": self.ci95, "half_width95": dict(self.half_width95), "fs": self.fs, "rms_fit": self.rms_fit,
                 "rms_fit_linear": self.rms_fit_linear, "n_samples": self.n_samples, "nfev": self.nfev,
                 "seconds": self.seconds, "options": dict(self.options)}
 
@@ -107,7 +113,7 @@ class OscillatorFit:
         lines = [f"oscillator fit: {self.n_samples} samples, {self.nfev} simulations, {self.seconds:.1f} s",
                  f"  rms error on the fitted samples: linear {self.rms_fit_linear:.4g}, "
                  f"nonlinear {self.rms_fit:.4g}"]
-        lines += [f"  {k:>22s} = {v:.6g}" + (f" ± {self.ci95[k]:.2g}" if k in self.ci95 else "")
+        lines += [f"  {k:>22s} = {v:.6g}" + (f" ± {self.half_width95[k]:.2g}" if k in self.half_width95 else "")
                   for k, v in self.values.items()]
         return "\n".join(lines)
 
@@ -353,7 +359,7 @@ def fit_oscillator(u, y, fs, ranges=None, *, delay=True, feedthrough=False, quad
     linear = prob.oscillator(r_lin.x, lin_names)
     model = prob.oscillator(r_nl.x, nl_names)
     return OscillatorFit(
-        model=model, linear=linear, values=_physical(prob, r_nl.x, nl_names), ci95=_intervals(prob, r_nl, nl_names),
+        model=model, linear=linear, values=_physical(prob, r_nl.x, nl_names), half_width95=_intervals(prob, r_nl, nl_names),
         fs=float(fs), rms_fit=float(np.sqrt(2 * r_nl.cost / r_nl.fun.size)) * prob.sy,
         rms_fit_linear=float(np.sqrt(2 * r_lin.cost / r_lin.fun.size)) * prob.sy, n_samples=prob.n_scored,
         nfev=nfev, seconds=time.perf_counter() - t0,

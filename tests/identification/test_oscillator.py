@@ -84,8 +84,10 @@ def test_fit_recovers_k3_within_its_interval():
     fit = fit_oscillator(u, y, FS, delay=False, substeps=4)
     assert time.perf_counter() - t0 < 20.0
     for name in ("k3", "k2", "k"):
-        assert abs(fit.values[name] - getattr(truth, name)) < fit.ci95[name], name
-    assert fit.ci95["k3"] < 0.05 * truth.k3
+        assert abs(fit.values[name] - getattr(truth, name)) < fit.half_width95[name], name
+        lo, hi = fit.ci95[name]  # spelt [lo, hi] as every result's ci95
+        assert lo < fit.values[name] < hi and hi - lo == pytest.approx(2 * fit.half_width95[name])
+    assert fit.half_width95["k3"] < 0.05 * truth.k3
     assert fit.rms_fit < 0.2 * fit.rms_fit_linear
     d = fit.to_dict()
     assert d["model"]["k3"] == fit.model.k3 and "k3" in fit.report()
