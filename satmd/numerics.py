@@ -129,3 +129,17 @@ def batched_least_squares(residuals, x0, bounds, max_nfev: int, steps=None, rel_
     opts = {"xtol": 1e-10, "ftol": 1e-10, **tolerances}
     sol = least_squares(fun, x0, jac=jac, bounds=bounds, method="trf", x_scale="jac", max_nfev=max_nfev, **opts)
     return sol, jac
+
+
+def force_level(force) -> float:
+    """The drive level of a recording: the force's RMS about its mean (a load cell's offset is no drive).
+
+    Parameters
+    ----------
+    force : samples.
+
+    Returns
+    -------
+    float
+    """
+    return float(np.std(np.asarray(force, float)))

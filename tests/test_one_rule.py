@@ -49,3 +49,20 @@ def test_the_band_scan_is_written_once():
     windowing = re.compile(r"np\.convolve\([^)]*np\.ones\(w\)")
     where = sorted(str(p.relative_to(SRC.parent)) for p in SRC.rglob("*.py") if windowing.search(p.read_text()))
     assert where == ["satmd/discovery/locate.py"], where
+
+
+def test_a_recordings_drive_level_is_read_one_way():
+    """"Level" was the force's std in one place and its RMS in another (issue 36): `numerics.force_level`."""
+    level = re.compile(r"np\.(std|sqrt\(np\.mean)\(.*\[\"force\"\]")
+    # satmd/io/timesim.py scales its simulated force to the RMS it is asked for: a setting, not a reading
+    found = [f"{p.relative_to(SRC.parent)}:{i}" for p in SRC.rglob("*.py") if p.name not in ("numerics.py", "timesim.py")
+             for i, line in enumerate(p.read_text().splitlines(), 1) if level.search(line)]
+    assert not found, f"a drive level read by hand (use satmd.numerics.force_level): {found}"
+
+
+def test_one_output_error_fitter():
+    """The time-domain fits share `numerics.batched_least_squares` (issue 36: two fitters, each its own
+    finite differences)."""
+    for name in ("identification/nonlinear.py", "identification/oscillator.py"):
+        text = (SRC / name).read_text()
+        assert "batched_least_squares(" in text and "np.eye(x.size)" not in text, name

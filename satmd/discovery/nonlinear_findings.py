@@ -9,6 +9,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..numerics import force_level
+
 from ..conventions import ACCEL_CHANNELS, DEFAULT_FREE, MIN_DELTA_BIC, TINY
 from .nonlinear import (
     EXPERIMENT_LEVEL,
@@ -44,7 +46,7 @@ def regressor_hint(regressor: str) -> str | None:
 
 def force_levels(recordings) -> list:
     """RMS of each recording's force (the level figure the findings are read against)."""
-    return [float(np.std(r["force"])) for r in recordings]
+    return [force_level(r["force"]) for r in recordings]
 
 
 def _distortion_tests(recordings, alpha):

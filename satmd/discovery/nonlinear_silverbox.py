@@ -17,6 +17,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..numerics import force_level
+
 from ..io.recdata import Recording
 from ..io.silverbox import load_silverbox_level, load_silverbox_snls, silverbox_levels
 from .nonlinear_findings import analyse_generic
@@ -49,7 +51,7 @@ def ladder_report(directory, alpha: float = 1e-3):
         stds.append({"y": bla["std"]})
         t = detection_lines_test(u, y, lines, rec.fs_hz, alpha=alpha / len(levels), name=f"distortion_lines@{level}")
         tests.append(t)
-        rms.append(float(np.std(rec["force"])))
+        rms.append(force_level(rec["force"]))
     return analyse_generic(frfs, stds, freq, rms, tests, alpha)
 
 
@@ -80,7 +82,7 @@ def snls_report(directory, alpha: float = 1e-3):
     idx = [np.searchsorted(np.round(e.freq_hz, 9), freq) for e in ests]
     frfs = [{"y": e.frf["a1"][i]} for e, i in zip(ests, idx)]
     stds = [{"y": e.std["a1"][i]} for e, i in zip(ests, idx)]
-    levels = [float(np.std(p["force"])) for p in parts]
+    levels = [force_level(p["force"]) for p in parts]
     test = _multisine_distortion(ms, band, alpha / 2)
     return analyse_generic(frfs, stds, freq, levels, [test], alpha / 2)
 

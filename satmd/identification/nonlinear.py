@@ -26,7 +26,7 @@ import numpy as np
 from ..conventions import ACCEL_CHANNELS, DEFAULT_FREE
 from ..errors import DataError
 from ..io.estimate import estimate_frf
-from ..numerics import batched_least_squares
+from ..numerics import batched_least_squares, force_level
 from ..io.recording import Recording
 from ..physics import Rig, integrate
 from ..physics.nonlinear import NONLINEAR, NonlinearElement, element as make_element, response_rms
@@ -69,7 +69,7 @@ def prepare(rec, seconds=None, band_hz=None) -> dict:
     out_band = ((f > 2.0) & (f < band_hz[0] / 1.35)) | ((f > 1.35 * band_hz[1]) & (f < 0.95 * fs / 2))
     noise_var = float(np.mean(np.abs(spec[out_band]) ** 2) / n) if np.count_nonzero(out_band) > 32 else 0.0
     return {"force": band_limit(F, fs, band_hz), "acc": np.vstack([rec["acc1"][:n], rec["acc2"][:n]]), "fs": fs,
-            "level": float(np.sqrt(np.mean(np.asarray(rec["force"], float) ** 2))), "band": tuple(band_hz),
+            "level": force_level(rec["force"]), "band": tuple(band_hz),
             "force_noise_var": noise_var}
 
 
@@ -137,7 +137,7 @@ def _residuals(sims, data, weights, skip) -> np.ndarray:
 
 def linear_start(recordings, rig) -> Rig:
     """m2, kp, R, L from `identify` (global search) on the H1 FRF of the lowest-level recording."""
-    rec = min(recordings, key=lambda r: float(np.std(r["force"])))
+    rec = min(recordings, key=lambda r: force_level(r["force"]))
     fs = float(rec.fs_hz)
     data = estimate_frf(rec, estimator="H1", nperseg=int(min(rec.n_samples // 4, 8 * fs)))
     fit = identify(data.band(30.0, 160.0), rig=rig, warn=False)

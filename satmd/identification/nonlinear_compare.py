@@ -11,6 +11,8 @@ from __future__ import annotations
 from ..conventions import TINY
 
 import numpy as np
+
+from ..numerics import force_level
 from scipy.signal import csd, welch
 
 from .nonlinear import fit_nonlinear, predict, prepare
@@ -84,7 +86,7 @@ def compare_models(train, held_out, element, seconds: float | None = 30.0, best_
     linears = {"all training levels": lin}
     if best_linear and len(train) > 1:
         for i, rec in enumerate(train):
-            lev = float(np.sqrt(np.mean(np.asarray(rec["force"]) ** 2)))
+            lev = force_level(rec["force"])
             linears[f"level {lev:.3g} N"] = fit_nonlinear([rec], None, seconds=seconds, start=nl.rig, **fit_options)
     rows = []
     for held, recs in ((False, train), (True, held_out)):
@@ -93,7 +95,7 @@ def compare_models(train, held_out, element, seconds: float | None = 30.0, best_
             preds = {k: predict(f, rec, seconds) for k, f in linears.items()}
             best = min(preds, key=lambda k: preds[k]["rel_error_excited"]["both"])
             p_lin = preds[best]
-            row = {"level": float(np.sqrt(np.mean(np.asarray(rec["force"]) ** 2))), "held_out": held,
+            row = {"level": force_level(rec["force"]), "held_out": held,
                    "linear_model": best, "band_hz": p_nl["band_hz"]}
             for key, pkey in (("", "rel_error_excited"), ("_band", "rel_error_band"), ("_broadband", "rel_error")):
                 row["td_error" + key] = {"linear": p_lin[pkey]["both"], "nonlinear": p_nl[pkey]["both"]}

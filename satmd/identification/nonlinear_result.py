@@ -22,7 +22,7 @@ class NonlinearFit:
     values : {name: value} of every fitted parameter (rig fields and the element's, by name).
     std : {name: standard deviation} (sandwich covariance: residual colour allowed).
     ci95 : {name: [lo, hi]} 95 % intervals.
-    levels : force RMS [N] of each recording, in the order given.
+    levels : drive level [N] of each recording (`numerics.force_level`: RMS about the mean), in the order given.
     rel_error : RMS over recordings and channels of RMS(residual) / RMS(measured) after the fit (one
         figure, as `FitResult.rel_error`).
     rel_error_per_level : {level index: {"a1", "a2"}: RMS(residual) / RMS(measured)}.
