@@ -21,11 +21,11 @@ from .effects import (
     ShuntCapacitance,
     StructuralDamping,
     TimeDelay,
-    effect,
     register,
     registered_names,
     unregister,
 )
+from ..errors import DataError
 from .model import CHANNELS, STATES, Response, frf, parameter_names, solve, terms
 from .rig import PAPER_GRID_HZ, PARAMETER_INFO, Rig
 from .nonlinear import (
@@ -43,6 +43,31 @@ from .nonlinear import (
     unregister_nonlinear,
 )
 from .nonlinear import element as nonlinear_element
+from .effects import effect as _linear_effect
+
+
+def effect(name: str, **parameters):
+    """Build a missing-physics effect (SPEC §8) or a nonlinear element (SPEC §8b) by its name: one factory.
+
+    Parameters
+    ----------
+    name : a name from `registered_names` (``parameter_offset:<p>`` for offsets) or from `nonlinear_names`.
+    **parameters : values of its parameters (defaults fill the rest).
+
+    Returns
+    -------
+    Effect
+        A `NonlinearElement` for an element's name (it acts in the time domain: `integrate`, or
+        ``simulate(time=True, nonlinear=[...])``; `frf` refuses it).
+    """
+    if name in NONLINEAR:
+        return nonlinear_element(name, **parameters)
+    try:
+        return _linear_effect(name, **parameters)
+    except DataError as exc:
+        if str(exc).startswith(f"unknown effect {name!r}"):
+            raise DataError(f"{exc}; nonlinear elements: {', '.join(NONLINEAR)}") from None
+        raise
 
 __all__ = [
     "CHANNELS", "STATES", "OFFSET_PARAMETERS", "VOCABULARY", "VOCABULARY_NAMES", "PAPER_GRID_HZ",

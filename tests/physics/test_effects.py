@@ -255,3 +255,19 @@ def test_rig_validate_accepts_the_paper_rig_and_zero_losses():
     Rig(R=np.linspace(0, 100, 5)).validate()
     with pytest.raises(ValueError):
         Rig().replace(nope=1.0)
+
+
+def test_one_factory_builds_effects_and_nonlinear_elements():
+    """`effect` builds either vocabulary (issue 36: three factories for one concept); `frf` refuses an element."""
+    import numpy as np
+
+    from satmd import effect, frf
+    from satmd.errors import DataError
+    from satmd.physics import NonlinearElement, Rig
+
+    assert isinstance(effect("cubic_absorber_spring", k3=2e9), NonlinearElement)
+    assert effect("time_delay", tau_s=1e-4).name == "time_delay"
+    with pytest.raises(DataError, match="nonlinear elements: cubic_absorber_spring"):
+        effect("bogus")
+    with pytest.raises(DataError, match="acts in the time domain"):
+        frf(np.linspace(20.0, 200.0, 5), Rig(), effects=[effect("quadratic_damping", c2=10.0)])
