@@ -180,7 +180,7 @@ def linearity_test(force, responses: dict, fs_hz: float, regressors: dict, band=
     X = np.fft.rfft(np.asarray(force, float) - np.mean(force))
     Z = np.stack([np.fft.rfft(z - z.mean()) for z in regressors.values()], axis=1) if regressors else None
     df = fs_hz / n
-    lo, hi = band if band is not None else _power_band(X, df)
+    lo, hi = band if band is not None else _excited(force, fs_hz)
     nz = 0 if Z is None else Z.shape[1]
     p_h = 2 * (degree + 1)
     width = max(window_bins, 2 * (p_h + nz) + 1)
@@ -267,14 +267,12 @@ def _rss(K, Y):
     return np.sum(np.abs(Y - proj) ** 2, axis=1)
 
 
-def _power_band(X, df, drop_db=20.0):
-    """(lo, hi) Hz where the smoothed input power is within ``drop_db`` of its 95th percentile."""
-    p = np.abs(X) ** 2
-    k = max(1, int(round(1.0 / df)))
-    sm = np.convolve(p, np.ones(k) / k, mode="same")
-    sm[0] = 0.0
-    on = np.flatnonzero(sm > np.percentile(sm[1:], 95) * 10 ** (-drop_db / 10))
-    return (on[0] + k) * df, (on[-1] - k) * df
+def _excited(force, fs_hz) -> tuple:
+    """(lo, hi) Hz the force excites: the one rule (`satmd.io.lpm.excited_band`)."""
+    from ..io.lpm import excited_band
+
+    lo, hi, _ = excited_band(np.asarray(force, float), fs_hz)
+    return lo, hi
 
 
 def integrate(signal, fs_hz, times: int, band):
