@@ -101,8 +101,8 @@ def test_modal_and_retune_entry_points_validate_their_arguments():
 
     f = np.linspace(10.0, 50.0, 200)
     H = {"a1": 1.0 / (20.0 ** 2 - f ** 2 + 0.4j * f)}
-    with pytest.raises(DataError, match="^fit_modes: band must be"):
-        fit_modes(f, H, band=(50.0, 10.0))
+    with pytest.raises(DataError, match="^fit_modes: band_hz must be"):
+        fit_modes(f, H, band_hz=(50.0, 10.0))
     with pytest.raises(DataError, match="^fit_modes: n_modes must be"):
         fit_modes(f, H, n_modes=0)
     with pytest.raises(DataError, match="^follow_modes: alpha must be"):

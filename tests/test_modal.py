@@ -74,7 +74,7 @@ def test_noisy_data_close_modes_and_intervals_that_hold_the_truth():
 def test_a_mode_at_the_band_edge():
     truth = [(20.0, 0.01, -1e-3j, -1e-3j), (39.6, 0.01, -1e-3j, 0.5e-3j)]
     H = modal_frf(FREQ, truth)
-    fit = fit_modes(FREQ, H, band=(10.0, 39.8))  # the second peak's upper flank is cut off
+    fit = fit_modes(FREQ, H, band_hz=(10.0, 39.8))  # the second peak's upper flank is cut off
     assert [round(m.f_hz, 4) for m in fit.modes] == [20.0, 39.6]
     assert fit.modes[1].zeta == pytest.approx(0.01, rel=1e-3)
 

@@ -103,9 +103,9 @@ class ModalFit:
                 "weighted": self.weighted, "modes": [m.to_dict() for m in self.modes]}
 
 
-@validate_params({"band": [None, Band()], "n_modes": [None, Interval(Whole, 1)],
+@validate_params({"band_hz": [None, Band()], "n_modes": [None, Interval(Whole, 1)],
                   "max_order": [None, Interval(Whole, 2)]})
-def fit_modes(freq_hz, frf, std=None, band=None, n_modes=None, max_order=None, start=None) -> ModalFit:
+def fit_modes(freq_hz, frf, std=None, band_hz=None, n_modes=None, max_order=None, start=None) -> ModalFit:
     """Natural frequencies and damping ratios of every mode in a band, with 95 % intervals.
 
     Parameters
@@ -113,7 +113,7 @@ def fit_modes(freq_hz, frf, std=None, band=None, n_modes=None, max_order=None, s
     freq_hz : (M,) Hz, increasing (None: the grid of an FRFData ``frf``)
     frf : {channel: (M,) complex} or FRFData; the channels share their poles
     std : {channel: (M,) std of the real and imaginary parts}, or None (FRFData: its std)
-    band : (lo, hi) Hz to fit (default: all of ``freq_hz``)
+    band_hz : (lo, hi) Hz to fit (default: all of ``freq_hz``)
     n_modes : keep the strongest ``n_modes`` of the modes found, without the BIC test (default: those BIC keeps)
     max_order : highest denominator order of the pole search (default 60, fewer for short data)
     start : [(f_hz, zeta), ...] poles to refine instead of searching (e.g. another level's modes); every one
@@ -123,7 +123,7 @@ def fit_modes(freq_hz, frf, std=None, band=None, n_modes=None, max_order=None, s
     -------
     ModalFit
     """
-    freq, names, H, S, weighted = _inputs(freq_hz, frf, std, band)
+    freq, names, H, S, weighted = _inputs(freq_hz, frf, std, band_hz)
     w = 2 * np.pi * freq
     band_hz = (float(freq[0]), float(freq[-1]))
     order = int(min(max_order or DEFAULT_MAX_ORDER, freq.size - 2))

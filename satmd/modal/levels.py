@@ -86,9 +86,9 @@ def smoothed_std(std, dof):
     return out, dof * n
 
 
-@validate_params({"alpha": [Interval(Real, 0, 1, open="both")], "band": [None, Band()],
+@validate_params({"alpha": [Interval(Real, 0, 1, open="both")], "band_hz": [None, Band()],
                   "dof": [None, Interval(Real, 0, open="lo")]})
-def follow_modes(freq_hz, frfs, stds=None, levels=None, alpha: float = 0.05, band=None, dof=None) -> list:
+def follow_modes(freq_hz, frfs, stds=None, levels=None, alpha: float = 0.05, band_hz=None, dof=None) -> list:
     """The modes of several levels of one structure, fitted from one set level by level, and their trends.
 
     Parameters
@@ -98,7 +98,7 @@ def follow_modes(freq_hz, frfs, stds=None, levels=None, alpha: float = 0.05, ban
     stds : per level {channel: (M,) std} or None
     levels : one level figure per FRF (default: the order given is increasing)
     alpha : family-wise level of the trend tests (Bonferroni over modes and both quantities)
-    band : (lo, hi) Hz to fit (default: all of ``freq_hz``)
+    band_hz : (lo, hi) Hz to fit (default: all of ``freq_hz``)
     dof : degrees of freedom of ``stds`` (None: many); below `MIN_STD_DOF` their variances are averaged
         over neighbouring lines (`smoothed_std`) and the trend tests read Student's t at the degrees of
         freedom that gives
@@ -118,7 +118,7 @@ def follow_modes(freq_hz, frfs, stds=None, levels=None, alpha: float = 0.05, ban
     pairs = [smoothed_std(s, dof) for s in stds]
     stds, dof = [p[0] for p in pairs], (pairs[0][1] if pairs else dof)
     order = list(np.argsort(levels, kind="stable")) if levels is not None else list(range(n))
-    fits = [fit_modes(freq_hz, frfs[i], stds[i], band) for i in order]
+    fits = [fit_modes(freq_hz, frfs[i], stds[i], band_hz) for i in order]
     origins = mode_origins(fits)
     if not origins:
         return []
@@ -128,7 +128,7 @@ def follow_modes(freq_hz, frfs, stds=None, levels=None, alpha: float = 0.05, ban
     since = [j for _, _, j in origins]
     per_level: dict = {}
     for p, i in enumerate(order):
-        fit = fit_modes(freq_hz, frfs[i], stds[i], band, start=current)
+        fit = fit_modes(freq_hz, frfs[i], stds[i], band_hz, start=current)
         got = assign(fit.modes, current, [max(1, abs(j - p)) for j in since])
         per_level[i] = got
         since = [p if m is not None and determined(m) else j for m, j in zip(got, since)]
