@@ -50,7 +50,7 @@ class OscillatorFit:
         natural_frequency_hz, damping_ratio) and the half-widths of their 95 % intervals (from the
         Jacobian; the residual's colour is ignored, so on real data they are optimistic); ``ci95``
         gives the intervals as {name: [lo, hi]}, as every other result does.
-    fs : float
+    fs_hz : float
         Sampling frequency [Hz].
     rms_fit, rms_fit_linear : float
         RMS output error on the fitted samples (nonlinear, linear).
@@ -66,7 +66,7 @@ class OscillatorFit:
     linear: PolynomialOscillator
     values: dict
     half_width95: dict
-    fs: float
+    fs_hz: float
     rms_fit: float
     rms_fit_linear: float
     n_samples: int
@@ -98,13 +98,13 @@ class OscillatorFit:
         """
         m = self.linear if linear else self.model
         seg = {"warmup": 4 * self.options["warmup"], "length": 4 * self.options["segment"]} if segmented else {}
-        return m.simulate(u, self.fs, substeps=self.options["substeps"], intersample=self.options["intersample"],
+        return m.simulate(u, self.fs_hz, substeps=self.options["substeps"], intersample=self.options["intersample"],
                           **seg)
 
     def to_dict(self) -> dict:
         """JSON-ready summary."""
         return {"model": self.model.to_dict(), "linear": self.linear.to_dict(), "values": dict(self.values),
-                "ci95": self.ci95, "half_width95": dict(self.half_width95), "fs": self.fs, "rms_fit": self.rms_fit,
+                "ci95": self.ci95, "half_width95": dict(self.half_width95), "fs_hz": self.fs_hz, "rms_fit": self.rms_fit,
                 "rms_fit_linear": self.rms_fit_linear, "n_samples": self.n_samples, "nfev": self.nfev,
                 "seconds": self.seconds, "options": dict(self.options)}
 
@@ -139,14 +139,14 @@ def rms_error(y_model, y, lo=0, hi=None):
     return {"rms": rms, "pct": 100.0 * rms / ref, "n": int(e.size)}
 
 
-def frf_start(u, y, fs, nperseg=1024):
+def frf_start(u, y, fs_hz, nperseg=1024):
     """Second-order start G0·ω²·e^(−sτ)/(s² + 2ζωs + ω²) fitted to the H1 FRF estimate.
 
     Parameters
     ----------
     u, y : numpy.ndarray
         Input and output records.
-    fs : float
+    fs_hz : float
         Sampling frequency [Hz].
     nperseg : int
         Welch segment length.
@@ -157,11 +157,11 @@ def frf_start(u, y, fs, nperseg=1024):
         ``wn`` [rad/s], ``zeta``, ``gain`` (static gain y/u), ``delay`` [samples].
     """
     nper = int(min(nperseg, max(64, u.size // 8)))
-    f, puu = signal.welch(u, fs, nperseg=nper)
-    _, puy = signal.csd(u, y, fs, nperseg=nper)
-    _, coh = signal.coherence(u, y, fs, nperseg=nper)
+    f, puu = signal.welch(u, fs_hz, nperseg=nper)
+    _, puy = signal.csd(u, y, fs_hz, nperseg=nper)
+    _, coh = signal.coherence(u, y, fs_hz, nperseg=nper)
     h = puy / np.where(puu > 0, puu, np.inf)
-    keep = (f > 0) & (coh > 0.5) & (f < 0.45 * fs) & np.isfinite(h)
+    keep = (f > 0) & (coh > 0.5) & (f < 0.45 * fs_hz) & np.isfinite(h)
     if keep.sum() < 6:
         raise DataError("too few coherent frequencies to start the oscillator fit (input too narrow or too noisy)")
     f, h = f[keep], h[keep]
@@ -170,7 +170,7 @@ def frf_start(u, y, fs, nperseg=1024):
 
     def model(p):
         wn, z, g0, tau = p
-        return g0 * wn * wn * np.exp(-s * tau / fs) / (s * s + 2 * z * wn * s + wn * wn)
+        return g0 * wn * wn * np.exp(-s * tau / fs_hz) / (s * s + 2 * z * wn * s + wn * wn)
 
     def res(p):
         r = (model(p) - h) / np.abs(h)
@@ -289,7 +289,7 @@ def _intervals(problem, r, names):
     return {key: float(T95 * np.sqrt(max(v, 0.0))) for key, v in zip(base, var)}
 
 
-def fit_oscillator(u, y, fs, ranges=None, *, delay=True, feedthrough=False, quadratic=True, lag=False,
+def fit_oscillator(u, y, fs_hz, ranges=None, *, delay=True, feedthrough=False, quadratic=True, lag=False,
                    substeps=6, intersample="bandlimited", warmup=None, segment=None, max_nfev=60):
     """Fit ÿ + cẏ + ky + k2y² + k3y³ = g·u(t − τ) (+ y0, d·u) to a record by simulation output error.
 
@@ -297,7 +297,7 @@ def fit_oscillator(u, y, fs, ranges=None, *, delay=True, feedthrough=False, quad
     ----------
     u, y : array_like, shape (n,)
         Input and output records (one channel each, same length).
-    fs : float
+    fs_hz : float
         Sampling frequency [Hz].
     ranges : list of (int, int) or None
         Sample ranges [lo, hi) used in the fit (None: the whole record). Each range's first
@@ -328,19 +328,19 @@ def fit_oscillator(u, y, fs, ranges=None, *, delay=True, feedthrough=False, quad
         raise DataError(f"input and output must be 1-D records of the same length, got {u.shape} and {y.shape}")
     if not (np.all(np.isfinite(u)) and np.all(np.isfinite(y))):
         raise DataError("the oscillator record holds NaN or infinite samples")
-    if not fs > 0:
-        raise DataError(f"the sampling frequency must be positive, got {fs}")
+    if not fs_hz > 0:
+        raise DataError(f"the sampling frequency must be positive, got {fs_hz}")
     ranges = [(0, u.size)] if ranges is None else [(int(a), int(b)) for a, b in ranges]
     if any(not 0 <= a < b <= u.size for a, b in ranges):
         raise DataError(f"fit ranges {ranges} must lie inside the record of {u.size} samples")
     sel = np.concatenate([np.arange(a, b) for a, b in ranges])
     start = frf_start(u[ranges[0][0]:ranges[0][1]] if len(ranges) == 1 else u[sel],
-                      y[ranges[0][0]:ranges[0][1]] if len(ranges) == 1 else y[sel], fs)
+                      y[ranges[0][0]:ranges[0][1]] if len(ranges) == 1 else y[sel], fs_hz)
     if warmup is None:
-        warmup = int(np.clip(np.ceil(12 * fs / (start["zeta"] * start["wn"])), 50, 20000))
+        warmup = int(np.clip(np.ceil(12 * fs_hz / (start["zeta"] * start["wn"])), 50, 20000))
     if segment is None:
         segment = max(2 * warmup, sel.size // 64)
-    prob = _Problem(u, y, fs, ranges, start, int(substeps), intersample, int(warmup), int(segment))
+    prob = _Problem(u, y, fs_hz, ranges, start, int(substeps), intersample, int(warmup), int(segment))
     lin_names = [n for n in LINEAR if (n != "delay" or delay) and (n != "feedthrough" or feedthrough)]
     p0 = {"wn": 1.0, "zeta": start["zeta"], "gain": start["gain"] * prob.su / prob.sy, "y0": 0.0,
           "delay": min(max(start["delay"], 0.0), 5.0), "feedthrough": 0.0, "a2": 0.0, "a3": 0.0,
@@ -360,7 +360,7 @@ def fit_oscillator(u, y, fs, ranges=None, *, delay=True, feedthrough=False, quad
     model = prob.oscillator(r_nl.x, nl_names)
     return OscillatorFit(
         model=model, linear=linear, values=_physical(prob, r_nl.x, nl_names), half_width95=_intervals(prob, r_nl, nl_names),
-        fs=float(fs), rms_fit=float(np.sqrt(2 * r_nl.cost / r_nl.fun.size)) * prob.sy,
+        fs_hz=float(fs_hz), rms_fit=float(np.sqrt(2 * r_nl.cost / r_nl.fun.size)) * prob.sy,
         rms_fit_linear=float(np.sqrt(2 * r_lin.cost / r_lin.fun.size)) * prob.sy, n_samples=prob.n_scored,
         nfev=nfev, seconds=time.perf_counter() - t0,
         options={"substeps": int(substeps), "intersample": intersample, "warmup": int(warmup), "segment": int(segment)})
