@@ -159,8 +159,8 @@ def _truth_error(rec, truth, seconds):
     k = valid(n, FS, 2.0)
     ref, meas = truth[:, :n][:, k], d["acc"][:, k]
     broad = np.sqrt(np.sum((ref - meas) ** 2, axis=1) / np.sum(meas ** 2, axis=1))
-    band = band_error(ref, meas, FS, d["band"])
-    excited = excited_error(ref, meas, FS, d["band"])
+    band = band_error(ref, meas, FS, d["band_hz"])
+    excited = excited_error(ref, meas, FS, d["band_hz"])
     return {k: float(np.sqrt(np.mean(v ** 2))) for k, v in (("excited", excited), ("band", band), ("broadband", broad))}
 
 

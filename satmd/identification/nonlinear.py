@@ -68,8 +68,8 @@ def prepare(rec, seconds=None, band_hz=None) -> dict:
         band_hz = (f[on[0]], f[on[-1]])
     out_band = ((f > 2.0) & (f < band_hz[0] / 1.35)) | ((f > 1.35 * band_hz[1]) & (f < 0.95 * fs / 2))
     noise_var = float(np.mean(np.abs(spec[out_band]) ** 2) / n) if np.count_nonzero(out_band) > 32 else 0.0
-    return {"force": band_limit(F, fs, band_hz), "acc": np.vstack([rec["acc1"][:n], rec["acc2"][:n]]), "fs": fs,
-            "level": force_level(rec["force"]), "band": tuple(band_hz),
+    return {"force": band_limit(F, fs, band_hz), "acc": np.vstack([rec["acc1"][:n], rec["acc2"][:n]]), "fs_hz": fs,
+            "level": force_level(rec["force"]), "band_hz": tuple(band_hz),
             "force_noise_var": noise_var}
 
 
@@ -121,7 +121,7 @@ def simulate_batch(coords, X, data) -> list:
     rig, els = coords.decode(X)
     out = []
     for d in data:
-        r = integrate(rig, d["force"], d["fs"], els, outputs=ACCEL_CHANNELS, oversample=coords.oversample)
+        r = integrate(rig, d["force"], d["fs_hz"], els, outputs=ACCEL_CHANNELS, oversample=coords.oversample)
         out.append(np.stack([np.atleast_2d(r.a1), np.atleast_2d(r.a2)], axis=1))
     return out
 
@@ -187,10 +187,10 @@ def fit_nonlinear(recordings, element=None, rig: Rig | None = None, free=LINEAR_
     data = [prepare(r, seconds) for r in recordings]
     base = start if start is not None else linear_start(recordings, rig)
     top = max(data, key=lambda d: d["level"])
-    rms_top = {k: float(v) for k, v in response_rms(base, force=top["force"], fs_hz=top["fs"]).items()}
+    rms_top = {k: float(v) for k, v in response_rms(base, force=top["force"], fs_hz=top["fs_hz"]).items()}
     coords = _Coordinates(base, free, el, rms_top)
     coords.oversample = max(1, int(oversample)) if el is not None else 1  # no element force: nothing to hold
-    skip = [valid(d["acc"].shape[1], d["fs"], skip_s) for d in data]  # samples judged: start and end left out
+    skip = [valid(d["acc"].shape[1], d["fs_hz"], skip_s) for d in data]  # samples judged: start and end left out
     weights = [np.sqrt(np.mean(d["acc"] ** 2, axis=1)) for d in data]
     lo, hi = coords.bounds()
     x_lin = np.array([math.log(float(getattr(base, p))) for p in free])
@@ -215,7 +215,7 @@ def fit_nonlinear(recordings, element=None, rig: Rig | None = None, free=LINEAR_
     shift, cov_shift = simex_shift(coords, x0, data, weights, skip, simex, seed, simulate_batch, _residuals)
     x0 = np.clip(x0 + shift, lo, hi)
     lengths = [k.stop - k.start for k in skip]
-    cov_x = cov_shift + sandwich(J, r, [2 * m for m in lengths], lengths, lags=int(data[0]["fs"]))
+    cov_x = cov_shift + sandwich(J, r, [2 * m for m in lengths], lengths, lags=int(data[0]["fs_hz"]))
     return _result(coords, x0, cov_x, data, sims, skip, 0.5 * float(r @ r), nfev, time.perf_counter() - t0,
                    {"seconds": seconds, "skip_s": skip_s, "free": list(free), "passes": passes, "simex": simex,
                     "simex_shift": (np.asarray(shift) * np.ones(x0.size)).tolist(), "oversample": coords.oversample})
@@ -245,7 +245,7 @@ def _result(coords, x, cov_x, data, sims, skip, cost, nfev, wall, settings) -> N
     if el is not None:
         vals = []
         for d in data:
-            rms = response_rms(rig, force=d["force"], fs_hz=d["fs"])
+            rms = response_rms(rig, force=d["force"], fs_hz=d["fs_hz"])
             vals.append(float(np.ravel(el.equivalent_linear(rig, rms).value)[0]))
         eq[el.linear_parameter] = vals
     overall = float(np.sqrt(np.mean(np.square([e for per in rel.values() for e in per.values()] or [np.nan]))))
@@ -284,16 +284,16 @@ def predict(fit: NonlinearFit, recording, seconds: float | None = None, skip_s: 
     """
     d = prepare(recording, seconds)
     els = [fit.element] if fit.element is not None else []
-    r = integrate(fit.rig, d["force"], d["fs"], els, outputs=ACCEL_CHANNELS,
+    r = integrate(fit.rig, d["force"], d["fs_hz"], els, outputs=ACCEL_CHANNELS,
                   oversample=int(fit.settings.get("oversample", 1)))
-    k = valid(d["acc"].shape[1], d["fs"], skip_s)
-    out = {"a1": r.a1, "a2": r.a2, "band_hz": [float(b) for b in d["band"]], "rel_error": {}, "rel_error_band": {},
+    k = valid(d["acc"].shape[1], d["fs_hz"], skip_s)
+    out = {"a1": r.a1, "a2": r.a2, "band_hz": [float(b) for b in d["band_hz"]], "rel_error": {}, "rel_error_band": {},
            "rel_error_excited": {}}
     sim = np.vstack([r.a1, r.a2])[:, k]
     meas = d["acc"][:, k]
     broad = np.sqrt(np.sum((sim - meas) ** 2, axis=1) / np.sum(meas ** 2, axis=1))
-    band = band_error(sim, meas, d["fs"], d["band"])
-    excited = excited_error(sim, meas, d["fs"], d["band"])
+    band = band_error(sim, meas, d["fs_hz"], d["band_hz"])
+    excited = excited_error(sim, meas, d["fs_hz"], d["band_hz"])
     for key, e in (("rel_error", broad), ("rel_error_band", band), ("rel_error_excited", excited)):
         out[key] = {ch: float(e[c]) for c, ch in enumerate(ACCEL_CHANNELS)}
         out[key]["both"] = float(np.sqrt(np.mean(e ** 2)))

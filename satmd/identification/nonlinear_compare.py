@@ -44,9 +44,9 @@ def frf_residual(recording, prediction, band_hz=None, seconds=None) -> float:
     float
     """
     d = prepare(recording, seconds)
-    band = band_hz or d["band"]
-    _, meas = _h1(d["force"], d["acc"], d["fs"], band)
-    _, model = _h1(d["force"], np.vstack([prediction["a1"], prediction["a2"]]), d["fs"], band)
+    band = band_hz or d["band_hz"]
+    _, meas = _h1(d["force"], d["acc"], d["fs_hz"], band)
+    _, model = _h1(d["force"], np.vstack([prediction["a1"], prediction["a2"]]), d["fs_hz"], band)
     return float(np.linalg.norm(model - meas) / np.linalg.norm(meas))
 
 

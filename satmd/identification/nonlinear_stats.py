@@ -60,8 +60,8 @@ def simex_shift(coords, x, data, weights, skip, draws: int, seed: int = 0, simul
             noise = []
             for d in data:
                 n = d["force"].size
-                f = np.fft.rfftfreq(n, 1.0 / d["fs"])
-                spec = np.fft.rfft(rng.standard_normal(n)) * math.sqrt(d["force_noise_var"]) * band_gain(f, d["band"])
+                f = np.fft.rfftfreq(n, 1.0 / d["fs_hz"])
+                spec = np.fft.rfft(rng.standard_normal(n)) * math.sqrt(d["force_noise_var"]) * band_gain(f, d["band_hz"])
                 noise.append(np.fft.irfft(spec, n))
         sign = 1.0 if j % 2 == 0 else -1.0
         noisy = [{**d, "force": d["force"] + sign * e} for d, e in zip(data, noise)]
