@@ -189,6 +189,7 @@ def summarise(cases) -> dict:
     joint = [c for c in cases if c["rig"]["joint"]]
     nulls = [c for c in cases if not c["rig"]["joint"]]
     kinds = [e for e in ("random", "periodic", "sweep") if any(c["rig"]["excitation"] == e for c in cases)]
+    structures = [k for k in ("chain", "beam", "plate") if any(_structure(c) == k for c in joint)]
 
     def rates(sel):
         n = len(sel)
@@ -214,10 +215,29 @@ def summarise(cases) -> dict:
                           for k in LEVEL_COUNTS},
            "nulls_per_excitation": {e: null_rates([c for c in nulls if c["rig"]["excitation"] == e])
                                     for e in kinds},
+           "per_structure": {k: rates([c for c in joint if _structure(c) == k]) for k in structures},
            "nulls_per_levels": {str(k): null_rates([c for c in nulls if len(c["rig"]["levels_n_rms"]) == k])
                                 for k in LEVEL_COUNTS},
            "seconds_per_discover_median": float(np.median([c["result"]["seconds"] for c in cases])) if cases else None}
     return out
+
+
+def _structure(case) -> str:
+    """chain, beam or plate, from the rig's name (chain4, beam-ss, plate)."""
+    name = case["rig"]["name"]
+    return "chain" if name.startswith("chain") else "beam" if name.startswith("beam") else name
+
+
+def _commit() -> str | None:
+    """The satmd commit the benchmark runs (None outside a git checkout)."""
+    import subprocess
+
+    try:
+        out = subprocess.run(["git", "-C", str(ROOT), "rev-parse", "--short", "HEAD"], capture_output=True,
+                             text=True, timeout=10)
+    except (OSError, subprocess.SubprocessError):
+        return None
+    return out.stdout.strip() or None
 
 
 def merge(paths, out: Path) -> None:
@@ -269,7 +289,7 @@ def main(argv=None) -> int:
               "machine": info, "settings": {"rigs_per_joint": args.rigs, "seed0": args.seed0,
                                             "duration_s": args.duration, "fs_hz": sim.FS, "oversampling": sim.OVER,
                                             "band_hz": list(sim.BAND), "level_span": sim.SPAN,
-                                            "excitations": list(excitations)}}
+                                            "excitations": list(excitations), "satmd_commit": _commit()}}
     args.out.write_text(json.dumps(result, indent=1))
     print(line(result) + f" {describe(info)} -> {args.out}")
     return 0
@@ -298,11 +318,20 @@ def readme_markdown(result: dict) -> str:
     n = s["nulls"]
     rows.append(f"| none (nulls) | no resonance moves | {n['n']} | | | {_pct(n['clean'], n['n'])} clean | |")
     pe = ", ".join(f"{e} {_pct(v['right'], v['n'])}" for e, v in s["per_excitation"].items())
+    ps = ", ".join(f"{k} {_pct(v['right'], v['n'])}" for k, v in s.get("per_structure", {}).items())
     pl = ", ".join(f"{k} levels {_pct(v['right'], v['n'])}" for k, v in s["per_levels"].items())
     st = result["settings"]
     errs = (f"`discover` raised an error on {a['errors']} joint rig(s) and {n['errors']} null(s), counted as wrong. "
             if a["errors"] or n["errors"] else "")
-    rows += ["", f"All right by force: {pe}; by number of levels: {pl}. {errs}Nulls flagged nonlinear: {n['detected']}, "
+    commits: dict = {}
+    for r in result.get("runs", []):
+        c = (r.get("settings") or {}).get("satmd_commit")
+        if c:
+            commits.setdefault(c, []).append(r["file"])
+    code = ("Parts ran at satmd " + "; ".join(f"{c} ({', '.join(sorted(f))})" for c, f in commits.items()) + ". "
+            if len(commits) > 1 else "")
+    rows += ["", f"All right by force: {pe}; by structure: {ps}; by number of levels: {pl}. {errs}{code}"
+             f"Nulls flagged nonlinear: {n['detected']}, "
              f"SATMD element named on nulls: {n['named']}, on joints: {a['named']}. "
              f"({st['duration_s']:.0f} s records at {st['fs_hz']:.0f} Hz, force {st['band_hz'][0]:.0f}–"
              f"{st['band_hz'][1]:.0f} Hz, levels spanning {20 * np.log10(st['level_span']):.0f} dB; median "
