@@ -18,7 +18,7 @@ import math
 from satmd import Rig, discover, effect, simulate, tune
 from satmd.tuning.objective import Objective
 
-res = tune(Rig(), objective="hinf", output="u1", band=(20, 200))
+res = tune(Rig(), objective="hinf", output="u1", band_hz=(20, 200))
 print(res.report())
 fig = res.figure()
 

@@ -30,7 +30,7 @@ def main():
     out.mkdir(parents=True, exist_ok=True)
 
     # 1. the paper's rig
-    res = tune(Rig(), objective="hinf", output="u1", band=(20, 200))
+    res = tune(Rig(), objective="hinf", output="u1", band_hz=(20, 200))
     print(res.report())
     res.plot(out / "tune_paper.png")
 

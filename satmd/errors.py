@@ -85,3 +85,25 @@ class WarningRecord(str):
         import warnings
 
         warnings.warn(str(self), self.category, stacklevel=stacklevel + 1)
+
+
+def renamed_keyword(old_value, new_value, owner: str, old: str = "band", new: str = "band_hz"):
+    """``new_value``, or ``old_value`` given under a keyword's former name (with a DeprecationWarning).
+
+    Parameters
+    ----------
+    old_value : what the caller gave under the former name (None: nothing).
+    new_value : the value under the new name.
+    owner : the function named in the warning.
+    old, new : the two names.
+
+    Returns
+    -------
+    object
+    """
+    if old_value is None:
+        return new_value
+    import warnings
+
+    warnings.warn(f"{owner}: {old}= is now {new}= (the same value)", DeprecationWarning, stacklevel=4)
+    return old_value

@@ -107,5 +107,5 @@ def test_modal_and_retune_entry_points_validate_their_arguments():
         fit_modes(f, H, n_modes=0)
     with pytest.raises(DataError, match="^follow_modes: alpha must be"):
         follow_modes(f, [H, H], alpha=1.5)
-    with pytest.raises(DataError, match="^retune: band must be"):
-        retune([], band=(200.0, 20.0))
+    with pytest.raises(DataError, match="^retune: band_hz must be"):
+        retune([], band_hz=(200.0, 20.0))

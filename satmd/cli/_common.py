@@ -345,7 +345,7 @@ def load_data(args):
     with one_line_warnings(command):
         if is_recording(args.data):
             rec = load_recording_args(args, args.data)
-            data = estimate_frf(rec, band=(lo, hi))
+            data = estimate_frf(rec, band_hz=(lo, hi))
 
             check_usable(args.data, data)
             estimate_notes(args, data.estimator, data.estimator.get("measurement", []))

@@ -78,7 +78,7 @@ def _run(args):
             rec = load_recording(args.recording, channel_map=args.map, scale=scale, fs_hz=args.fs)
         except SatmdError as exc:
             raise SatmdError(_as_typed(str(exc))) from None
-        options = dict(nperseg=args.nperseg, window=args.window, overlap=args.overlap, band=band)
+        options = dict(nperseg=args.nperseg, window=args.window, overlap=args.overlap, band_hz=band)
         if rec.has_force:
             overlay = [f"--{n}" for n in DEFAULT_FREE if getattr(args, n, None) is not None]
             if overlay:
@@ -108,8 +108,8 @@ def _run(args):
             if args.estimator == "lpm":
                 raise SatmdError(f"{args.recording}: an output-only recording gives a transmissibility, "
                                  f"estimated by Welch H1/H2, not lpm")
-            t = transmissibility(rec, estimator=args.estimator or "H1",
-                                 **{k: v for k, v in options.items() if v is not None})
+            t = transmissibility(rec, estimator=args.estimator or "H1",  # it still spells its band "band"
+                                 **{("band" if k == "band_hz" else k): v for k, v in options.items() if v is not None})
             save_transmissibility(t, out)
             kind = "transmissibility A2/A1 (output-only recording)"
             freq, coh = t.freq_hz, {"T": t.coherence}

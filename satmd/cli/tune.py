@@ -73,7 +73,7 @@ def run(args):
     if args.levels is not None or args.nonlinear:  # a nonlinear rig across drive levels
         from ._tune_levels import run_levels
 
-        return run_levels(args, options["band"], _model_rig, files)
+        return run_levels(args, options["band_hz"], _model_rig, files)
     if args.plot:  # every output is checked before the first piece of work
         check_outputs([("--plot", args.plot, plot_suffixes())], inputs=files)
     if args.rig is not None:
@@ -152,7 +152,7 @@ def _tune_options(args) -> dict:
             _check_scale(f"{flag} {name}={x:g}", name, x)
     if uncertainty and q is None:
         raise DataError("--uncertainty applies to --robust")
-    return {"objective": args.objective, "output": args.output, "band": band, "design": design,
+    return {"objective": args.objective, "output": args.output, "band_hz": band, "design": design,
             "bounds": bounds or None, "robust": q is not None, "quantile": q or 0.95, "n_draws": args.draws,
             "current": current, "uncertainty": uncertainty}
 

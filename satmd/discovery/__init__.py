@@ -104,7 +104,7 @@ def discover(
 
         # the excitation is read once and travels with the recording: the FRF and the linearity test agree
         recording = data = with_excitation(data, detect_excitation(data))
-        data = estimate_frf(data, band=band_hz)
+        data = estimate_frf(data, band_hz=band_hz)
     elif band_hz is not None:
         data = data.band(*band_hz)
     report = _discover_frf(data, rig, free, candidates, channels, alpha, max_effects)

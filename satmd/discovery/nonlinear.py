@@ -274,9 +274,9 @@ def common_frfs(recordings) -> list:
         return [estimate_frf(r) for r in recordings]
     bands = [excited_band(r["force"], r.fs_hz)[:2] for r in recordings]
     band = (max(b[0] for b in bands), min(b[1] for b in bands))
-    first = estimate_frf(recordings[0], band=band)
+    first = estimate_frf(recordings[0], band_hz=band)
     width = first.estimator.get("window_hz") or first.estimator.get("settings", {}).get("window_hz")
-    out = [estimate_frf(r, band=band, width_hz=width) for r in recordings]
+    out = [estimate_frf(r, band_hz=band, width_hz=width) for r in recordings]
     return [_with_model_error(d, r, band, width) if d.estimator.get("method") == "lpm" else d
             for d, r in zip(out, recordings)]
 

@@ -12,7 +12,7 @@ from numbers import Real
 import numpy as np
 
 from ..conventions import ESTIMATE_REL_FLOOR, RECORDING_CHANNELS
-from ..errors import DataError
+from ..errors import DataError, renamed_keyword
 from ..validation import LOAD_HINT, Interval, Whole, check_data, validate_params
 from ._common import warn
 from .frfdata import FRFData
@@ -38,8 +38,8 @@ __all__ = ["estimate_frf", "describe_estimate", "default_nperseg", "get_window",
 @validate_params({"nperseg": [None, Interval(Whole, 8)], "overlap": [None, Interval(Real, 0, 1, "hi")],
                   "width_hz": [None, Interval(Real, 0, open="lo")], "period_s": [None, Interval(Real, 0, open="lo")]})
 def estimate_frf(recording: Recording, nperseg: int | None = None, window=None, overlap: float | None = None,
-                 estimator: str | None = None, band=None, width_hz: float | None = None,
-                 excitation: str = "auto", period_s: float | None = None) -> FRFData:
+                 estimator: str | None = None, band_hz=None, width_hz: float | None = None,
+                 excitation: str = "auto", period_s: float | None = None, band=None) -> FRFData:
     """FRFs a1 = acc1/force and a2 = acc2/force with std, coherence and measurement-chain findings.
 
     Parameters
@@ -57,8 +57,8 @@ def estimate_frf(recording: Recording, nperseg: int | None = None, window=None, 
         calls for: the mean over steady periods at the excited lines for a
         periodic force (`satmd.io.periodic`), H1 over hits for impacts
         (`satmd.io.impact`), the LPM for random forces and sweeps.
-    band : (lo, hi), optional
-        Band to keep in Hz, either may be None. The LPM also keeps to the band
+    band_hz : (lo, hi), optional
+        Band to keep in Hz, either may be None (``band=``, its former name, still works and warns). The LPM also keeps to the band
         the force excites, and says so.
     width_hz : float, optional
         LPM window width in Hz (default: 0.3 Hz, or a fifth of the sharpest
@@ -70,6 +70,8 @@ def estimate_frf(recording: Recording, nperseg: int | None = None, window=None, 
     period_s : float, optional
         The period of a periodic force in seconds (default: detected).
 
+    band : (lo, hi), optional
+        The former name of ``band_hz`` (deprecated: it warns).
     Returns
     -------
     FRFData
@@ -79,6 +81,7 @@ def estimate_frf(recording: Recording, nperseg: int | None = None, window=None, 
     from .excitation import detect_excitation
 
     check_data(recording, "recording", (Recording,), "estimate_frf", hint=LOAD_HINT)
+    band = renamed_keyword(band, band_hz, "estimate_frf")  # the estimators below still call it band
     source, responses = _check_force(recording)
     welch_given = any(v is not None for v in (nperseg, window, overlap))
     exc = detect_excitation(recording, excitation, period_s)

@@ -22,7 +22,7 @@ def _textbook_rows():
     kp0 = m2 * k1 / m1
     tmd = Rig(m1=m1, k1=k1, c1=0.0, cp=0.1, e=0.0, m2=m2, kp=kp0)
     bounds = {"kp": (0.5 * kp0, 1.5 * kp0), "cp": (0.02 * math.sqrt(kp0 * m2), math.sqrt(kp0 * m2))}
-    res = tune(tmd, band=(0.3, 3.0), design=("kp", "cp"), bounds=bounds)
+    res = tune(tmd, band_hz=(0.3, 3.0), design=("kp", "cp"), bounds=bounds)
     kp, cp = res.design["kp"], res.design["cp"]
     dh = next(c for c in res.closed_forms if c["name"].startswith("Den Hartog"))
     rows = [("classic TMD, μ = 0.05: frequency ratio", f"{math.sqrt(kp / m2 / (k1 / m1)):.5f}", "0.95237"),
@@ -36,7 +36,7 @@ def _textbook_rows():
         f_oc = math.sqrt(ktot / 0.85) / (2 * math.pi)
         f_sc = math.sqrt((ktot - e**2 / 27e-6) / 0.85) / (2 * math.pi)
         band = (0.5 * f_oc, 1.5 * f_oc)
-        opt = tune(rig, band=band, closed_form_check=False)
+        opt = tune(rig, band_hz=band, closed_form_check=False)
         closed = Objective("hinf", "u1", band)(rig.replace(**equal_peak_shunt(27e-6, f_oc, f_sc)))[0]
         rows.append((f"piezo RL shunt, undamped host, k_c = {kc}: equal-peak closed form above the minimax",
                      f"{20 * math.log10(closed / opt.value):.4f} dB", expected))
@@ -48,8 +48,8 @@ def build(ctx) -> str:
     from ..tuning import tune
 
     rig = Rig()
-    hinf = tune(rig, band=BAND)
-    h2 = tune(rig, objective="h2", band=BAND)
+    hinf = tune(rig, band_hz=BAND)
+    h2 = tune(rig, objective="h2", band_hz=BAND)
     lines = [
         "`satmd.tune` finds the globally best shunt setting over R ∈ [0.1, 1000] Ω, L ∈ [1e-3, 5] H (log space: "
         "a batched Sobol search, then restarted Nelder–Mead). H∞ is the true peak of |U1| over the band (every "

@@ -1,7 +1,7 @@
 """Shunt tuning: the best R and L (or any rig parameters) for a measured or modelled rig.
 
 >>> from satmd import Rig, tune
->>> res = tune(Rig(), band=(20, 200))                 # doctest: +SKIP
+>>> res = tune(Rig(), band_hz=(20, 200))                 # doctest: +SKIP
 >>> round(res.design["R"], 1), round(res.attenuation_db["vs_current"], 2)   # doctest: +SKIP
 (46.9, 8.68)
 

@@ -15,7 +15,7 @@ from typing import Sequence
 
 import numpy as np
 
-from ..errors import DataError
+from ..errors import DataError, renamed_keyword
 from ..physics.effects import Effect
 from ..physics.rig import Rig
 from ..validation import NAMES, Band, Interval, Options, SequenceOf, Whole, validate_params
@@ -32,11 +32,13 @@ __all__ = ["tune", "TUNE_CONSTRAINTS", "Robustness", "SearchPlan", "TuneProblem"
 
 DEFAULT_BAND = PAPER_BAND_HZ
 
+
 #: What every keyword of `tune` may be (`satmd.validation`); the model itself is checked by `resolve_model`.
 TUNE_CONSTRAINTS = {
     "objective": [Options(OBJECTIVES)],
     "output": [Options(OUTPUTS)],
-    "band": [Band()],
+    "band_hz": [Band()],
+    "band": [None, Band()],
     "bounds": [None, dict],
     "design": [NAMES],
     "robust": [bool],
@@ -133,12 +135,13 @@ def tune(
     model,
     objective: str = "hinf",
     output: str = "u1",
-    band: tuple[float, float] = DEFAULT_BAND,
+    band_hz: tuple[float, float] = DEFAULT_BAND,
     bounds: dict | None = None,
     design: Sequence[str] = ("R", "L"),
     robust: bool = False,
     quantile: float = 0.95,
     *,
+    band: tuple[float, float] | None = None,
     effects: Sequence[Effect] = (),
     current: dict | None = None,
     uncertainty: dict | None = None,
@@ -161,7 +164,7 @@ def tune(
     objective : "hinf" (the true peak of |output| over the band) or "h2"
         (its RMS over the band)
     output : "u1" (primary displacement) or "a1" (primary acceleration as measured)
-    band : (lo, hi) in Hz
+    band_hz : (lo, hi) in Hz (``band=``, its former name, still works and warns)
     bounds : {name: (lo, hi)}; defaults R ∈ [0.1, 1000] Ω, L ∈ [1e-3, 5] H,
         others a decade either side of the current value. Searched in log space.
     design : rig fields to design (any of R, L, kp, cp, m2, ...)
@@ -169,6 +172,7 @@ def tune(
         uncertain parameters (fit covariance, or ``uncertainty``) instead of
         the nominal objective
     quantile : the quantile minimised by robust tuning (default 0.95)
+    band : the former name of ``band_hz`` (deprecated: it warns)
     effects : effects of the model when ``model`` is a Rig
     current : the current setting {name: value} (default: the model's values)
     uncertainty : {parameter: standard deviation}, independent Gaussian
@@ -187,12 +191,13 @@ def tune(
     TuneResult
     """
     t0 = time.perf_counter()
+    band_hz = renamed_keyword(band, band_hz, "tune")
     forced = _refuse_inadequate(model, force)
     resolved = resolve_model(model, effects)
     notes = list(resolved.notes)
     if forced:
         notes.append(f"tuned although the SATMD model cannot describe these data (forced): {forced}")
-    problem = _set_up(resolved, Objective(objective, output, tuple(band)), design, current, bounds, notes)
+    problem = _set_up(resolved, Objective(objective, output, tuple(band_hz)), design, current, bounds, notes)
     plan = SearchPlan.make(n_search, n_starts, seed, objective, problem.space.dim)
     rob = Robustness(float(quantile), uncertainty, n_draws) if robust else None
     draws = make_draws(resolved.uncertain, rob.uncertainty, resolved.rig, problem.effects, problem.space.names,

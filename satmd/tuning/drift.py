@@ -15,7 +15,7 @@ from typing import Sequence
 import numpy as np
 
 from ..conventions import DEFAULT_FREE, PAPER_BAND_HZ
-from ..errors import DataError
+from ..errors import DataError, renamed_keyword
 from ..physics.rig import Rig
 from .laws import OPEN_CIRCUIT_R
 from .objective import Objective
@@ -109,8 +109,8 @@ class RetuneResult:
         return fig if path is None else save(fig, path)
 
 
-@validate_params({"rig": [None, Rig], "free": [NAMES], "labels": [None, NAMES], "band": [Band()],
-                  "design": [NAMES]})
+@validate_params({"rig": [None, Rig], "free": [NAMES], "labels": [None, NAMES], "band_hz": [Band()],
+                  "band": [None, Band()], "design": [NAMES]})
 def retune(
     series: Sequence,
     rig: Rig | None = None,
@@ -118,9 +118,10 @@ def retune(
     labels: Sequence[str] | None = None,
     objective: str = "hinf",
     output: str = "u1",
-    band: tuple[float, float] = PAPER_BAND_HZ,
+    band_hz: tuple[float, float] = PAPER_BAND_HZ,
     design: Sequence[str] = ("R", "L"),
     bounds: dict | None = None,
+    band: tuple[float, float] | None = None,
     **tune_options,
 ) -> RetuneResult:
     """Identify each FRF of a drifting rig (warm-started) and retune at each step.
@@ -141,15 +142,17 @@ def retune(
         Names of the steps, one per FRF (default: each FRFData's
         ``meta["label"]``, else its index).
     objective : {"hinf", "h2"}
-        Peak (H∞) or RMS (H2) of ``output`` over ``band``, as `satmd.tune`.
+        Peak (H∞) or RMS (H2) of ``output`` over ``band_hz``, as `satmd.tune`.
     output : {"u1", "a1"}
         Primary displacement or primary acceleration, as `satmd.tune`.
-    band : (float, float)
-        Band (lo, hi) of the objective in Hz.
+    band_hz : (float, float)
+        Band (lo, hi) of the objective in Hz (``band=``, its former name, still works and warns).
     design : sequence of str
         Rig fields tuned at each step.
     bounds : dict, optional
         ``{name: (lo, hi)}`` search bounds of the design (defaults as `satmd.tune`).
+    band : (float, float), optional
+        The former name of ``band_hz`` (deprecated: it warns).
     **tune_options
         Further keywords for `satmd.tune` (``robust``, ``n_search``, ``seed``,
         ...); the closed-form check is always off.
@@ -179,14 +182,15 @@ def retune(
         labels = [d.meta.get("label", str(i)) for i, d in enumerate(series)]
     if len(labels) != len(series):
         raise DataError(f"{len(labels)} labels for {len(series)} FRFs")
-    obj = Objective(objective, output, tuple(band))
+    band_hz = renamed_keyword(band, band_hz, "retune")
+    obj = Objective(objective, output, tuple(band_hz))
     prev, results = None, []
     fixed: dict = {}  # the first setting, kept through the series
     fixed_values, open_values = [], []
     for data in series:
         fit = identify(data, rig, free, start=prev, global_search=prev is None, warn=False)
         prev = dict(fit.values)
-        res = tune(fit, objective, output, band, bounds, design, closed_form_check=False, **tune_options)
+        res = tune(fit, objective, output, band_hz, bounds, design, closed_form_check=False, **tune_options)
         results.append(res)
         if not fixed:
             fixed = dict(res.design)

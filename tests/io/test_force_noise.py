@@ -61,7 +61,7 @@ def test_no_floor_and_no_correction_while_the_force_still_rolls_off(fs, order):
     assert verdict["bound"] >= truth  # signal + noise >= noise: an upper bound on the floor
     rng = np.random.default_rng(4)
     acc = np.convolve(x, [0.5, 0.3, 0.1], mode="same") + 1e-3 * rng.standard_normal(x.size)
-    d = estimate_frf(Recording(fs, {"force": x, "acc1": acc}), band=(20, 250))
+    d = estimate_frf(Recording(fs, {"force": x, "acc1": acc}), band_hz=(20, 250))
     assert d.estimator["max_force_noise_bias"] == 0.0
     assert d.estimator["force_noise_status"] == "no_plateau"
     found = {m["name"]: m for m in d.estimator["measurement"]}

@@ -223,7 +223,7 @@ def test_lpm_recovers_the_model_at_full_resolution(excitation):
     rig = Rig(R=30.0)
     effects = [effect("time_delay", tau_s=2e-4)]
     r = simulate_recording(40.0, 1000.0, rig, effects, seed=2, band_hz=(20, 250), excitation=excitation, ideal=True)
-    d = estimate_frf(r, band=(40, 200))
+    d = estimate_frf(r, band_hz=(40, 200))
     assert d.estimator["method"] == ("sweep" if excitation == "sweep" else "lpm")
     assert d.freq_hz[0] >= 40 and d.freq_hz[-1] <= 200
     model = frf(d.freq_hz, rig, effects, outputs=("a1", "a2"))
@@ -250,7 +250,7 @@ def test_lpm_std_is_honest_with_noise_on_every_channel():
 
 def test_lpm_finds_the_excited_band_and_says_so():
     r = simulate_recording(30.0, 1000.0, noise=0.02, seed=1, band_hz=(30, 150), ideal=True)  # sharp band edges
-    d = estimate_frf(r, band=(10, 400))
+    d = estimate_frf(r, band_hz=(10, 400))
     assert 30 <= d.freq_hz[0] < 31 and 149 < d.freq_hz[-1] <= 150
     names = [m["name"] for m in d.estimator["measurement"]]
     assert "unexcited_band" in names
@@ -258,9 +258,9 @@ def test_lpm_finds_the_excited_band_and_says_so():
 
 def test_welch_resolution_bias_is_named_as_a_measurement_finding():
     r = simulate_recording(120.0, 1000.0, noise=0.02, seed=1, ideal=True)
-    d = estimate_frf(r, nperseg=1024, band=(30, 150))
+    d = estimate_frf(r, nperseg=1024, band_hz=(30, 150))
     assert "resolution_bias" in [m["name"] for m in d.estimator["measurement"]]
-    assert not estimate_frf(r, band=(30, 150)).estimator["measurement"]
+    assert not estimate_frf(r, band_hz=(30, 150)).estimator["measurement"]
     with pytest.raises(DataError, match="inside"):
         simulate_recording(1.0, 100.0, band_hz=(10, 60))
 
@@ -270,7 +270,7 @@ def test_noise_free_estimate_matches_the_model_in_phase_and_magnitude():
     rig = Rig(R=30.0)
     effects = [effect("time_delay", tau_s=2e-4)]
     r = simulate_recording(10.0, 1000.0, rig, effects, seed=2, band_hz=(20, 250), ideal=True)
-    d = estimate_frf(r, nperseg=2048, band=(40, 200))
+    d = estimate_frf(r, nperseg=2048, band_hz=(40, 200))
     model = frf(d.freq_hz, rig, effects, outputs=("a1", "a2"))
     for ch in ("a1", "a2"):  # what is left is the window's resolution bias at the peaks
         err = np.abs(d[ch] - model.channel(ch)) / np.abs(model.channel(ch))
@@ -286,7 +286,7 @@ def test_phase_sign_of_a_pure_delay():
     x = rng.standard_normal(20000)
     shift = 3
     r = Recording(1000.0, {"force": x, "acc1": np.roll(x, shift)})
-    d = estimate_frf(r, nperseg=256, band=(10, 100))
+    d = estimate_frf(r, nperseg=256, band_hz=(10, 100))
     expected = np.exp(-2j * np.pi * d.freq_hz * shift / 1000.0)
     np.testing.assert_allclose(d["a1"], expected, atol=0.02)
     assert np.all(np.angle(d["a1"]) < 0)
@@ -297,7 +297,7 @@ def test_coherence_based_std_is_honest():
     z = []
     for seed in range(4):
         r = simulate_recording(20.0, 500.0, noise=0.05, seed=seed)
-        d = estimate_frf(r, nperseg=1024, band=(35, 140))
+        d = estimate_frf(r, nperseg=1024, band_hz=(35, 140))
         model = frf(d.freq_hz, outputs=("a1", "a2"))
         for ch in ("a1", "a2"):
             e = (d[ch] - model.channel(ch)) / d.std[ch]
@@ -313,7 +313,7 @@ def test_h2_is_unbiased_with_noise_on_the_force():
     rng = np.random.default_rng(1)
     noisy = Recording(r.fs_hz, {**r.channels, "force": r["force"] + 0.5 * rng.standard_normal(r.n_samples)})
     band = (60, 90)  # away from the peaks: resolution bias is negligible, noise bias is not
-    h1, h2 = (estimate_frf(noisy, nperseg=1024, band=band, estimator=e) for e in ("H1", "H2"))
+    h1, h2 = (estimate_frf(noisy, nperseg=1024, band_hz=band, estimator=e) for e in ("H1", "H2"))
     model = np.abs(frf(h1.freq_hz, outputs=("a2",)).a2)
     assert np.median(np.abs(h1["a2"]) / model) < 0.9  # H1 biased low by 1/(1 + noise/force)
     assert np.median(np.abs(h2["a2"]) / model) == pytest.approx(1.0, abs=0.02)
@@ -331,7 +331,7 @@ def test_estimate_frf_option_errors(rec):
     with pytest.raises(DataError, match="window"):
         estimate_frf(rec, window="no-such-window")
     with pytest.raises(DataError, match="holds no frequency bin"):
-        estimate_frf(rec, band=(300, 400))
+        estimate_frf(rec, band_hz=(300, 400))
 
 
 def test_default_nperseg():
@@ -352,7 +352,7 @@ def test_transmissibility_matches_the_model(rec):
 def test_recording_to_identification_end_to_end(rec):
     """The chain recording -> FRF -> identify recovers the rig with an honest χ²."""
     identify = pytest.importorskip("satmd.identification").identify
-    d = estimate_frf(rec, band=(30, 150))
+    d = estimate_frf(rec, band_hz=(30, 150))
     fit = identify(d)
     true = Rig()
     for name in ("m2", "kp", "R", "L"):

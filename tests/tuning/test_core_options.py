@@ -60,9 +60,10 @@ def test_a_new_option_needs_one_keyword_and_one_constraint():
     from satmd.validation import Interval, validate_params
 
     @validate_params({**TUNE_CONSTRAINTS, "margin_db": [Interval(Real, 0)]})
-    def tune_with_margin(model, objective="hinf", output="u1", band=(20.0, 200.0), bounds=None, design=("R", "L"),
-                         robust=False, quantile=0.95, *, effects=(), current=None, uncertainty=None, n_draws=128,
-                         n_search=None, n_starts=3, closed_form_check=True, seed=0, force=False, margin_db=0.0):
+    def tune_with_margin(model, objective="hinf", output="u1", band_hz=(20.0, 200.0), bounds=None,
+                         design=("R", "L"), robust=False, quantile=0.95, *, band=None, effects=(), current=None,
+                         uncertainty=None, n_draws=128, n_search=None, n_starts=3, closed_form_check=True, seed=0,
+                         force=False, margin_db=0.0):
         return margin_db
 
     assert tune_with_margin(Rig(), margin_db=1.5) == 1.5

@@ -34,7 +34,7 @@ def test_closed_forms_reproduce_the_published_numbers():
 
 
 def test_classic_tmd_hinf_meets_nishihara_asami():
-    res = tune(TMD, objective="hinf", band=(0.3, 3.0), design=("kp", "cp"), bounds=TMD_BOUNDS)
+    res = tune(TMD, objective="hinf", band_hz=(0.3, 3.0), design=("kp", "cp"), bounds=TMD_BOUNDS)
     ratio, zeta = ratio_and_zeta(res.design)
     assert ratio == pytest.approx(0.95237, abs=2e-4)
     assert zeta == pytest.approx(0.13394, abs=5e-4)
@@ -49,7 +49,7 @@ def test_classic_tmd_hinf_meets_nishihara_asami():
 
 def test_classic_tmd_h2_meets_asami():
     band = (0.01, 100.0)  # white noise: a band wide enough that the tails do not matter
-    res = tune(TMD, objective="h2", band=band, design=("kp", "cp"), bounds=TMD_BOUNDS)
+    res = tune(TMD, objective="h2", band_hz=band, design=("kp", "cp"), bounds=TMD_BOUNDS)
     ratio, zeta = ratio_and_zeta(res.design)
     assert ratio == pytest.approx(0.96421, abs=5e-4)
     assert zeta == pytest.approx(0.10977, abs=1e-3)
@@ -72,7 +72,7 @@ def test_piezo_rl_shunt_equal_peak_closed_form(kc, gap):
     rig, f_oc, f_sc = piezo_rig(kc)
     assert math.sqrt(f_oc**2 - f_sc**2) / f_sc == pytest.approx(kc)
     band = (0.5 * f_oc, 1.5 * f_oc)
-    res = tune(rig, band=band)
+    res = tune(rig, band_hz=band)
     closed = equal_peak_shunt(rig.Cp, f_oc, f_sc)
     obj = Objective("hinf", "u1", band)
     closed_db = db(obj(rig.replace(**closed))[0], res.value)

@@ -53,13 +53,13 @@ def test_fit_and_discovery_models():
     data = simulate(effects=[effect("extra_mode", f_hz=75.0, zeta=0.01, mass_ratio=0.02)], noise=0.01, seed=2)
     rep = satmd.discover(data)
     assert rep.significant_mismatch and "extra_mode" in rep.effect_names
-    res = tune(rep, objective="h2", output="a1", band=(40.0, 130.0))
+    res = tune(rep, objective="h2", output="a1", band_hz=(40.0, 130.0))
     assert res.model_source.startswith("augmented model")
     assert [e["name"] for e in res.to_dict()["model"]["effects"]] == ["extra_mode"]
     assert any("augmented" in n for n in res.notes)
     assert any(n.startswith("tuned on the nominal model instead") for n in res.notes)
     # the nominal fit of the same data is tuned on the wrong model
-    nominal = tune(rep.nominal_fit, objective="h2", output="a1", band=(40.0, 130.0))
+    nominal = tune(rep.nominal_fit, objective="h2", output="a1", band_hz=(40.0, 130.0))
     assert nominal.model_source == "identified model" and nominal.to_dict()["model"]["effects"] == []
 
 
@@ -106,3 +106,17 @@ def test_design_beyond_the_shunt(paper):
     res = tune(Rig(), design=("R", "L", "kp"), n_search=256, n_starts=2, closed_form_check=False)
     assert res.value <= paper.value * (1 + 1e-6)  # one more knob never hurts
     assert math.isfinite(res.attenuation_db["vs_current"])
+
+
+def test_band_is_spelt_band_hz_and_the_old_keyword_still_works_with_a_warning():
+    """One spelling per name (issue 36): every band in Hz is band_hz; band= is kept for old scripts."""
+    import warnings
+
+    from satmd import Rig
+
+    new = tune(Rig(), band_hz=(40.0, 130.0), n_search=64, n_starts=1, closed_form_check=False)
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        old = tune(Rig(), band=(40.0, 130.0), n_search=64, n_starts=1, closed_form_check=False)
+    assert any(issubclass(w.category, DeprecationWarning) and "band_hz" in str(w.message) for w in caught)
+    assert old.design == new.design and old.band_hz == new.band_hz == (40.0, 130.0)
