@@ -72,9 +72,8 @@ def laws_pass(laws: tuple):
     (callable, list of int)
     """
     _load()
-    py = list(_BUILTIN_PY)
-    if all(f in py for f in laws):
-        return _run, [py.index(f) for f in laws]
+    if all(f in BUILTIN_LAWS for f in laws):  # the Python functions: `_load` rebinds only the module's names
+        return _run, [BUILTIN_LAWS.index(f) for f in laws]
     distinct = tuple(dict.fromkeys(laws))
     if distinct not in _PASSES:
         import numba
@@ -150,9 +149,6 @@ def _run(phi, g0, g1, C, D, out_rows, out_direct, drive, force, codes, prm, rd, 
                 gp[j] = g[j]
             f_prev = fk
 
-
-
-_BUILTIN_PY = BUILTIN_LAWS  # the Python functions, before `_load` compiles the module's names
 
 
 def run(phi, g0, g1, C, D, out_rows, out_direct, drive, force, laws, prm, rd, corrections):
