@@ -27,13 +27,13 @@ from numbers import Real
 from typing import Sequence
 
 from ..validation import LOAD_HINT, NAMES, Band, Interval, Whole, check_data, validate_params
-from ..conventions import ACCEL_CHANNELS, DEFAULT_FREE
+from ..conventions import ACCEL_CHANNELS, DEFAULT_FREE, MIN_DELTA_BIC
 from .._fleet import fleet_map
 from ..identification import identify
 from ..io.frfdata import FRFData, require_data
 from ..physics import Rig
 from .adequacy import after_search, assess_fit, drop_stretched, inadequate_report, withdraw_if_inadequate
-from .budget import bias_note, bias_share
+from .budget import bias_note, evidence_beyond_bias
 from .candidates import default_candidates
 from .discrepancy import fit_discrepancy
 from .findings import UNEXPLAINED, EffectFinding, UnexplainedFinding
@@ -215,9 +215,9 @@ def _discover_frf(data: FRFData, rig, free, candidates, channels, alpha, max_eff
             # what accounting for this effect does to the free parameters (vs the model without it)
             ref = without[name].fit.values
             shifts = {k: final.fit.values[k] / ref[k] - 1 for k in free if ref[k]}
-            share = bias_share(final.fit, without[name].fit, data.bias_bound)
-            if share <= 1.0:  # the estimator's own bias could make it: kept in the fit, not named (budget.py)
-                bias_notes.append(bias_note(name, describe_effect(eff, rig, shifts), share, data.bias_bound))
+            evidence = evidence_beyond_bias(final.fit, without[name].fit, data.bias_bound)
+            if evidence <= MIN_DELTA_BIC:  # the estimator's own bias could make it: kept in the fit, not named
+                bias_notes.append(bias_note(name, describe_effect(eff, rig, shifts), evidence, data.bias_bound))
                 continue
             effects.append(EffectFinding(name=name, parameters={k: float(v) for k, v in eff.params.items()
                                                                 if search.measured(k)},

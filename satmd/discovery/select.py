@@ -155,16 +155,18 @@ def select(search: Search, nominal: Model, still_significant, max_effects: int =
     # parsimony: models within MIN_DELTA_BIC of the best explain the data as well; take the fewest effects
     lowest = min(m.bic for m in reached)
     best = min((m for m in reached if m.bic - lowest < MIN_DELTA_BIC), key=lambda m: (len(m.names), m.bic))
-    if best.names:
-        best = _swaps(search, _backward(search, best, nominal), nominal)
+    if best.names:  # a swap, or a better basin found for a smaller set, can leave an effect without its place
+        best = _backward(search, _swaps(search, _backward(search, best, nominal), nominal), nominal)
     return best
 
 
 def _backward(search, model, nominal):
+    """Drop effects, one at a time, until each lowers BIC by more than MIN_DELTA_BIC against the model
+    refitted without it."""
     changed = True
-    while changed and len(model.names) > 1:
+    while changed and model.names:
         changed = False
-        for name in model.names[:-1]:
+        for name in model.names:
             without = search.remove(model, name, nominal)
             if without.bic - model.bic <= MIN_DELTA_BIC:
                 model, changed = without, True

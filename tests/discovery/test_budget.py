@@ -39,3 +39,35 @@ def test_bias_bound_is_checked_and_follows_the_band():
         FRFData(d.freq_hz, d.channels, d.std, bias_bound=np.ones(3))
     with pytest.raises(DataError, match="bias_bound"):
         FRFData(d.freq_hz, d.channels, d.std, bias_bound=-np.ones(F.size))
+
+
+class _Prediction(dict):
+    def __init__(self, f, channels):
+        super().__init__(channels)
+        self.freq_hz, self.channels = f, tuple(channels)
+
+
+def _fit(h, std, k):
+    """A fitted model's face as `evidence_beyond_bias` reads it: prediction, std, χ² and BIC with k parameters."""
+    from types import SimpleNamespace
+
+    n = 4 * F.size
+    return SimpleNamespace(prediction=lambda: _Prediction(F, {"a1": h, "a2": h}),
+                           data=SimpleNamespace(std={"a1": std, "a2": std}), chi2=float(n), bic=n + k * np.log(n))
+
+
+@pytest.mark.parametrize("rel_std, named", [(1e-3, False), (1e-5, True)])
+def test_only_the_signature_beyond_the_bias_is_evidence(rel_std, named):
+    """A change within the bound at every point but three, where it exceeds it by a fifth: the excess is evidence
+    at a tiny noise, none at a noise comparable to the bound (the old max-share rule named it at both)."""
+    from satmd.conventions import MIN_DELTA_BIC
+    from satmd.discovery.budget import evidence_beyond_bias
+
+    bound = np.full(F.size, 1e-3)
+    without = np.ones(F.size, complex)
+    change = np.full(F.size, 0.5e-3)
+    change[[50, 100, 150]] = 1.2e-3
+    with_ = without * (1 + change)
+    ev = evidence_beyond_bias(_fit(with_, rel_std, 6), _fit(without, rel_std, 4), bound)
+    assert (ev > MIN_DELTA_BIC) == named
+    assert evidence_beyond_bias(_fit(with_, rel_std, 6), _fit(without, rel_std, 4), None) == float("inf")
