@@ -66,3 +66,36 @@ def test_one_output_error_fitter():
     for name in ("identification/nonlinear.py", "identification/oscillator.py"):
         text = (SRC / name).read_text()
         assert "batched_least_squares(" in text and "np.eye(x.size)" not in text, name
+
+
+def test_a_band_in_hz_is_spelled_band_hz():
+    """Every function of the package that takes a frequency band calls it ``band_hz``; ``band=`` survives only as
+    the deprecated former name beside it (`errors.renamed_keyword`)."""
+    import ast
+
+    wrong = []
+    for p in SRC.rglob("*.py"):
+        if "cli" in p.parts:  # argparse namespaces, not signatures
+            continue
+        for node in ast.walk(ast.parse(p.read_text())):
+            if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef)):
+                names = {a.arg for a in node.args.args + node.args.kwonlyargs + node.args.posonlyargs}
+                if "band" in names and "band_hz" not in names:
+                    wrong.append(f"{p.relative_to(SRC.parent)}:{node.lineno} {node.name}")
+    assert not wrong, f"a band parameter not spelled band_hz: {wrong}"
+
+
+def test_the_former_band_keyword_still_works_and_warns():
+    import warnings
+
+    from satmd.discovery.nonlinear_stats import linearity_test
+
+    rng = np.random.default_rng(1)
+    x = rng.standard_normal(4096)
+    y = np.convolve(x, [1.0, 0.5, 0.2])[:4096]
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        old = linearity_test(x, {"y": y}, 1.0, {"y3": y ** 3}, band=(0.05, 0.3))
+    new = linearity_test(x, {"y": y}, 1.0, {"y3": y ** 3}, band_hz=(0.05, 0.3))
+    assert any("band_hz" in str(w.message) for w in caught)
+    assert old.p_value == new.p_value

@@ -108,8 +108,8 @@ def _run(args):
             if args.estimator == "lpm":
                 raise SatmdError(f"{args.recording}: an output-only recording gives a transmissibility, "
                                  f"estimated by Welch H1/H2, not lpm")
-            t = transmissibility(rec, estimator=args.estimator or "H1",  # it still spells its band "band"
-                                 **{("band" if k == "band_hz" else k): v for k, v in options.items() if v is not None})
+            t = transmissibility(rec, estimator=args.estimator or "H1",
+                                 **{k: v for k, v in options.items() if v is not None})
             save_transmissibility(t, out)
             kind = "transmissibility A2/A1 (output-only recording)"
             freq, coh = t.freq_hz, {"T": t.coherence}

@@ -97,20 +97,21 @@ class NonlinearReport:
 
 
 # --- detection on one recording ----------------------------------------------------------------------------
-def distortion_test(recording, band=None, alpha: float = 1e-3) -> NonlinearTest:
+def distortion_test(recording, band_hz=None, alpha: float = 1e-3, band=None) -> NonlinearTest:
     """Distortion test of one random-force recording (force and accelerations, or force and any output ``y``).
 
     Parameters
     ----------
     recording : Recording with ``force`` and ``acc1``/``acc2`` (SATMD) or one other output channel
-    band : (lo, hi) Hz (default: the band the force excites)
+    band_hz : (lo, hi) Hz (default: the band the force excites)
     alpha : level
+    band : former name of ``band_hz`` (deprecated)
 
     Returns
     -------
     NonlinearTest
     """
-    from ..errors import DataError
+    from ..errors import DataError, renamed_keyword
     from ..io.excitation import detect_excitation
     from ..io.lpm import excited_band
 
@@ -119,23 +120,24 @@ def distortion_test(recording, band=None, alpha: float = 1e-3) -> NonlinearTest:
         raise DataError(f"the distortion test needs a random or periodic force; a{'n' if kind == 'impact' else ''} "
                         f"{kind} record cannot be tested for distortion (record two levels apart to see level "
                         "dependence, or a periodic multisine for its detection lines)")
+    band_hz = renamed_keyword(band, band_hz, "distortion_test")
     fs = recording.fs_hz
     x = recording["force"]
-    if band is None:
+    if band_hz is None:
         lo, hi, _ = excited_band(x, fs)
-        band = (lo, hi)
+        band_hz = (lo, hi)
     accs = [c for c in ("acc1", "acc2") if c in recording.channels]
     if accs:
         responses = {ch: recording[c] for c, ch in zip(("acc1", "acc2"), ACCEL_CHANNELS) if c in recording.channels}
-        predicted = linear_prediction(recording, band)
+        predicted = linear_prediction(recording, band_hz)
         a1, a2 = predicted.get(ACCEL_CHANNELS[0]), predicted.get(ACCEL_CHANNELS[1])
         signals: dict[str, np.ndarray] = {}
         shapes: dict[str, tuple[str, ...]] = {}
         if a1 is not None:
-            signals["u1"], shapes["u1"] = integrate(a1, fs, 2, band), ("cube",)
+            signals["u1"], shapes["u1"] = integrate(a1, fs, 2, band_hz), ("cube",)
         if a1 is not None and a2 is not None:
-            signals["d"], shapes["d"] = integrate(a2 - a1, fs, 2, band), ("cube",)
-            signals["v"], shapes["v"] = integrate(a2 - a1, fs, 1, band), ("cube", "absv", "sign")
+            signals["d"], shapes["d"] = integrate(a2 - a1, fs, 2, band_hz), ("cube",)
+            signals["v"], shapes["v"] = integrate(a2 - a1, fs, 1, band_hz), ("cube", "absv", "sign")
     else:
         others = [c for c in recording.channels if c != "force"]
         responses = {c: recording[c] for c in others}
@@ -144,8 +146,8 @@ def distortion_test(recording, band=None, alpha: float = 1e-3) -> NonlinearTest:
         shapes = {"y": ("square", "cube"), "dy": ("cube", "absv")}
     regs = distortion_regressors(signals, shapes)
     if accs:
-        return separate_linearity_test(x, responses, fs, regs, band=band, alpha=alpha)
-    return linearity_test(x, responses, fs, regs, band=band, alpha=alpha)
+        return separate_linearity_test(x, responses, fs, regs, band_hz=band_hz, alpha=alpha)
+    return linearity_test(x, responses, fs, regs, band_hz=band_hz, alpha=alpha)
 
 
 def is_multisine(recording) -> bool:
@@ -194,7 +196,7 @@ def multisine_test(recording, alpha: float = 1e-3) -> NonlinearTest:
     hi = lines.max() * recording.fs_hz / u.shape[-1]
     forced = np.union1d(lines, forced_lines(u, lines=lines))  # a line with force on it is no detection line
     outs = {c: without_linear_response(u, y, lines) for c, y in outs.items()}
-    tests = {c: detection_lines_test(u, y, forced, recording.fs_hz, band=(0.0, 1.5 * hi), alpha=alpha / len(outs))
+    tests = {c: detection_lines_test(u, y, forced, recording.fs_hz, band_hz=(0.0, 1.5 * hi), alpha=alpha / len(outs))
              for c, y in outs.items()}
     worst = min(tests.values(), key=lambda t: t.p_value)
     p = min(1.0, worst.p_value * len(tests))
@@ -224,7 +226,7 @@ def multisine_frf(recording):
     return FRFData(b["freq_hz"], chans, std, meta)
 
 
-def linear_prediction(recording, band) -> dict:
+def linear_prediction(recording, band_hz) -> dict:
     """The accelerations the best linear approximation predicts from the force alone (LPM FRF x force spectrum).
 
     Regressors built from these, not from the measured responses, hold no response noise: the
@@ -232,7 +234,7 @@ def linear_prediction(recording, band) -> dict:
     """
     from ..io.lpm import lpm
 
-    est = lpm(recording, band=band)
+    est = lpm(recording, band_hz=band_hz)
     n, fs = recording.n_samples, recording.fs_hz
     x = recording["force"]
     X = np.fft.rfft(x - x.mean())
@@ -281,15 +283,15 @@ def common_frfs(recordings) -> list:
             for d, r in zip(out, recordings)]
 
 
-def _with_model_error(data, recording, band, width):
+def _with_model_error(data, recording, band_hz, width):
     """Attach the local-polynomial model error (degree 2 vs 3 on the same windows) as ``meta['model_error']``."""
     from dataclasses import replace
 
     from ..io.lpm import lpm
 
     try:
-        e2 = lpm(recording, band=band, width_hz=width, degree=2)
-        e3 = lpm(recording, band=band, width_hz=width, degree=3)
+        e2 = lpm(recording, band_hz=band_hz, width_hz=width, degree=2)
+        e3 = lpm(recording, band_hz=band_hz, width_hz=width, degree=3)
     except Exception:  # noqa: BLE001 - too few bins for degree 3: no model-error estimate
         return data
     if e2.freq_hz.shape != e3.freq_hz.shape or not np.allclose(e2.freq_hz, e3.freq_hz):

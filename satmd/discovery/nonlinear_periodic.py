@@ -81,7 +81,7 @@ def multisine_bla(u, y, lines, fs_hz: float) -> dict:
             "var_nl": var_nl, "std": np.sqrt(best / 2.0), "M": M, "P": P}
 
 
-def detection_lines_test(u, y, lines, fs_hz: float, band=None, alpha: float = 1e-3,
+def detection_lines_test(u, y, lines, fs_hz: float, band_hz=None, alpha: float = 1e-3,
                          name: str = "distortion_lines") -> NonlinearTest:
     """Output at the lines the multisine leaves out, against the noise seen over periods.
 
@@ -90,7 +90,7 @@ def detection_lines_test(u, y, lines, fs_hz: float, band=None, alpha: float = 1e
     u, y : (M, P, N) periods (P ≥ 2)
     lines : excited lines
     fs_hz : sample rate
-    band : (lo, hi) Hz of detection lines to use (default: up to 3x the highest excited line)
+    band_hz : (lo, hi) Hz of detection lines to use (default: up to 3x the highest excited line)
     alpha : level
     name : test name
 
@@ -109,7 +109,7 @@ def detection_lines_test(u, y, lines, fs_hz: float, band=None, alpha: float = 1e
     Y = np.fft.rfft(y - y.mean(axis=2, keepdims=True), axis=2)
     k = np.arange(Y.shape[2])
     lines = np.asarray(lines, int)
-    lo, hi = band if band is not None else (0.0, 3 * lines.max() * fs_hz / N)
+    lo, hi = band_hz if band_hz is not None else (0.0, 3 * lines.max() * fs_hz / N)
     mask = np.ones(k.size, bool)
     mask[lines] = False
     mask[0] = False
@@ -134,7 +134,7 @@ def detection_lines_test(u, y, lines, fs_hz: float, band=None, alpha: float = 1e
     return NonlinearTest(name, p, bands, alpha, details)
 
 
-def one_mode_fit(freq, H, std, band=None) -> dict:
+def one_mode_fit(freq, H, std, band_hz=None) -> dict:
     """Fit ``A / (ωn² − ω² + 2iζωn ω) + B`` (A, B complex) near the peak of |H|.
 
     Parameters
@@ -142,7 +142,7 @@ def one_mode_fit(freq, H, std, band=None) -> dict:
     freq : (n,) Hz
     H : (n,) complex FRF
     std : (n,) std per Re/Im (weights)
-    band : (lo, hi) Hz fitted (default 0.7–1.35 × the peak frequency)
+    band_hz : (lo, hi) Hz fitted (default 0.7–1.35 × the peak frequency)
 
     Returns
     -------
@@ -155,7 +155,7 @@ def one_mode_fit(freq, H, std, band=None) -> dict:
 
     freq, H, std = np.asarray(freq, float), np.asarray(H, complex), np.asarray(std, float)
     fpk = float(freq[np.argmax(np.abs(H))])
-    lo, hi = band if band is not None else (0.7 * fpk, 1.35 * fpk)
+    lo, hi = band_hz if band_hz is not None else (0.7 * fpk, 1.35 * fpk)
     sel = (freq >= lo) & (freq <= hi)
     f, h, s = freq[sel], H[sel], np.maximum(std[sel], TINY)
     w = 2 * np.pi * f

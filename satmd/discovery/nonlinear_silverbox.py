@@ -77,7 +77,7 @@ def snls_report(directory, alpha: float = 1e-3):
 
     edges = [excited_band(p["force"], p.fs_hz)[:2] for p in parts]
     band = (max(20.0, *(e[0] for e in edges)), min(200.0, *(e[1] for e in edges)))  # one grid for both halves
-    ests = [lpm(p, band=band, width_hz=0.5) for p in parts]
+    ests = [lpm(p, band_hz=band, width_hz=0.5) for p in parts]
     freq = np.intersect1d(np.round(ests[0].freq_hz, 9), np.round(ests[1].freq_hz, 9))
     idx = [np.searchsorted(np.round(e.freq_hz, 9), freq) for e in ests]
     frfs = [{"y": e.frf["a1"][i]} for e, i in zip(ests, idx)]
@@ -87,7 +87,7 @@ def snls_report(directory, alpha: float = 1e-3):
     return analyse_generic(frfs, stds, freq, levels, [test], alpha / 2)
 
 
-def _multisine_distortion(ms, band, alpha) -> NonlinearTest:
+def _multisine_distortion(ms, band_hz, alpha) -> NonlinearTest:
     """Distortion regressors on every steady-state multisine period, scores summed over realisations."""
     fs = ms["fs_hz"]
     scores, freq, dof = None, None, 0
@@ -95,7 +95,7 @@ def _multisine_distortion(ms, band, alpha) -> NonlinearTest:
         yc = y - y.mean()
         regs = distortion_regressors({"y": yc, "dy": np.gradient(yc) * fs},
                                      {"y": ("square", "cube"), "dy": ("cube", "absv")})
-        t = linearity_test(u, {"y": y}, fs, regs, band=band, alpha=alpha)
+        t = linearity_test(u, {"y": y}, fs, regs, band_hz=band_hz, alpha=alpha)
         if "scores" not in t.details:
             continue
         scores = t.details["scores"] if scores is None else scores + t.details["scores"]

@@ -152,8 +152,8 @@ def distortion_regressors(signals: dict, shapes=("cube",)) -> dict:
     return out
 
 
-def linearity_test(force, responses: dict, fs_hz: float, regressors: dict, band=None, window_bins: int = 0,
-                   degree: int = 2, alpha: float = 1e-3) -> NonlinearTest:
+def linearity_test(force, responses: dict, fs_hz: float, regressors: dict, band_hz=None, window_bins: int = 0,
+                   degree: int = 2, alpha: float = 1e-3, band=None) -> NonlinearTest:
     """Test one random-excitation record for nonlinear distortion (see the module docstring).
 
     Parameters
@@ -162,10 +162,11 @@ def linearity_test(force, responses: dict, fs_hz: float, regressors: dict, band=
     responses : {channel: (n,) samples} measured outputs
     fs_hz : sample rate
     regressors : {name: (n,) samples} nonlinear regressors (e.g. `hermite_regressors` of the responses)
-    band : (lo, hi) Hz analysed (default: where the force has power)
+    band_hz : (lo, hi) Hz analysed (default: where the force has power)
     window_bins : bins per local window (default: twice the local parameters, + 1)
     degree : polynomial degree of H and of the transient in each window
     alpha : level
+    band : former name of ``band_hz`` (deprecated)
 
     Returns
     -------
@@ -176,11 +177,14 @@ def linearity_test(force, responses: dict, fs_hz: float, regressors: dict, band=
     """
     from scipy import stats
 
+    from ..errors import renamed_keyword
+
+    band_hz = renamed_keyword(band, band_hz, "linearity_test")
     n = len(force)
     X = np.fft.rfft(np.asarray(force, float) - np.mean(force))
     Z = np.stack([np.fft.rfft(z - z.mean()) for z in regressors.values()], axis=1) if regressors else None
     df = fs_hz / n
-    lo, hi = band if band is not None else _excited(force, fs_hz)
+    lo, hi = band_hz if band_hz is not None else _excited(force, fs_hz)
     nz = 0 if Z is None else Z.shape[1]
     p_h = 2 * (degree + 1)
     width = max(window_bins, 2 * (p_h + nz) + 1)
@@ -223,7 +227,7 @@ def linearity_test(force, responses: dict, fs_hz: float, regressors: dict, band=
     return NonlinearTest("distortion", p_value, bands, alpha, details)
 
 
-def separate_linearity_test(force, responses: dict, fs_hz: float, regressors: dict, band=None,
+def separate_linearity_test(force, responses: dict, fs_hz: float, regressors: dict, band_hz=None,
                             window_hz: float = 1.5, degree: int = 3, alpha: float = 1e-3) -> NonlinearTest:
     """`linearity_test` for each regressor alone, in windows ``window_hz`` wide, Bonferroni over the regressors.
 
@@ -235,7 +239,7 @@ def separate_linearity_test(force, responses: dict, fs_hz: float, regressors: di
 
     Parameters
     ----------
-    force, responses, fs_hz, regressors, band : as `linearity_test`
+    force, responses, fs_hz, regressors, band_hz : as `linearity_test`
     window_hz : local window width [Hz] (at least the bins the local model needs)
     degree : polynomial degree of H and the transient in each window
     alpha : level (each regressor's test at alpha / number of regressors)
@@ -251,7 +255,7 @@ def separate_linearity_test(force, responses: dict, fs_hz: float, regressors: di
         return NonlinearTest("distortion", 1.0, [], alpha, {"reason": "no regressors"})
     k = len(regressors)
     bins = int(round(window_hz * len(force) / fs_hz))
-    tests = {name: linearity_test(force, responses, fs_hz, {name: z}, band=band, window_bins=bins, degree=degree,
+    tests = {name: linearity_test(force, responses, fs_hz, {name: z}, band_hz=band_hz, window_bins=bins, degree=degree,
                                   alpha=alpha / k) for name, z in regressors.items()}
     order = sorted(tests, key=lambda n: tests[n].p_value)
     best = tests[order[0]]
@@ -275,12 +279,12 @@ def _excited(force, fs_hz) -> tuple:
     return lo, hi
 
 
-def integrate(signal, fs_hz, times: int, band):
-    """Band-limited integration in the frequency domain (÷ iω per time), zero outside ``band``."""
+def integrate(signal, fs_hz, times: int, band_hz):
+    """Band-limited integration in the frequency domain (÷ iω per time), zero outside ``band_hz``."""
     n = len(signal)
     S = np.fft.rfft(np.asarray(signal, float) - np.mean(signal))
     f = np.fft.rfftfreq(n, 1.0 / fs_hz)
-    keep = (f >= band[0]) & (f <= band[1])
+    keep = (f >= band_hz[0]) & (f <= band_hz[1])
     out = np.zeros_like(S)
     out[keep] = S[keep] / (2j * np.pi * f[keep]) ** times
     return np.fft.irfft(out, n)

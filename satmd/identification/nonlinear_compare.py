@@ -18,10 +18,10 @@ from scipy.signal import csd, welch
 from .nonlinear import fit_nonlinear, predict, prepare
 
 
-def _h1(force, acc, fs, band):
+def _h1(force, acc, fs, band_hz):
     nper = int(min(force.size // 4, 4 * fs))
     f, pff = welch(force, fs, nperseg=nper)
-    keep = (f >= band[0]) & (f <= band[1])
+    keep = (f >= band_hz[0]) & (f <= band_hz[1])
     out = []
     for x in acc:
         _, pfx = csd(force, x, fs, nperseg=nper)

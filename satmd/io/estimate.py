@@ -81,7 +81,7 @@ def estimate_frf(recording: Recording, nperseg: int | None = None, window=None, 
     from .excitation import detect_excitation
 
     check_data(recording, "recording", (Recording,), "estimate_frf", hint=LOAD_HINT)
-    band = renamed_keyword(band, band_hz, "estimate_frf")  # the estimators below still call it band
+    band_hz = renamed_keyword(band, band_hz, "estimate_frf")
     source, responses = _check_force(recording)
     welch_given = any(v is not None for v in (nperseg, window, overlap))
     exc = detect_excitation(recording, excitation, period_s)
@@ -92,19 +92,19 @@ def estimate_frf(recording: Recording, nperseg: int | None = None, window=None, 
         designed = at_rest_at_the_end(recording, responses)
     if estimator is None and not welch_given and width_hz is None and designed:
         _check_constant(recording, source, responses)
-        return _estimate_designed(recording, exc, band)
+        return _estimate_designed(recording, exc, band_hz)
     if exc.kind == "sweep" and exc.sweep and not designed:  # cut off mid-sweep: its ends carry the cut's transient
         lo_s, hi_s = sorted((exc.sweep["f_start_hz"], exc.sweep["f_end_hz"]))
-        band = (max(1.05 * lo_s, band[0] if band and band[0] is not None else 0.0),
-                min(0.95 * hi_s, band[1] if band and band[1] is not None else np.inf))
+        band_hz = (max(1.05 * lo_s, band_hz[0] if band_hz and band_hz[0] is not None else 0.0),
+                   min(0.95 * hi_s, band_hz[1] if band_hz and band_hz[1] is not None else np.inf))
     method = ("H1" if welch_given else "lpm") if estimator is None else str(estimator)
     if method.lower() == "lpm":
         if welch_given:
             raise DataError("nperseg, window and overlap are Welch settings: they do not apply to the lpm estimator")
-        data = _estimate_lpm(recording, band, width_hz)
+        data = _estimate_lpm(recording, band_hz, width_hz)
     else:
         data = _estimate_welch(recording, nperseg, "hann" if window is None else window,
-                               0.5 if overlap is None else overlap, method, band)
+                               0.5 if overlap is None else overlap, method, band_hz)
     from dataclasses import replace
 
     from .chain import sweep_findings
@@ -162,7 +162,7 @@ def _check_constant(recording: Recording, source, responses):
                             f"{'nothing excited the rig' if name == 'force' else 'the sensor recorded nothing'}")
 
 
-def _estimate_lpm(recording: Recording, band, width_hz) -> FRFData:
+def _estimate_lpm(recording: Recording, band_hz, width_hz) -> FRFData:
     from .chain import clipping_findings, lpm_findings
     from .lpm import lpm
 
@@ -171,10 +171,10 @@ def _estimate_lpm(recording: Recording, band, width_hz) -> FRFData:
         raise DataError(f"{source}: {recording.n_samples} samples is too short for a local-polynomial FRF "
                         f"estimate (need at least 256)")
     _check_constant(recording, source, responses)
-    est = lpm(recording, band=band, width_hz=width_hz)
+    est = lpm(recording, band_hz=band_hz, width_hz=width_hz)
     s = est.settings
     findings = clipping_findings(recording) + lpm_findings(est.freq_hz, est.frf, est.std, s,
-                                                           est.force_noise_bias, band, est.force_noise_bias_bound)
+                                                           est.force_noise_bias, band_hz, est.force_noise_bias_bound)
     floor = 1e-10 * max(np.max(np.abs(h)) for h in est.frf.values())
     std = {c: np.maximum(v, floor) for c, v in est.std.items()}
     info = {"method": "lpm", "reference": "Pintelon et al. 2010, local polynomial method",
@@ -194,7 +194,7 @@ def _estimate_lpm(recording: Recording, band, width_hz) -> FRFData:
                    correlation=est.correlation, bias_bound=est.force_noise_bias_bound)
 
 
-def _estimate_designed(recording: Recording, exc, band) -> FRFData:
+def _estimate_designed(recording: Recording, exc, band_hz) -> FRFData:
     """FRFs of a periodic or an impact excitation (`satmd.io.periodic`, `satmd.io.impact`)."""
     from .chain import clipping_findings
     from .impact import impact_frf, whole_record_frf
@@ -203,17 +203,17 @@ def _estimate_designed(recording: Recording, exc, band) -> FRFData:
 
     source, responses = _check_force(recording)
     if exc.kind == "periodic":
-        f, frf, std, coh, dof = periodic_frf(recording, exc, responses, band)
+        f, frf, std, coh, dof = periodic_frf(recording, exc, responses, band_hz)
         extra = []
         ref = "Pintelon & Schoukens 2012, periodic excitation: mean over steady periods"
         noise = f"spread over {len(exc.steady)} steady periods"
     elif (exc.kind == "impact" and not exc.dropped and "cut_mid_ring" not in recording.meta
           and at_rest_at_the_end(recording, responses)):
-        f, frf, std, coh, dof, extra = whole_record_frf(recording, exc, responses, band)
+        f, frf, std, coh, dof, extra = whole_record_frf(recording, exc, responses, band_hz)
         ref = "hits as one transient: the whole record's spectra, force windowed to its pulses, G fitted locally"
         noise = "local residual, smoothed over neighbouring windows"
     elif exc.kind == "impact":
-        f, frf, std, coh, dof, extra = impact_frf(recording, exc, responses, band)
+        f, frf, std, coh, dof, extra = impact_frf(recording, exc, responses, band_hz)
         ref = "H1 over hits, force window (ISO 7626-5)"
         noise = f"scatter over {len(exc.hits)} hits" if len(exc.hits) > 1 else "the quiet tail of the one hit"
     else:
@@ -221,10 +221,10 @@ def _estimate_designed(recording: Recording, exc, band) -> FRFData:
         from .sweepfrf import sweep_frf
 
         lo, hi, _ = excited_band(recording["force"], recording.fs_hz)
-        lo = lo if not band or band[0] is None else max(lo, band[0])
-        hi = hi if not band or band[1] is None else min(hi, band[1])
+        lo = lo if not band_hz or band_hz[0] is None else max(lo, band_hz[0])
+        hi = hi if not band_hz or band_hz[1] is None else min(hi, band_hz[1])
         if hi <= lo:
-            raise DataError(f"band {band[0]}:{band[1]} Hz holds nothing of the sweep's {lo:.4g}–{hi:.4g} Hz")
+            raise DataError(f"band {band_hz[0]}:{band_hz[1]} Hz holds nothing of the sweep's {lo:.4g}–{hi:.4g} Hz")
         f, frf, std, coh, dof = sweep_frf(recording, responses, (lo, hi))
         extra = []
         ref = "whole-record spectra of a sweep at rest at both ends, G fitted locally (no leakage term)"
@@ -246,7 +246,7 @@ def _estimate_designed(recording: Recording, exc, band) -> FRFData:
     return FRFData(f, frf, std, meta, coherence=coh, estimator=info, bias_bound=np.full(f.size, ESTIMATE_REL_FLOOR))
 
 
-def _estimate_welch(recording: Recording, nperseg, window, overlap, estimator, band) -> FRFData:
+def _estimate_welch(recording: Recording, nperseg, window, overlap, estimator, band_hz) -> FRFData:
     from .chain import clipping_findings, welch_findings
     from .lpm import excited_band
 
@@ -256,14 +256,14 @@ def _estimate_welch(recording: Recording, nperseg, window, overlap, estimator, b
     _check_constant(recording, source, responses)
     # bins the force never excited are noise over noise: keep to the excited band, as the LPM does
     lo, hi, _ = excited_band(recording["force"], recording.fs_hz)
-    requested = band
-    band = (lo if not band or band[0] is None else max(lo, band[0]),
-            hi if not band or band[1] is None else min(hi, band[1]))
-    if band[1] <= band[0]:
+    requested = band_hz
+    band_hz = (lo if not band_hz or band_hz[0] is None else max(lo, band_hz[0]),
+            hi if not band_hz or band_hz[1] is None else min(hi, band_hz[1]))
+    if band_hz[1] <= band_hz[0]:
         raise DataError(f"band {requested[0]}:{requested[1]} Hz holds no frequency bin the force excites "
                         f"({lo:.1f}–{hi:.1f} Hz)")
     results = {r: frf_from_spectra(s, r, est) for r in responses}
-    keep = usable_bins(source, s, [a for res in results.values() for a in res], band)
+    keep = usable_bins(source, s, [a for res in results.values() for a in res], band_hz)
     f = s.freq_hz[keep]
     channels, std, coh = {}, {}, {}
     for r, (h, g, sd) in results.items():

@@ -62,7 +62,7 @@ def windowed_force(recording, excitation):
     return out
 
 
-def whole_record_frf(recording, excitation, responses, band=None):
+def whole_record_frf(recording, excitation, responses, band_hz=None):
     """(freq_hz, frf, std, coherence, noise_dof, findings) of hits taken as one transient of the whole record.
 
     When the rig rests at the record's start and end and no hit was dropped, the responses of all hits
@@ -82,16 +82,16 @@ def whole_record_frf(recording, excitation, responses, band=None):
     on = usable & (smooth >= np.max(smooth[usable]) * 10 ** (-FORCE_BAND_DB / 10))
     idx = np.flatnonzero(on)
     lo, hi = float(f[idx[0]]), float(f[idx[-1]])
-    if band:
-        lo = lo if band[0] is None else max(lo, band[0])
-        hi = hi if band[1] is None else min(hi, band[1])
+    if band_hz:
+        lo = lo if band_hz[0] is None else max(lo, band_hz[0])
+        hi = hi if band_hz[1] is None else min(hi, band_hz[1])
     if hi <= lo:
-        raise DataError(f"the hits excite {f[idx[0]]:.4g}–{f[idx[-1]]:.4g} Hz: nothing left in {band[0]}:{band[1]} Hz")
+        raise DataError(f"the hits excite {f[idx[0]]:.4g}–{f[idx[-1]]:.4g} Hz: nothing left in {band_hz[0]}:{band_hz[1]} Hz")
     freq, frf, std, coh, dof = sweep_frf(recording, responses, (lo, hi), force=x)
     return freq, frf, std, coh, dof, []
 
 
-def impact_frf(recording, excitation, responses, band=None):
+def impact_frf(recording, excitation, responses, band_hz=None):
     """(freq_hz, frf, std, coherence, noise_dof, findings) of an impact recording.
 
     Parameters
@@ -99,7 +99,7 @@ def impact_frf(recording, excitation, responses, band=None):
     recording : Recording
     excitation : an impact `satmd.io.excitation.Excitation`
     responses : recording channels (``acc1``, ``acc2``)
-    band : (lo, hi) Hz, either may be None
+    band_hz : (lo, hi) Hz, either may be None
 
     Returns
     -------
@@ -167,8 +167,8 @@ def impact_frf(recording, excitation, responses, band=None):
         hi_i += 1
     keep = np.zeros(f.size, bool)
     keep[lo_i:hi_i + 1] = True
-    if band:
-        keep &= (f >= (band[0] if band[0] is not None else -np.inf)) & (f <= (band[1] if band[1] is not None
+    if band_hz:
+        keep &= (f >= (band_hz[0] if band_hz[0] is not None else -np.inf)) & (f <= (band_hz[1] if band_hz[1] is not None
                                                                                else np.inf))
     if findings:  # windowed: an offset's error c spreads as c·fs·τ/(1 + iωτ), over the lines below ~3/(2πτ)
         keep &= f >= 3.0 * fs / (2.0 * np.pi * np.sum(w))
@@ -177,7 +177,7 @@ def impact_frf(recording, excitation, responses, band=None):
     keep &= (k - lo_i) % step == 0
     if keep.sum() < 2:
         raise DataError(f"the hits excite {f[lo_i]:.4g}–{f[hi_i]:.4g} Hz (within {FORCE_BAND_DB:g} dB of the force's "
-                        f"peak): no band left{'' if not band else f' in {band[0]}:{band[1]} Hz'}")
+                        f"peak): no band left{'' if not band_hz else f' in {band_hz[0]}:{band_hz[1]} Hz'}")
     n = len(hits)
     # the load cell's noise (each segment's second half, after the pulse), per line over the force window
     var_f = float(np.mean([np.var(np.asarray(recording["force"][s + L // 2:s + L], float)) for s, _ in hits]))

@@ -124,14 +124,15 @@ def _excited(force, fs_hz, smooth_hz=1.0, drop_db=20.0) -> dict:
 
 
 @validate_params({"width_hz": [None, Interval(Real, 0, open="lo")], "degree": [Interval(Whole, 0)]})
-def lpm(recording, band=None, width_hz: float | None = None, degree: int = 2, smooth: int = 10) -> LPMEstimate:
+def lpm(recording, band_hz=None, width_hz: float | None = None, degree: int = 2, smooth: int = 10,
+        band=None) -> LPMEstimate:
     """LPM FRF estimates a1 = acc1/force, a2 = acc2/force on non-overlapping windows.
 
     Parameters
     ----------
     recording : Recording
         With ``force`` and ``acc1`` and/or ``acc2``.
-    band : (lo, hi), optional
+    band_hz : (lo, hi), optional
         Band to estimate in Hz (either may be None); it is cut to the band the
         force excites (`excited_band`).
     width_hz : float, optional
@@ -143,13 +144,18 @@ def lpm(recording, band=None, width_hz: float | None = None, degree: int = 2, sm
         Polynomial degree R of H and T in each window.
     smooth : int
         Half-width, in windows, of the local fit of the noise spectra.
+    band : (lo, hi), optional
+        Former name of ``band_hz`` (deprecated).
 
     Returns
     -------
     LPMEstimate
     """
+    from ..errors import renamed_keyword
     from .chain import sharpest_resonance
     from .recdata import check_rate
+
+    band_hz = renamed_keyword(band, band_hz, "lpm")
 
     check_rate(recording.meta.get("source", "recording"), recording.fs_hz)  # entry check (time in ms, ...)
     fs, n = recording.fs_hz, recording.n_samples
@@ -157,7 +163,7 @@ def lpm(recording, band=None, width_hz: float | None = None, degree: int = 2, sm
     found = _excited(x, fs)
     excited_lo, excited_hi, floor = found["lo"], found["hi"], found["floor"]  # floor: the verdict dict
     lo, hi = excited_lo, excited_hi
-    band_lo, band_hi = (band or (None, None))
+    band_lo, band_hi = (band_hz or (None, None))
     if band_lo is not None:
         lo = max(lo, float(band_lo))
     if band_hi is not None:

@@ -29,15 +29,15 @@ def periodic_spectra(recording, excitation, channel) -> np.ndarray:
     return np.fft.rfft(blocks, axis=1)[:, list(excitation.lines)]
 
 
-def periodic_frf(recording, excitation, responses, band=None):
-    """(freq_hz, frf, std, coherence, noise_dof) at the excited lines within ``band``.
+def periodic_frf(recording, excitation, responses, band_hz=None):
+    """(freq_hz, frf, std, coherence, noise_dof) at the excited lines within ``band_hz``.
 
     Parameters
     ----------
     recording : Recording
     excitation : a periodic `satmd.io.excitation.Excitation`
     responses : recording channels (``acc1``, ``acc2``)
-    band : (lo, hi) Hz, either may be None
+    band_hz : (lo, hi) Hz, either may be None
 
     Returns
     -------
@@ -48,11 +48,11 @@ def periodic_frf(recording, excitation, responses, band=None):
     """
     lines = np.asarray(excitation.lines, int)
     f = lines * recording.fs_hz / excitation.period_samples
-    lo = -np.inf if not band or band[0] is None else band[0]
-    hi = np.inf if not band or band[1] is None else band[1]
+    lo = -np.inf if not band_hz or band_hz[0] is None else band_hz[0]
+    hi = np.inf if not band_hz or band_hz[1] is None else band_hz[1]
     keep = (f >= lo) & (f <= hi)
     if keep.sum() < 2:
-        raise DataError(f"band {band[0]}:{band[1]} Hz holds {int(keep.sum())} of the {lines.size} lines the "
+        raise DataError(f"band {band_hz[0]}:{band_hz[1]} Hz holds {int(keep.sum())} of the {lines.size} lines the "
                         f"periodic force excites ({f[0]:.4g}–{f[-1]:.4g} Hz)")
     U = periodic_spectra(recording, excitation, "force")[:, keep]
     P = U.shape[0]

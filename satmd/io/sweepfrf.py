@@ -41,14 +41,14 @@ def at_rest_at_the_end(recording, responses, strict: bool = False) -> bool:
     return True
 
 
-def sweep_frf(recording, responses, band, force=None):
-    """(freq_hz, frf, std, coherence, noise_dof) of a sweep at rest at both ends, over ``band`` (lo, hi) Hz.
+def sweep_frf(recording, responses, band_hz, force=None):
+    """(freq_hz, frf, std, coherence, noise_dof) of a sweep at rest at both ends, over ``band_hz`` (lo, hi) Hz.
 
     Parameters
     ----------
     recording : Recording
     responses : recording channels (``acc1``, ``acc2``)
-    band : (lo, hi) Hz: the band the force excites
+    band_hz : (lo, hi) Hz: the band the force excites
     force : the force to use instead of the recording's (an impact record's force windowed to its pulses)
 
     Returns
@@ -64,8 +64,8 @@ def sweep_frf(recording, responses, band, force=None):
     X = np.fft.rfft(x - np.median(x) if force is None else x)
     f = np.fft.rfftfreq(n, 1.0 / fs)
     width = 2 * HALF + 1
-    lo_k = max(HALF + 1, int(np.ceil(band[0] * n / fs)))
-    hi_k = min(f.size - HALF - 1, int(np.floor(band[1] * n / fs)))
+    lo_k = max(HALF + 1, int(np.ceil(band_hz[0] * n / fs)))
+    hi_k = min(f.size - HALF - 1, int(np.floor(band_hz[1] * n / fs)))
     centres = np.arange(lo_k, hi_k - HALF, width)
     idx = centres[:, None] + np.arange(-HALF, HALF + 1)[None, :]  # (W, width)
     delta = np.arange(-HALF, HALF + 1) / HALF

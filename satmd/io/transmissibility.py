@@ -7,6 +7,7 @@ from pathlib import Path
 import numpy as np
 
 from ..conventions import ACCEL_CHANNELS
+from ..errors import renamed_keyword
 from ._common import atomic_write
 from .recording import Recording
 from .welch import STD_FLOOR, check_estimator, frf_from_spectra, usable_bins, spectra
@@ -59,8 +60,8 @@ def model_transmissibility(freq_hz, rig=None, effects=()) -> np.ndarray:
 
 
 def transmissibility(recording: Recording, nperseg: int | None = None, window="hann", overlap: float = 0.5,
-                     estimator: str = "H1", band=None, reference: str = "acc1",
-                     response: str = "acc2") -> Transmissibility:
+                     estimator: str = "H1", band_hz=None, reference: str = "acc1",
+                     response: str = "acc2", band=None) -> Transmissibility:
     """Transmissibility response/reference with coherence and std, as `estimate_frf` does for FRFs.
 
     H1 assumes the noise is on ``response``; with comparable noise on both
@@ -82,19 +83,21 @@ def transmissibility(recording: Recording, nperseg: int | None = None, window="h
     estimator : {"H1", "H2"}
         ``H1 = Gxy/Gxx`` (noise on the response) or ``H2 = Gyy/Gyx`` (noise on
         the reference); case does not matter.
-    band : (lo, hi), optional
+    band_hz : (lo, hi), optional
         Band to keep in Hz, either may be None (default: every bin above 0 Hz).
     reference : str
         Channel in the denominator (default ``acc1``, the primary mass).
     response : str
         Channel in the numerator (default ``acc2``, the absorber).
+    band : (lo, hi), optional
+        Former name of ``band_hz`` (deprecated).
 
     Returns
     -------
     Transmissibility
         ``freq_hz``, complex ``value``, ``std`` (on each of Re and Im, floored
         at 1e-10 max|T|) and ``coherence`` on the kept bins (f > 0, inside
-        ``band``, where the reference has energy: others are dropped with a
+        ``band_hz``, where the reference has energy: others are dropped with a
         `DataWarning`); ``meta`` gives the source, estimator, channels and
         Welch settings (``nperseg``, ``segments``, ``resolution_hz``, ``n_eff``, ...).
 
@@ -104,13 +107,14 @@ def transmissibility(recording: Recording, nperseg: int | None = None, window="h
         A missing channel, an unknown estimator or window, Welch settings the
         record cannot support, or a band that holds no usable bin.
     """
+    band_hz = renamed_keyword(band, band_hz, "transmissibility")
     est = check_estimator(estimator)
     source = recording.meta.get("source", "recording")
     for name in (reference, response):
         recording[name]  # noqa: B018 - raises a DataError naming the missing channel
     s = spectra(recording, reference, [response], nperseg, window, overlap)
     h, g, sd = frf_from_spectra(s, response, est)
-    keep = usable_bins(source, s, [h, g, sd], band)
+    keep = usable_bins(source, s, [h, g, sd], band_hz)
     t = h[keep]
     meta = {"source": str(source), "estimator": est, "reference": reference, "response": response, **s.meta,
             "n_eff": f"{s.n_eff:.4g}"}

@@ -167,10 +167,10 @@ def check_estimator(estimator):
     return est
 
 
-def usable_bins(path, s: Spectra, arrays, band):
+def usable_bins(path, s: Spectra, arrays, band_hz):
     """Mask of bins to keep: f > 0, inside the band, finite everywhere (force has energy)."""
     keep = s.freq_hz > 0
-    lo, hi = band if band else (None, None)
+    lo, hi = band_hz if band_hz else (None, None)
     if lo is not None:
         keep &= s.freq_hz >= lo
     if hi is not None:

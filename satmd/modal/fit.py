@@ -148,7 +148,7 @@ def _one_blas_thread():
 
 
 # --- inputs -------------------------------------------------------------------------------------------------
-def _inputs(freq_hz, frf, std, band):
+def _inputs(freq_hz, frf, std, band_hz):
     """(freq, channel names, H (C, M), weights S (C, M), weighted) in the band."""
     if hasattr(frf, "channels"):  # FRFData
         freq_hz = frf.freq_hz if freq_hz is None else freq_hz
@@ -157,7 +157,7 @@ def _inputs(freq_hz, frf, std, band):
     freq = np.asarray(freq_hz, float)
     names = tuple(frf)
     H = np.stack([np.asarray(frf[c], complex) for c in names])
-    keep = np.ones(freq.size, bool) if band is None else (freq >= band[0]) & (freq <= band[1])
+    keep = np.ones(freq.size, bool) if band_hz is None else (freq >= band_hz[0]) & (freq <= band_hz[1])
     if keep.sum() < 8:
         raise ValueError(f"the band holds {keep.sum()} frequencies: a modal fit needs at least 8")
     freq, H = freq[keep], H[:, keep]

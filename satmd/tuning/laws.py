@@ -89,10 +89,10 @@ def effective_rig(rig: Rig, effects: Sequence[Effect]) -> Rig:
     return rig
 
 
-def shunt_modes(rig: Rig, effects: Sequence[Effect], band) -> list[tuple[float, float]]:
+def shunt_modes(rig: Rig, effects: Sequence[Effect], band_hz) -> list[tuple[float, float]]:
     """(f_oc, f_sc) in Hz of each mode the shunt couples to, from the undamped model's peaks."""
     undamped = rig.replace(c1=0.0, cp=0.0)
-    grid = band_grid((band[0] / 1.5, band[1] * 1.5), 0.002)
+    grid = band_grid((band_hz[0] / 1.5, band_hz[1] * 1.5), 0.002)
     peaks = []
     for r in (undamped.replace(R=OPEN_CIRCUIT_R), undamped.replace(R=0.0, L=0.0)):
         def mag(f, r=r):
@@ -111,7 +111,7 @@ def shunt_modes(rig: Rig, effects: Sequence[Effect], band) -> list[tuple[float, 
     return pairs
 
 
-def closed_forms(rig: Rig, effects: Sequence[Effect], design: Sequence[str], kind: str, band) -> list[dict]:
+def closed_forms(rig: Rig, effects: Sequence[Effect], design: Sequence[str], kind: str, band_hz) -> list[dict]:
     """The classical laws that apply to this design, on this rig.
 
     Parameters
@@ -119,7 +119,7 @@ def closed_forms(rig: Rig, effects: Sequence[Effect], design: Sequence[str], kin
     rig, effects : the model
     design : names of the design variables (RL laws need R and L; TMD laws kp and cp)
     kind : "hinf" or "h2" (the H2 TMD law is added for "h2")
-    band : (lo, hi) in Hz; only modes inside it are used
+    band_hz : (lo, hi) in Hz; only modes inside it are used
 
     Returns
     -------
@@ -128,8 +128,8 @@ def closed_forms(rig: Rig, effects: Sequence[Effect], design: Sequence[str], kin
     eff_rig = effective_rig(rig, effects)
     out = []
     if {"R", "L"} <= set(design) and float(eff_rig.e) > 0:
-        for f_oc, f_sc in shunt_modes(rig, effects, band):
-            if not band[0] <= f_oc <= band[1] or f_oc <= f_sc:
+        for f_oc, f_sc in shunt_modes(rig, effects, band_hz):
+            if not band_hz[0] <= f_oc <= band_hz[1] or f_oc <= f_sc:
                 continue
             kc = math.sqrt((f_oc**2 - f_sc**2)) / f_sc
             note = f"mode at {f_oc:.4g} Hz open / {f_sc:.4g} Hz short circuit, k_c = {kc:.3g}"

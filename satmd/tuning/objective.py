@@ -39,19 +39,19 @@ _T = np.linspace(0.0, 1.0, ZOOM_POINTS)
 _S = np.linspace(0.0, 1.0, 101)  # points per peak window
 
 
-def band_grid(band: tuple[float, float], rel_step: float = 0.004) -> np.ndarray:
+def band_grid(band_hz: tuple[float, float], rel_step: float = 0.004) -> np.ndarray:
     """Log-spaced frequencies over a band.
 
     Parameters
     ----------
-    band : (lo, hi) in Hz
+    band_hz : (lo, hi) in Hz
     rel_step : relative spacing of neighbouring points (at least 64 points)
 
     Returns
     -------
     ndarray of frequencies in Hz, both ends included
     """
-    lo, hi = band
+    lo, hi = band_hz
     n = max(64, int(np.ceil(np.log(hi / lo) / rel_step)) + 1)
     return np.geomspace(lo, hi, n)
 

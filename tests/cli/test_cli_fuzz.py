@@ -280,7 +280,7 @@ def cases_damaged_formats(base: Path) -> list[Case]:
 
 def cases_bad_options(base: Path) -> list[Case]:
     """Option values that must be refused, for every command, and options that conflict."""
-    frf, rec, net, opt = "{base}/frf.csv", "{base}/rec.csv", "{base}/net", "{base}/opt"
+    frf, rec, net = "{base}/frf.csv", "{base}/rec.csv", "{base}/net"
     out = "{work}/out.csv"
     numbers = ["nan", "inf", "-inf", "abc", "", "1e999", "0x10"]
     cases = []

@@ -50,7 +50,7 @@ def test_linear_record_passes_and_cubic_output_fails():
         y = y_lin + cubic * _resonator(y_lin ** 3) / _resonator(y_lin ** 3).std() * 3
         y = y + 0.02 * rng.standard_normal(n)
         regs = distortion_regressors({"y": y}, ("square", "cube"))
-        t = linearity_test(x, {"y": y}, 1.0, regs, band=(0.06, 0.29))
+        t = linearity_test(x, {"y": y}, 1.0, regs, band_hz=(0.06, 0.29))
         assert t.significant is expect, t.report()
 
 
@@ -141,7 +141,7 @@ def test_multisine_bla_and_detection_lines():
         y = y + cubic * y ** 3 + 0.01 * rng.standard_normal(y.shape)
         b = multisine_bla(u, y, lines, 1.0)
         assert b["bla"].shape == lines.shape and np.all(np.isfinite(b["var_total"]))
-        t = detection_lines_test(u, y, lines, 1.0, band=(0.0, 0.25))
+        t = detection_lines_test(u, y, lines, 1.0, band_hz=(0.0, 0.25))
         assert t.significant is (cubic > 0), t.report()
         if cubic:
             assert t.details["odd_ratio"] > 3 * max(t.details["even_ratio"], 1.0)

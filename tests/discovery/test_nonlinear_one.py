@@ -58,7 +58,7 @@ def test_separate_test_holds_its_level_on_linear_records(seed):
     x, y = _resonant_record(rng, 1 << 15, 0.0)
     dy = np.gradient(y)
     regs = distortion_regressors({"y": y, "dy": dy}, {"y": ("cube",), "dy": ("cube", "absv", "sign")})
-    t = separate_linearity_test(x, {"y": y}, 1.0, regs, band=(0.06, 0.29), window_hz=0.004, alpha=0.01)
+    t = separate_linearity_test(x, {"y": y}, 1.0, regs, band_hz=(0.06, 0.29), window_hz=0.004, alpha=0.01)
     assert t.p_value > 1e-3, t.report()
 
 
@@ -67,6 +67,6 @@ def test_separate_test_is_more_powerful_than_the_joint_test_for_one_shape():
     x, y = _resonant_record(rng, 1 << 15, 0.03)
     dy = np.gradient(y)
     regs = distortion_regressors({"y": y, "dy": dy}, {"y": ("cube",), "dy": ("cube", "absv", "sign")})
-    joint = linearity_test(x, {"y": y}, 1.0, regs, band=(0.06, 0.29))
-    sep = separate_linearity_test(x, {"y": y}, 1.0, regs, band=(0.06, 0.29), window_hz=0.004)
+    joint = linearity_test(x, {"y": y}, 1.0, regs, band_hz=(0.06, 0.29))
+    sep = separate_linearity_test(x, {"y": y}, 1.0, regs, band_hz=(0.06, 0.29), window_hz=0.004)
     assert sep.significant and sep.p_value < joint.p_value, (sep.report(), joint.report())

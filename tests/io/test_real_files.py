@@ -27,7 +27,7 @@ def test_output_only_acceleration_records():
 
 def test_output_only_file_gives_a_transmissibility():
     rec = load_recording(MPSTD, channel_map="a1=#1,a2=#2")
-    t = transmissibility(rec, band=(1, 400))
+    t = transmissibility(rec, band_hz=(1, 400))
     assert np.all(np.isfinite(t.value)) and np.all((t.coherence >= 0) & (t.coherence <= 1))
     assert t.freq_hz[0] > 0 and t.freq_hz[-1] <= 400
 

@@ -342,7 +342,7 @@ def test_default_nperseg():
 
 def test_transmissibility_matches_the_model(rec):
     oo = Recording(rec.fs_hz, {"acc1": rec["acc1"], "acc2": rec["acc2"]})
-    t = transmissibility(oo, nperseg=1024, band=(40, 130))
+    t = transmissibility(oo, nperseg=1024, band_hz=(40, 130))
     model = model_transmissibility(t.freq_hz)
     assert np.median(np.abs(t.value - model) / np.abs(model)) < 0.02
     np.testing.assert_allclose(t.model(), model)
