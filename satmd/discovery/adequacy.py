@@ -177,7 +177,7 @@ def drop_stretched(search, nominal, final, rig) -> tuple:
     """
     from dataclasses import replace
 
-    from ..conventions import MIN_DELTA_BIC
+    from .select import backward
 
     dropped: dict = {}
     if not final.names or not trusted(nominal.fit):
@@ -189,14 +189,7 @@ def drop_stretched(search, nominal, final, rig) -> tuple:
         for n in _blame(search, final, nominal, rig, reasons):
             dropped[n] = [r for r in reasons if r.kind != "effect_at_bound" or r.evidence.get("effect") == n]
             final = search.remove(final, n, nominal)
-        changed = True
-        while changed and final.names:  # what is left must still earn its place
-            changed = False
-            for n in final.names:
-                without = search.remove(final, n, nominal)
-                if without.bic - final.bic <= MIN_DELTA_BIC:
-                    final, changed = without, True
-                    break
+        final = backward(search, final, nominal)  # what is left must still earn its place
     if dropped:  # the equivalents are sought among the candidates that were not stretched
         search = replace(search, candidates=tuple(c for c in search.candidates if c not in dropped))
     return search, final, dropped

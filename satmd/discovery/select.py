@@ -156,11 +156,11 @@ def select(search: Search, nominal: Model, still_significant, max_effects: int =
     lowest = min(m.bic for m in reached)
     best = min((m for m in reached if m.bic - lowest < MIN_DELTA_BIC), key=lambda m: (len(m.names), m.bic))
     if best.names:  # a swap, or a better basin found for a smaller set, can leave an effect without its place
-        best = _backward(search, _swaps(search, _backward(search, best, nominal), nominal), nominal)
+        best = backward(search, _swaps(search, backward(search, best, nominal), nominal), nominal)
     return best
 
 
-def _backward(search, model, nominal):
+def backward(search, model, nominal):
     """Drop effects, one at a time, until each lowers BIC by more than MIN_DELTA_BIC against the model
     refitted without it."""
     changed = True

@@ -2,7 +2,7 @@
 from types import SimpleNamespace
 
 from satmd.conventions import MIN_DELTA_BIC
-from satmd.discovery.select import Model, _backward
+from satmd.discovery.select import Model, backward
 
 
 class _Search:
@@ -21,11 +21,11 @@ def test_the_last_effect_found_is_checked_too():
     model = Model(("a", "b"), [None, None], SimpleNamespace(bic=500.0))
     # without a: far worse; without b (the last found): within MIN_DELTA_BIC, as a better basin can leave it
     search = _Search({("b",): 900.0, ("a",): 500.0 + MIN_DELTA_BIC / 2})
-    assert _backward(search, model, nominal).names == ("a",)
+    assert backward(search, model, nominal).names == ("a",)
 
 
 def test_effects_that_earn_their_place_stay():
     nominal = Model((), [], SimpleNamespace(bic=1000.0))
     model = Model(("a", "b"), [None, None], SimpleNamespace(bic=500.0))
     search = _Search({("b",): 900.0, ("a",): 500.0 + 3 * MIN_DELTA_BIC})
-    assert _backward(search, model, nominal).names == ("a", "b")
+    assert backward(search, model, nominal).names == ("a", "b")
