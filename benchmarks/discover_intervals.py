@@ -9,7 +9,9 @@ every coefficient (friction: Fc; v0 is a regularisation, reported but not scored
 
 Writes benchmarks/results/discover_intervals.json (``--out``; ``--merge`` joins parts) and prints one
 line of figures.
-Usage: python benchmarks/discover_intervals.py [--seeds 10] [--elements a,b] [--duration 30]
+Usage: python benchmarks/discover_intervals.py [--seeds 10] [--seed-offset 0] [--elements a,b] [--duration 30]
+           [--out PART.json]   (rewritten after every case)
+       python benchmarks/discover_intervals.py --merge PART1.json PART2.json ... [--out ...]
 """
 from __future__ import annotations
 
@@ -33,28 +35,32 @@ SCORED = {"cubic_absorber_spring": ("k3",), "cubic_host_spring": ("k3",), "quadr
           "absorber_friction": ("Fc",), "inductor_saturation": ("isat",)}
 
 
-def run(name, seeds, duration):
+def run(name, seeds, duration, offset=0, done=None):
+    """``seeds`` rigs of element ``name``, drawn from the part's own stream (``offset`` 0 is the first part's);
+    ``done(cases)`` is called after each case (a run stopped early keeps what it did)."""
     from satmd.discovery import discover
     from satmd.physics import Rig
 
     e_i = indep.ELEMENTS.index(name)
-    rng = np.random.default_rng(7000 + e_i)
+    rng = np.random.default_rng(7000 + e_i if offset == 0 else [7000 + e_i, offset])
     rigs = [Rig(m2=rng.uniform(0.4, 0.7), kp=rng.uniform(8e4, 1.5e5), R=rng.uniform(10, 60),
                 L=rng.uniform(0.04, 0.2)) for _ in range(seeds)]
     params = [nm._strength(name, r, rng) for r in rigs]
-    recs, _ = nm._recordings(name, rigs, params, duration, 8000 + e_i)
+    recs, _ = nm._recordings(name, rigs, params, duration, 8000 + e_i if offset == 0 else [8000 + e_i, offset])
     cases = []
     for i, par in enumerate(params):
         t0 = time.perf_counter()
         rep = discover([recs[(i, 1.0)], recs[(i, 10.0)]])
         sec = time.perf_counter() - t0
         found = rep.nonlinear.findings[0] if rep.nonlinear is not None and rep.nonlinear.findings else {}
-        case = {"seed": i, "truth": par, "named": found.get("name"), "parameters": found.get("parameters", {}),
+        case = {"seed": offset + i, "truth": par, "named": found.get("name"), "parameters": found.get("parameters", {}),
                 "ci95": found.get("ci95", {}), "seconds": sec}
         case["covered"] = {k: bool(k in case["ci95"] and case["ci95"][k][0] <= par[k] <= case["ci95"][k][1])
                            for k in SCORED[name]}
         cases.append(case)
-        print(f"  {name} #{i}: {case['named']}, covered {case['covered']}, {sec:.1f} s", flush=True)
+        if done is not None:
+            done(cases)
+        print(f"  {name} #{offset + i}: {case['named']}, covered {case['covered']}, {sec:.1f} s", flush=True)
     return cases
 
 
@@ -67,24 +73,43 @@ def summary(result) -> str:
     return "; ".join(parts)
 
 
+def _commit():
+    import subprocess
+
+    try:
+        return subprocess.run(["git", "rev-parse", "--short", "HEAD"], cwd=ROOT, capture_output=True, text=True,
+                              timeout=10).stdout.strip() or None
+    except OSError:
+        return None
+
+
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--seeds", type=int, default=10)
+    ap.add_argument("--seed-offset", type=int, default=0, help="the part's first seed: parts run apart draw other rigs")
     ap.add_argument("--duration", type=float, default=30.0)
     ap.add_argument("--elements", default=",".join(SCORED))
     ap.add_argument("--out", type=Path, default=ROOT / "benchmarks" / "results" / "discover_intervals.json")
-    ap.add_argument("--merge", nargs="+", type=Path, default=None)
+    ap.add_argument("--merge", nargs="+", type=Path, default=None, help="join parts' cases (per element) into --out")
     args = ap.parse_args(argv)
     if args.merge:
-        result = {"elements": {}}
+        result = {"elements": {}, "parts": []}
         for p in args.merge:
             part = json.loads(p.read_text())
-            result["elements"].update(part["elements"])
-            result.setdefault("machine", part.get("machine"))
+            for name, cases in part["elements"].items():
+                have = {c["seed"]: c for c in result["elements"].get(name, [])}
+                have.update({c["seed"]: c for c in cases})  # a later part's case replaces the same seed
+                result["elements"][name] = [have[k] for k in sorted(have)]
+            result["parts"].append({"file": p.name, "machine": part.get("machine"),
+                                    "satmd_commit": part.get("satmd_commit"), "duration_s": part.get("duration_s")})
     else:
-        result = {"machine": machine(), "duration_s": args.duration, "elements": {}}
+        result = {"machine": machine(), "duration_s": args.duration, "satmd_commit": _commit(), "elements": {}}
         for name in args.elements.split(","):
-            result["elements"][name] = run(name, args.seeds, args.duration)
+            def done(cases, name=name):
+                result["elements"][name] = cases
+                args.out.write_text(json.dumps(result, indent=1, default=float))
+
+            result["elements"][name] = run(name, args.seeds, args.duration, args.seed_offset, done)
     args.out.write_text(json.dumps(result, indent=1, default=float))
     print(summary(result))
 
