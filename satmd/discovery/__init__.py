@@ -32,11 +32,11 @@ from .._fleet import fleet_map
 from ..identification import identify
 from ..io.frfdata import FRFData, require_data
 from ..physics import Rig
-from .adequacy import after_search, assess_fit, drop_stretched, inadequate_report, withdraw_if_inadequate
+from .adequacy import Reason, after_search, assess_fit, drop_stretched, inadequate_report, withdraw_if_inadequate
 from .budget import bias_note, evidence_beyond_bias
 from .candidates import default_candidates
 from .discrepancy import fit_discrepancy
-from .findings import UNEXPLAINED, EffectFinding, UnexplainedFinding
+from .findings import UNEXPLAINED, EffectFinding, Judged, UnexplainedFinding
 from .locate import test_mismatch
 from .noise import estimate_std
 from .report import SCHEMA, DiscoveryReport, describe_effect, describe_unexplained
@@ -111,7 +111,7 @@ def discover(
     if not data.estimator:
         return report
     report = replace(report, estimator=dict(data.estimator),
-                     measurement=list(data.estimator.get("measurement", [])) + list(report.measurement))
+                     notes=list(data.estimator.get("measurement", [])) + list(report.notes))
     if recording is not None:  # one recording: is it linear at all? (issue 26)
         from .nonlinear_discover import check_one
 
@@ -192,7 +192,7 @@ def _discover_frf(data: FRFData, rig, free, candidates, channels, alpha, max_eff
     p_values = {"global": test0.p_global, "band": test0.p_band}
     if not test0.significant:
         return DiscoveryReport(significant_mismatch=False, noise=noise, mismatch_bands_hz=test0.bands_hz,
-                               effects=[], parameters=dict(nominal_fit.values), fit_before=before, fit_after=before,
+                               judged=(), parameters=dict(nominal_fit.values), fit_before=before, fit_after=before,
                                nominal_fit=nominal_fit, final_fit=nominal_fit, discrepancy=None, p_values=p_values,
                                whiteness=test0.whiteness, wall_time=time.perf_counter() - t0)
 
@@ -204,8 +204,9 @@ def _discover_frf(data: FRFData, rig, free, candidates, channels, alpha, max_eff
 
     final = select_effects(search, nominal, significant, max_effects)
     # a good, plausible nominal fit: a candidate the search stretches is left out, not held against the model
-    search, final, set_aside = drop_stretched(search, nominal, final, rig)
-    effects, bias_notes = [], []
+    search, final, stretched = drop_stretched(search, nominal, final, rig)
+    judged = [Judged(name, "set_aside", tuple(reasons) or (Reason("implausible", "stretched past a plausible magnitude"),))
+              for name, reasons in stretched.items()]
     if final.names:
         equiv = equivalents(search, final, nominal)
         without = {n: search.remove(final, n, nominal) for n in final.names}
@@ -215,39 +216,46 @@ def _discover_frf(data: FRFData, rig, free, candidates, channels, alpha, max_eff
             # what accounting for this effect does to the free parameters (vs the model without it)
             ref = without[name].fit.values
             shifts = {k: final.fit.values[k] / ref[k] - 1 for k in free if ref[k]}
+            finding = EffectFinding(name=name, parameters={k: float(v) for k, v in eff.params.items()
+                                                           if search.measured(k)},
+                                    equivalent=equiv[name], delta_bic=round(float(dbic[name]), 2),
+                                    explanation=describe_effect(eff, rig, shifts), shifts=shifts)
             evidence = evidence_beyond_bias(final.fit, without[name].fit, data.bias_bound)
             if evidence <= MIN_DELTA_BIC:  # the estimator's own bias could make it: kept in the fit, not named
-                bias_notes.append(bias_note(name, describe_effect(eff, rig, shifts), evidence, data.bias_bound))
-                continue
-            effects.append(EffectFinding(name=name, parameters={k: float(v) for k, v in eff.params.items()
-                                                                if search.measured(k)},
-                                         equivalent=equiv[name], delta_bic=round(float(dbic[name]), 2),
-                                         explanation=describe_effect(eff, rig, shifts), shifts=shifts))
+                note = bias_note(name, finding.explanation, evidence, data.bias_bound)
+                judged.append(Judged(name, "measurement", (Reason("within_estimator_bias", note["explanation"],
+                                                                  {"delta_bic_beyond_bias": evidence}),),
+                                     finding, note))
+            else:
+                judged.append(Judged(name, finding=finding))
     after = _fit_summary(final.fit)
     test1 = test_mismatch(final.fit, alpha, noise_dof)
-    disc, noise_notes = None, []
+    disc = None
     if test1.significant:
         disc = _unexplained(final.fit)
         structured = disc.structured_fraction
         dof = max(final.fit.dof - disc.n_parameters, 1)
         after = {"chi2_reduced": disc.chi2_after / dof, "rel_error": _rel_error(final.fit, disc)}
         n_terms = sum(disc.terms.values())
-    if test1.significant and structured < NOISE_LIKE:
-        # no smooth structure left to take: a statement about the noise model, not about physics
-        noise_notes.append(_noise_like(final.fit))
-    elif test1.significant:
-        assert disc is not None  # found when test1 is significant
-        effects.append(UnexplainedFinding(
+        finding = UnexplainedFinding(
             name=UNEXPLAINED, parameters={}, equivalent=[],
             delta_bic=round(float(final.fit.chi2 - disc.chi2_after - disc.n_parameters * _log_n(final.fit)), 2),
             explanation=describe_unexplained(test1.bands_hz, structured, n_terms),
-            bands_hz=test1.bands_hz, structured_fraction=structured, n_terms=n_terms))
+            bands_hz=test1.bands_hz, structured_fraction=structured, n_terms=n_terms)
+        if structured < NOISE_LIKE:
+            # no smooth structure left to take: a statement about the noise model, not about physics
+            note = _noise_like(final.fit)
+            judged.append(Judged(UNEXPLAINED, "measurement", (Reason("noise_like", note["explanation"],
+                                                                     {"structured_fraction": structured}),),
+                                 finding, note))
+        else:
+            judged.append(Judged(UNEXPLAINED, finding=finding))
     p_values.update({"global_after": test1.p_global, "band_after": test1.p_band})
-    report = DiscoveryReport(significant_mismatch=True, noise=noise, mismatch_bands_hz=test0.bands_hz, effects=effects,
-                           parameters={k: final.fit.values[k] for k in free}, fit_before=before, fit_after=after,
-                           nominal_fit=nominal_fit, final_fit=final.fit, discrepancy=disc, p_values=p_values,
-                           whiteness=test0.whiteness, wall_time=time.perf_counter() - t0,
-                           measurement=bias_notes + noise_notes, set_aside=set_aside)
+    report = DiscoveryReport(significant_mismatch=True, noise=noise, mismatch_bands_hz=test0.bands_hz,
+                             judged=tuple(judged), parameters={k: final.fit.values[k] for k in free},
+                             fit_before=before, fit_after=after, nominal_fit=nominal_fit, final_fit=final.fit,
+                             discrepancy=disc, p_values=p_values, whiteness=test0.whiteness,
+                             wall_time=time.perf_counter() - t0)
     return withdraw_if_inadequate(report, after_search(final.fit, final.effects, rig, disc))
 
 

@@ -221,18 +221,18 @@ def inadequate_report(verdict, fit, alpha: float, t0: float):
         significant, bands, white = test.significant, test.bands_hz, test.whiteness
         p_values = {"global": test.p_global, "band": test.p_band}
     return DiscoveryReport(significant_mismatch=bool(significant), noise="given" if fit.weighted else "estimated",
-                           mismatch_bands_hz=bands, effects=[], parameters=dict(fit.values), fit_before=summary,
+                           mismatch_bands_hz=bands, judged=(), parameters=dict(fit.values), fit_before=summary,
                            fit_after=summary, nominal_fit=fit, final_fit=fit, discrepancy=None, p_values=p_values,
                            whiteness=white, wall_time=time.perf_counter() - t0, adequacy=verdict)
 
 
 def withdraw_if_inadequate(report, reasons):
-    """``report`` unchanged when ``reasons`` is empty; else without effects, with the verdict and its evidence
-    (the nominal parameters; ``fit_after`` still says how far the best augmented model got)."""
-    from dataclasses import replace
-
+    """``report`` unchanged when ``reasons`` is empty; else its named candidates withdrawn for them, with the
+    verdict and its evidence (the nominal parameters; ``fit_after`` still says how far the best augmented model
+    got)."""
     if not reasons:
         return report
     fit = report.nominal_fit
-    return replace(report, effects=[], parameters={k: fit.values[k] for k in report.parameters},
-                   final_fit=fit, discrepancy=None, adequacy=Adequacy(False, tuple(reasons)))
+    return report.rejudged(lambda j: True, "withdrawn", reasons,
+                           parameters={k: fit.values[k] for k in report.parameters}, final_fit=fit, discrepancy=None,
+                           adequacy=Adequacy(False, tuple(reasons)))

@@ -110,3 +110,44 @@ class NonlinearFinding:
     def get(self, key: str, default=None):
         """The value of a JSON key, or ``default`` when it is absent."""
         return self[key] if key in self else default
+
+
+#: What became of a candidate (SPEC §9): ``named`` physics; ``set_aside`` (the search stretched it, or the data
+#: are nonlinear and it stands in for that); ``measurement`` (the estimator or the noise could make it);
+#: ``withdrawn`` (named, then the model was found not to describe the data at all).
+STATUSES = ("named", "set_aside", "measurement", "withdrawn")
+
+#: Reason kinds that set a candidate aside because the data are nonlinear (told in the ``nonlinear`` block).
+NONLINEAR_KINDS = ("distortion", "level_dependence")
+
+
+@dataclass(frozen=True)
+class Judged:
+    """One candidate of a discovery and the verdict on it: every candidate ends here, with one status.
+
+    Parameters
+    ----------
+    name : the candidate's name (an effect of SPEC §8, or ``unexplained``).
+    status : one of `STATUSES`.
+    reasons : `Reason` objects saying why it is not named (empty when named).
+    finding : what the candidate says of the data (None for a candidate the search set aside unfitted).
+    note : the ``measurement`` entry (name, explanation, remedy, corrected) when the status is ``measurement``.
+    """
+
+    name: str
+    status: str = "named"
+    reasons: tuple = ()
+    finding: EffectFinding | None = None
+    note: dict | None = None
+
+    def __post_init__(self):
+        if self.status not in STATUSES:
+            raise ValueError(f"status {self.status!r}: one of {', '.join(STATUSES)}")
+        if self.status != "named" and not self.reasons:
+            raise ValueError(f"{self.name}: a candidate that is not named needs a reason")
+
+    def judged(self, status: str, reasons) -> "Judged":
+        """The same candidate under another verdict."""
+        from dataclasses import replace
+
+        return replace(self, status=status, reasons=tuple(reasons))

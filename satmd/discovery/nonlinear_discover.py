@@ -29,6 +29,7 @@ from dataclasses import replace
 
 import numpy as np
 
+from ..identification.adequacy import Reason
 from .nonlinear_findings import analyse_recordings
 
 _UNEXPLAINED = "unexplained"
@@ -122,12 +123,25 @@ def discover_recordings(items, linear, rig=None, free=None, alpha: float = 1e-3,
         from .nonlinear_modes import unexplained_by_modes
 
         return replace(rep, nonlinear=unexplained_by_modes(nl, datas, unit))
-    drop = {_UNEXPLAINED} | ({f"parameter_offset:{moving}"} if moving else set())
-    if not moving:
-        drop |= {e.name for e in rep.effects}
-    kept = [e for e in rep.effects if e.name not in drop]
-    aside = [e.name for e in rep.effects if e.name in drop]
-    return replace(rep, effects=kept, nonlinear=replace(nl, set_aside=aside))
+    # with the moving parameter free, an effect that restates it (or what is left unexplained) is the
+    # nonlinearity seen at one level; without one, every linear effect may be
+    picked = [j.name for j in rep.judged if j.status == "named" and _stands_in(j, moving, rig)]
+    why = (f"{moving} moves with level ({finding.get('direction', 'changes')}): a linear effect at one level that "
+           "restates it is the nonlinearity seen there" if moving else
+           "the data depend on level: a linear effect fitted at one level stands in for the nonlinearity")
+    return rep.rejudged(lambda j: j.name in picked, "set_aside", [Reason("level_dependence", why, {"moving": moving})],
+                        nonlinear=replace(nl, set_aside=picked))
+
+
+def _stands_in(judged, moving, rig) -> bool:
+    """True when a named candidate may be the nonlinearity seen at one level: the unexplained rest, any effect
+    when no parameter is known to move, else an effect that changes the moving parameter itself."""
+    from ..physics import Rig
+    from ..physics.effects import at_rest
+
+    if judged.name == _UNEXPLAINED or not moving:
+        return True
+    return getattr(at_rest(judged.name, rig or Rig()), "parameter", None) == moving
 
 
 #: Impact files whose median hit heights lie within this factor are repeats of one test, not levels.
@@ -190,5 +204,8 @@ def check_one(report, recording, alpha: float = 1e-3, rig=None, free=None):
         return report
     if not nl.detected:
         return replace(report, nonlinear=nl)
-    aside = [e.name for e in report.effects]
-    return replace(report, effects=[], nonlinear=replace(nl, set_aside=aside))
+    aside = report.effect_names
+    why = Reason("distortion", "the record is distorted (nonlinear): a linear effect fitted to it stands in for the "
+                               "nonlinearity", {"p_value": min((float(t.p_value) for t in nl.tests if not t.not_run),
+                                                               default=None)})
+    return report.rejudged(lambda j: True, "set_aside", [why], nonlinear=replace(nl, set_aside=aside))

@@ -5,7 +5,7 @@ import json
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING
 
-from .findings import UNEXPLAINED
+from .findings import NONLINEAR_KINDS, UNEXPLAINED
 from ..conventions import MIN_DELTA_BIC
 
 if TYPE_CHECKING:
@@ -20,7 +20,7 @@ class DiscoveryReport:
     significant_mismatch: bool
     noise: str  # "given" or "estimated"
     mismatch_bands_hz: list
-    effects: list  # EffectFinding, most important first
+    judged: tuple  # Judged: every candidate with its verdict; the named ones, most important first, are `effects`
     parameters: dict
     fit_before: dict
     fit_after: dict
@@ -33,10 +33,52 @@ class DiscoveryReport:
     wall_time: float = 0.0
     # --- from recordings: how the FRFs were estimated, and what the chain did (SPEC §9) ---
     estimator: dict = field(default_factory=dict)
-    measurement: list = field(default_factory=list)  # dicts: name, explanation, remedy, corrected
+    notes: list = field(default_factory=list)  # the chain's measurement findings (dicts), no candidate's
     nonlinear: NonlinearReport | None = None  # (SPEC §9 ``nonlinear`` block), when time data or levels were given
     adequacy: Adequacy | None = None  # (SPEC §9 ``model_adequate``); None: adequate (nothing spoke against it)
-    set_aside: dict = field(default_factory=dict)  # {effect: [Reason]}: candidates the search stretched, left out
+
+    @property
+    def effects(self) -> list:
+        """The named physics (`EffectFinding`, most important first)."""
+        return [j.finding for j in self.judged if j.status == "named"]
+
+    @property
+    def set_aside(self) -> dict:
+        """{candidate: [Reason]} the search stretched past a plausible magnitude (those set aside because the
+        data are nonlinear are told in the ``nonlinear`` block)."""
+        return {j.name: list(j.reasons) for j in self.judged
+                if j.status == "set_aside" and not any(r.kind in NONLINEAR_KINDS for r in j.reasons)}
+
+    @property
+    def withdrawn(self) -> list:
+        """Candidates the search named before the model was found not to describe the data."""
+        return [j.name for j in self.judged if j.status == "withdrawn"]
+
+    @property
+    def measurement(self) -> list:
+        """SPEC §9 ``measurement``: the chain's findings, then each candidate the estimator or the noise could
+        make (dicts: name, explanation, remedy, corrected)."""
+        return list(self.notes) + [j.note for j in self.judged if j.status == "measurement" and j.note]
+
+    def rejudged(self, named_only, status: str, reasons, **changes) -> "DiscoveryReport":
+        """The report with a later rule's verdict: each named candidate that ``named_only(judged)`` picks gets
+        ``status`` for ``reasons``; ``changes`` are the other fields that verdict changes.
+
+        Parameters
+        ----------
+        named_only : predicate on a named `Judged` (True: the rule applies to it).
+        status : one of `findings.STATUSES`.
+        reasons : the `Reason` objects of the verdict.
+        **changes : other fields of the report to set alongside (``nonlinear``, ``adequacy``, ...).
+
+        Returns
+        -------
+        DiscoveryReport
+        """
+        from dataclasses import replace
+
+        judged = tuple(j.judged(status, reasons) if j.status == "named" and named_only(j) else j for j in self.judged)
+        return replace(self, judged=judged, **changes)
 
     @property
     def model_adequate(self) -> bool:
@@ -99,6 +141,9 @@ class DiscoveryReport:
             lines.append(f"    MODEL NOT ADEQUATE: {self.adequacy.summary}. No physics is named: the SATMD model, "
                          "with any vocabulary effects, does not describe these data.")
             lines += [f"      - {r.kind}: {r.message}" for r in self.adequacy_reasons]
+            if self.withdrawn:
+                lines.append(f"    withdrawn: {', '.join(self.withdrawn)} (what the search fitted before the model was "
+                             "found not to describe the data)")
             return self._with_nonlinear(lines)
         if not self.significant_mismatch:
             lines.append("    The nominal model fits within the noise: no missing physics is needed.")

@@ -215,6 +215,8 @@ def test_a_candidate_stretched_on_a_good_nominal_fit_is_dropped_not_held_against
     assert implausible_values(rep.final_fit) == {}  # what is reported is plausible
     # ... and the report says what it set aside, and why, in its text and its JSON
     assert list(rep.set_aside) == ["structural_damping"]
+    assert [(j.name, j.status) for j in rep.judged if j.name == "structural_damping"] == [("structural_damping",
+                                                                                           "set_aside")]
     assert "set aside: structural_damping" in rep.report()
     aside = rep.to_dict()["set_aside"]
     assert aside[0]["name"] == "structural_damping" and aside[0]["reasons"][0]["kind"] == "implausible"
@@ -256,6 +258,10 @@ def test_another_structure_that_reaches_the_search_stays_inadequate(monkeypatch)
     assert len(seen) == 1 and seen[0]["dropped"] == {} and seen[0]["kept"] == seen[0]["selected"]
     assert not rep.model_adequate and rep.effects == []
     assert set(_kinds(rep)) & {"structure_left", "effect_at_bound", "implausible"}
+    # what the search had named is not lost: withdrawn, with the verdict's reasons, in the text too
+    assert rep.withdrawn and {j.status for j in rep.judged} <= {"withdrawn", "set_aside", "measurement"}
+    assert all(j.reasons for j in rep.judged if j.status == "withdrawn")
+    assert "withdrawn: " + rep.withdrawn[0] in rep.report()
 
 
 def test_a_noisy_measurement_of_a_satmd_rig_is_not_called_inadequate():

@@ -23,6 +23,10 @@ def test_a_gain_inside_the_bias_bound_is_a_measurement_finding_not_physics():
     notes = [m for m in rep.measurement if m["name"] == "within_estimator_bias"]
     assert len(notes) == 1 and notes[0]["explanation"].startswith("sensor_gain")
     assert rep.fit_after["chi2_reduced"] < 1.5  # the fit keeps it: nothing left for `unexplained`
+    judged = {j.name: j for j in rep.judged}
+    assert judged["sensor_gain"].status == "measurement"
+    assert judged["sensor_gain"].reasons[0].kind == "within_estimator_bias"
+    assert judged["sensor_gain"].finding.parameters  # what it would have said is kept
     assert "within_estimator_bias" in rep.report()
 
 
