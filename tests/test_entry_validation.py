@@ -109,3 +109,30 @@ def test_modal_and_retune_entry_points_validate_their_arguments():
         follow_modes(f, [H, H], alpha=1.5)
     with pytest.raises(DataError, match="^retune: band_hz must be"):
         retune([], band_hz=(200.0, 20.0))
+
+
+def test_every_public_function_checks_its_arguments():
+    """Every function `import satmd` exports validates through `validate_params` (its table is on it)."""
+    import inspect
+
+    import satmd
+
+    bare = [n for n in satmd.__all__ if inspect.isfunction(getattr(satmd, n))
+            and not hasattr(getattr(satmd, n), "parameter_constraints")]
+    assert not bare, f"public functions without validate_params: {bare}"
+
+
+@pytest.mark.parametrize("call, message", [
+    (lambda s: s.load_frf(3), r"^load_frf: path must be a str or a PathLike, got 3$"),
+    (lambda s: s.load_recording(None), r"^load_recording: path must be a str or a PathLike, got None$"),
+    (lambda s: s.save_frf({"a1": 1}, "x.csv"), r"^save_frf: data must be a FRFData, got \{'a1': 1\}$"),
+    (lambda s: s.effect(3), r"^effect: name must be a str, got 3$"),
+    (lambda s: s.nonlinear_element(["cubic_host_spring"]), r"^element: name must be a str"),
+    (lambda s: s.frf([50.0], threads=0), r"^frf: threads must be None or"),
+    (lambda s: s.discover_many([], chunksize=0), r"^discover_many: chunksize must be"),
+])
+def test_a_wrong_argument_is_one_line_naming_it(call, message):
+    import satmd
+
+    with pytest.raises(DataError, match=message):
+        call(satmd)

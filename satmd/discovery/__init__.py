@@ -133,6 +133,7 @@ def _discover_one(data, kwargs):
     return discover(data, **kwargs)
 
 
+@validate_params({"progress": [bool], "chunksize": [Interval(Whole, 1)]})
 def discover_many(datas: Sequence, executor=None, progress: bool = False, chunksize: int = 1,
                   **kwargs) -> list[DiscoveryReport]:
     """Run `discover` on every dataset in ``datas`` (same keyword arguments).

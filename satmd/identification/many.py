@@ -5,6 +5,7 @@ from functools import partial
 from typing import TYPE_CHECKING, Sequence
 
 from .._fleet import fleet_map
+from ..validation import Interval, Whole, validate_params
 from ..io.frfdata import FRFData, require_data
 from .fit import identify
 
@@ -16,6 +17,7 @@ def _fit_one(data, kwargs):
     return identify(data, **{"warn": False, **kwargs})  # warnings stay on the results unless asked for
 
 
+@validate_params({"progress": [bool], "chunksize": [Interval(Whole, 1)]})
 def identify_many(datas: Sequence[FRFData], executor: Executor | None = None, progress: bool = False,
                   chunksize: int = 1, **kwargs) -> list:
     """Fit every FRF in ``datas`` (same keyword arguments as `identify`).

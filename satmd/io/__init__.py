@@ -12,10 +12,13 @@ type 4), ``.mat`` and ``.npz`` (documented variable names, see
 """
 from __future__ import annotations
 
+
 import inspect
+import os
 from pathlib import Path
 
-from ..errors import DataError, FormatError
+from ..errors import DataError, DataTypeError, FormatError
+from ..validation import validate_params
 from ._common import DataWarning, writer_for
 from .csvfrf import read_csv, write_csv
 from .estimate import (
@@ -40,6 +43,7 @@ WRITERS = {".csv": write_csv, ".uff": write_uff, ".unv": write_uff, ".mat": writ
            ".npz": write_frf_variables}
 
 
+@validate_params({"path": [str, os.PathLike]}, error=DataTypeError)
 def load_frf(path, **options) -> FRFData:
     """Load FRFs from a file; the reader is chosen by the suffix.
 
@@ -89,6 +93,7 @@ def load_frf(path, **options) -> FRFData:
         raise FormatError(path, str(exc)) from None
 
 
+@validate_params({"data": [FRFData], "path": [str, os.PathLike]}, error=DataTypeError)
 def save_frf(data: FRFData, path, **options) -> Path:
     """Save FRFs; the writer is chosen by the suffix.
 

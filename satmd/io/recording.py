@@ -26,9 +26,11 @@ mismatched lengths and non-uniform sampling with a one-line `FormatError`.
 """
 from __future__ import annotations
 
+import os
 from pathlib import Path
 
-from ..errors import DataError, FormatError
+from ..errors import DataError, DataTypeError, FormatError
+from ..validation import validate_params
 from ._common import read_text, text_lines, writer_for
 from .limits import MAX_BINARY_BYTES, check_file
 from .csvrec import CSV_MAGIC, read_recording_csv, write_recording_csv
@@ -66,6 +68,7 @@ RECORDING_WRITERS = {".csv": write_recording_csv, ".uff": write_recording_uff, "
                      ".mat": write_recording_variables}
 
 
+@validate_params({"path": [str, os.PathLike], "channel_map": [None, str], "scale": [None, dict]}, error=DataTypeError)
 def load_recording(path, channel_map=None, scale=None, fs_hz=None) -> Recording:
     """Load a time recording; the reader is chosen by the suffix (see the module docstring).
 
@@ -126,6 +129,7 @@ def load_recording(path, channel_map=None, scale=None, fs_hz=None) -> Recording:
     return rec
 
 
+@validate_params({"rec": [Recording], "path": [str, os.PathLike]}, error=DataTypeError)
 def save_recording(rec: Recording, path) -> Path:
     """Save a time recording; the writer is chosen by the suffix (see the module docstring).
 

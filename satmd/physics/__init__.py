@@ -25,7 +25,8 @@ from .effects import (
     registered_names,
     unregister,
 )
-from ..errors import DataError
+from ..errors import DataError, DataTypeError
+from ..validation import validate_params
 from .model import CHANNELS, STATES, Response, frf, parameter_names, solve, terms
 from .rig import PAPER_GRID_HZ, PARAMETER_INFO, Rig
 from .nonlinear import (
@@ -46,6 +47,7 @@ from .nonlinear import element as nonlinear_element
 from .effects import effect as _linear_effect
 
 
+@validate_params({"name": [str]}, error=DataTypeError)
 def effect(name: str, **parameters):
     """Build a missing-physics effect (SPEC §8) or a nonlinear element (SPEC §8b) by its name: one factory.
 

@@ -29,6 +29,7 @@ from typing import Any, Iterable, Sequence
 import numpy as np
 
 from ..errors import DataError  # a ValueError: user-facing, one line
+from ..validation import NAMES, Interval, Whole, validate_params
 
 from . import dual
 from .effects import Effect
@@ -203,6 +204,8 @@ def resolve_parameter(name: str, effects: Sequence[Effect]) -> tuple[int, str]:
     raise DataError(f"parameter name {name!r} is ambiguous; use the qualified form effect.param")
 
 
+@validate_params({"rig": [None, Rig], "outputs": [NAMES], "threads": [None, Interval(Whole, 1)],
+                  "validate": [bool]})
 def frf(
     freq_hz,
     rig: Rig | None = None,

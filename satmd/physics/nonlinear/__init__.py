@@ -46,7 +46,8 @@ trapezoidal-in-input for the element forces; outputs a1, a2 and states.
 """
 from __future__ import annotations
 
-from ...errors import DataError
+from ...errors import DataError, DataTypeError
+from ...validation import validate_params
 from .base import ACTS, READS, EquivalentLinear, NonlinearElement, gaussian_mean
 from .elements import (
     ELEMENT_CLASSES,
@@ -61,6 +62,7 @@ NONLINEAR_UNEXPLAINED = "nonlinear_unexplained"  # a finding, not an element: di
 NONLINEAR: dict[str, type[NonlinearElement]] = {}
 
 
+@validate_params({"cls": [type]}, error=DataTypeError)
 def register_nonlinear(cls: type[NonlinearElement]) -> type[NonlinearElement]:
     """Add a nonlinear element class to the registry (usable as a class decorator).
 
@@ -107,6 +109,7 @@ def nonlinear_names() -> tuple[str, ...]:
     return tuple(NONLINEAR)
 
 
+@validate_params({"name": [str]}, error=DataTypeError)
 def element(name: str, **parameters) -> NonlinearElement:
     """Build a nonlinear element by its SPEC §8b name, e.g. ``element("quadratic_damping", c2=300)``.
 
