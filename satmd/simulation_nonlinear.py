@@ -19,6 +19,7 @@ import numpy as np
 
 from .conventions import ACCEL_CHANNELS, PAPER_BAND_HZ
 from .errors import DataError
+from .io.acquisition import acquire, described, simulated_recording
 from .io.recording import Recording
 from .physics import Rig, integrate
 from .physics.nonlinear.excitation import log_sweep, odd_multisine, random_force
@@ -87,18 +88,8 @@ def simulate_nonlinear_recording(rig: Rig | None = None, nonlinear: Sequence = (
         forces = level * log_sweep(n, fs_hz, lo, hi, unit_rms=True)[None]
     # each realisation from rest; 4x the rate inside, so the element forces' hold errs by < 0.1 % (not ~1 %)
     r = integrate(rig, forces, fs_hz, list(nonlinear), outputs=ACCEL_CHANNELS, oversample=4 if nonlinear else 1)
-    clean = {"force": forces, "acc1": r.a1, "acc2": r.a2}
-    signals = {}
-    for name, parts in clean.items():
-        x = np.ravel(parts)
-        rel = force_noise if name == "force" else noise
-        if rel:
-            x = x + rel * np.sqrt(np.mean(x * x)) * rng.standard_normal(x.size)
-        signals[name] = x
-    meta = {"generator": "satmd simulate --time", "excitation": excitation, "band_hz": f"{lo:g}:{hi:g}",
-            "force_rms": f"{level:g}", "noise": f"{noise:g}", "force_noise": f"{force_noise:g}",
-            "burn_in_s": "0", "seed": str(seed), **extra}
-    meta.update({k: f"{float(v):.12g}" for k, v in rig.as_dict().items()})
-    for el in nonlinear:
-        meta[f"nonlinear {el.name}"] = ", ".join(f"{k}={float(v):.12g}" for k, v in el.params.items())
-    return Recording(fs_hz, signals, {"force": "N", "acc1": "m/s^2", "acc2": "m/s^2"}, meta)
+    clean = {"force": np.ravel(forces), "acc1": np.ravel(r.a1), "acc2": np.ravel(r.a2)}
+    signals = acquire(clean, fs_hz, noise, force_noise, rng)
+    how = {"excitation": excitation, "band_hz": f"{lo:g}:{hi:g}", "force_rms": f"{level:g}", "noise": f"{noise:g}",
+           "force_noise": f"{force_noise:g}", "burn_in_s": "0", "seed": str(seed), **extra}
+    return simulated_recording(fs_hz, signals, how, rig, described("nonlinear", nonlinear))

@@ -99,3 +99,12 @@ def test_the_former_band_keyword_still_works_and_warns():
     new = linearity_test(x, {"y": y}, 1.0, {"y3": y ** 3}, band_hz=(0.05, 0.3))
     assert any("band_hz" in str(w.message) for w in caught)
     assert old.p_value == new.p_value
+
+
+def test_one_acquisition_stage_for_every_simulated_recording():
+    """The linear and the nonlinear recorder add their sensors' noise and write their metadata in one place
+    (`satmd.io.acquisition`), so a linear and a nonlinear recording of one rig are taken alike."""
+    for path in ("io/timesim.py", "simulation_nonlinear.py"):
+        text = (SRC / path).read_text()
+        assert "acquire(" in text and "simulated_recording(" in text, path
+        assert "standard_normal(" not in text and "Recording(" not in text, f"{path} adds noise or builds meta itself"

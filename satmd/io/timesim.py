@@ -48,6 +48,7 @@ from ..errors import DataError
 from ..physics import Rig, frf
 from ..physics.nonlinear.excitation import log_sweep, random_force
 from .conditions import ForceSpectrum
+from .acquisition import acquire, described, simulated_recording
 from .limits import check_memory
 from .recording import Recording
 
@@ -149,26 +150,16 @@ def simulate_recording(duration_s: float = 60.0, fs_hz: float = 1000.0, rig: Rig
         clean = {"force": force, **_convolve(force, fs_hz, rig, effects, hi)}  # force: anti-aliased as recorded
         clean = {k: v[burn:total] for k, v in clean.items()}
     gain = force_rms / np.sqrt(np.mean(clean["force"] ** 2))  # linear: one scale for all channels
-    signals = {}
-    for name, x in clean.items():
-        x = x * gain
-        rel = force_noise if name == "force" else noise
-        if rel:
-            x = x + rel * np.sqrt(np.mean(x * x)) * rng.standard_normal(n)
-        if sensor_noise is not None and name != "force":
-            x = x + sensor_noise.sample(n, fs_hz, np.sqrt(np.mean(x * x)), rng)
-        signals[name] = x
-    meta = {"generator": "satmd simulate --time", "excitation": excitation, "band_hz": f"{lo:g}:{hi:g}",
-            "force_rms": f"{force_rms:g}", "noise": f"{noise:g}", "force_noise": f"{force_noise:g}",
-            "burn_in_s": f"{burn_in_s:g}", "seed": str(seed), "conditions": "ideal" if ideal else "lab"}
-    meta.update({k: f"{float(v):.12g}" for k, v in rig.as_dict().items()})
+    signals = acquire({k: v * gain for k, v in clean.items()}, fs_hz, noise, force_noise, rng, sensor_noise)
+    how = {"excitation": excitation, "band_hz": f"{lo:g}:{hi:g}", "force_rms": f"{force_rms:g}", "noise": f"{noise:g}",
+           "force_noise": f"{force_noise:g}", "burn_in_s": f"{burn_in_s:g}", "seed": str(seed),
+           "conditions": "ideal" if ideal else "lab"}
+    parts = {}
     if force_spectrum is not None and excitation == "random":
-        meta["force_spectrum"] = ", ".join(f"{k}={v}" for k, v in force_spectrum.to_dict().items())
+        parts["force_spectrum"] = ", ".join(f"{k}={v}" for k, v in force_spectrum.to_dict().items())
     if sensor_noise is not None:
-        meta["sensor_noise"] = ", ".join(f"{k}={v}" for k, v in sensor_noise.to_dict().items())
-    for eff in effects:
-        meta[f"effect {eff.name}"] = ", ".join(f"{k}={float(v):.12g}" for k, v in eff.params.items())
-    return Recording(fs_hz, signals, {"force": "N", "acc1": "m/s^2", "acc2": "m/s^2"}, meta)
+        parts["sensor_noise"] = ", ".join(f"{k}={v}" for k, v in sensor_noise.to_dict().items())
+    return simulated_recording(fs_hz, signals, how, rig, {**parts, **described("effect", effects)})
 
 
 def recording_memory(duration_s: float, fs_hz: float, burn_in_s: float = 0.0) -> float:
