@@ -108,7 +108,9 @@ class DiscoveryReport:
             "fit_after": dict(self.fit_after),
         } | chain | ({"nonlinear": self.nonlinear.to_dict()} if self.nonlinear is not None else {}) | (
             {"set_aside": [{"name": n, "reasons": [r.to_dict() for r in rs]} for n, rs in self.set_aside.items()]}
-            if self.set_aside else {})
+            if self.set_aside else {}) | (
+            {"withdrawn": [{"name": j.name, "reasons": [r.to_dict() for r in j.reasons]} for j in self.judged
+                           if j.status == "withdrawn"]} if self.withdrawn else {})
 
     def to_json(self, **kw) -> str:
         return json.dumps(self.to_dict(), **kw)
