@@ -1,17 +1,16 @@
 """The model-adequacy verdict of a discovery (SPEC §9 ``model_adequate``, ``adequacy_reasons``).
 
-Decided before any effect is named, in two steps:
+Decided in two steps:
 
-1. on the nominal fit (`satmd.identification.adequacy.assess_fit`): a fit that
-   reproduces less than half of the data, or needs absurd parameter values, is
-   no SATMD rig as measured; the data are read again as the usual mistakes
-   would have left them (conjugated, in g, mm/s², displacement, velocity, dB and
-   phase, a dead or copied channel, noise) to name what is wrong. No effect
-   search is run on such data: no vocabulary effect of a plausible size
-   changes an FRF by that much.
+1. on the nominal fit, before any search (`assess_fit`): only evidence that the data themselves are wrong
+   stops the search: read as the usual mistakes would have left them (conjugated, in g, mm/s²,
+   displacement, velocity, dB and phase) the SATMD model fits them far better, a channel is dead or a
+   copy of another, or the data are noise (`MISTAKES`; `satmd.identification.adequacy`). A nominal fit
+   that reproduces little of the data, or needs absurd values, is no such evidence: a missing effect can
+   do that (a light host mode at a resonance carries most of the FRF's energy), so the search runs.
 2. on the best augmented fit of the search: an effect that ends at the edge of
-   its own search range, a free parameter pinned at an absurd value, or a large
-   structured misfit left after the best vocabulary model (relative error
+   its own search range, a free parameter pinned at an absurd value, a fit that still reproduces little
+   of the data, or a large structured misfit left after the best vocabulary model (relative error
    ≥ ``STRUCTURE_REL_ERROR`` with most of it smooth) mean that the vocabulary
    does not describe these data: the effects are withdrawn and the verdict
    says why.
@@ -37,28 +36,36 @@ from ..identification.adequacy import (Adequacy, Reason, implausible_reason, imp
 from ..identification.adequacy import assess_fit as assess_one
 from ..identification.statistics import POOR_REL_ERROR
 
-__all__ = ["Adequacy", "Reason", "assess_fit", "after_search", "effects_at_edge", "inadequate_report",
+__all__ = ["Adequacy", "Reason", "MISTAKES", "assess_fit", "after_search", "effects_at_edge", "inadequate_report",
            "withdraw_if_inadequate", "trusted", "stretched", "drop_stretched", "STRUCTURE_REL_ERROR"]
 
 STRUCTURE_REL_ERROR = 0.15  # misfit left by the best vocabulary model beyond which it is another structure
 EDGE = 0.005  # share of a search range (log width for ranges over a decade) that counts as its edge
 
 
+#: Evidence that names what is wrong with the data themselves: no vocabulary effect can answer it, so the
+#: search is not run. A poor or implausible nominal fit alone is not such evidence (see `assess_fit`).
+MISTAKES = ("sign_convention", "units", "db_phase", "channel", "noise_like")
+
+
 def assess_fit(fit) -> Adequacy:
-    """The verdict of the nominal fit before the search: inadequate only when it reproduces little of the
-    data (then `FitResult.adequacy`, with the readings that name a mistake). Implausible values alone are
-    left to the search: a missing effect can push the nominal model's free parameters anywhere; the best
-    augmented fit is judged again (`after_search`). A channel that copies another is absent whatever the fit."""
+    """The verdict of the nominal fit before the search: inadequate only when the data themselves are wrong
+    (a reading that names a mistake, a dead or copied channel, noise: `MISTAKES`). A nominal fit that
+    reproduces little of the data, or needs implausible values, is left to the search: a missing effect
+    can do that (a light host mode at a resonance moves most of the FRF's energy); the best augmented fit
+    is judged again (`after_search`), and the verdict then withdraws what the search found."""
     quick = assess_one(fit, readings=False)
     if any(r.kind == "channel" for r in quick.reasons):
         return quick
     if quick.adequate or not any(r.kind == "poor_fit" for r in quick.reasons):
         return Adequacy(True)
     if fit.adequacy is not None:
-        return fit.adequacy
-    from ..identification import identify
+        full = fit.adequacy
+    else:
+        from ..identification import identify
 
-    return assess_one(fit, refit=identify)
+        full = assess_one(fit, refit=identify)
+    return full if any(r.kind in MISTAKES for r in full.reasons) else Adequacy(True)
 
 
 def effects_at_edge(effects, rig) -> list:
