@@ -212,7 +212,7 @@ def tune(
         notes.append(f"robust: the setting minimises the {100 * rob.quantile:g} % quantile of the objective over "
                      f"{draws.n} draws; 'value' is the nominal model's at that setting")
     if is_augmented(model):  # what finding the left-out physics is worth here
-        notes.append(_naive_note(model, problem, value, bounds, design, current, plan, force))
+        notes.append(_naive_note(model, problem, value, bounds, design, current, plan))
     hit = problem.space.on_bound(x)
     if hit:
         notes.append(f"{', '.join(hit)} ended on a bound of the search box: widen `bounds` to look further")
@@ -266,12 +266,12 @@ def _search_nominal(problem: TuneProblem, plan: SearchPlan) -> Minimum:
                     extra_starts=[start_now])
 
 
-def _naive_note(model, problem: TuneProblem, value: float, bounds, design, current, plan: SearchPlan,
-                force: bool) -> str:
-    """The setting tuned on the nominal model instead, and what it costs on the augmented one."""
+def _naive_note(model, problem: TuneProblem, value: float, bounds, design, current, plan: SearchPlan) -> str:
+    """The setting tuned on the nominal model instead, and what it costs on the augmented one (a comparison:
+    the nominal fit is tuned even when it alone does not describe the data, which the found physics explains)."""
     naive = tune(model.nominal_fit, problem.obj.kind, problem.obj.output, problem.obj.band, bounds, design,
                  current=current, n_search=plan.n_search, n_starts=plan.n_starts, closed_form_check=False,
-                 seed=plan.seed, force=force)
+                 seed=plan.seed, force=True)
     at_naive = problem.obj(problem.space.apply(problem.rig, [naive.design[n] for n in problem.space.names]),
                            problem.effects)[0]
     cost = db(float(at_naive) / value)

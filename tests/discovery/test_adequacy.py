@@ -296,3 +296,8 @@ def test_a_light_host_mode_that_wrecks_the_nominal_fit_is_searched_not_refused()
     assert rep.nominal_fit.rel_error > 0.5 and not rep.nominal_fit.model_adequate
     assert rep.model_adequate and rep.effect_names[0] == "extra_mode"
     assert abs(rep.effects[0].parameters["f_hz"] / 115.06 - 1) < 0.01
+    # tuned on the augmented model; the nominal one, though not adequate alone, is still the comparison
+    from satmd import tune
+
+    res = tune(rep, closed_form_check=False)
+    assert any("tuned on the nominal model instead" in n for n in res.notes)
