@@ -599,7 +599,7 @@ def _valid_number(key, x) -> bool:
     from satmd.io.estmeta import SCHEMA
 
     try:
-        return SCHEMA[key](x) is None and not (key == "kernel_rms_hz" and x > 130)
+        return SCHEMA[key](x) is None and not (key == "kernel_rms_hz" and x is not None and x > 130)
     except Exception:  # noqa: BLE001
         return False
 

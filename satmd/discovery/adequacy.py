@@ -2,12 +2,13 @@
 
 Decided in two steps:
 
-1. on the nominal fit, before any search (`assess_fit`): only evidence that the data themselves are wrong
-   stops the search: read as the usual mistakes would have left them (conjugated, in g, mm/s²,
-   displacement, velocity, dB and phase) the SATMD model fits them far better, a channel is dead or a
-   copy of another, or the data are noise (`MISTAKES`; `satmd.identification.adequacy`). A nominal fit
-   that reproduces little of the data, or needs absurd values, is no such evidence: a missing effect can
-   do that (a light host mode at a resonance carries most of the FRF's energy), so the search runs.
+1. on the nominal fit, before any search (`assess_fit`): a fit that reproduces less than half of the
+   data is read again as the usual mistakes would have left the data (conjugated, in g, mm/s²,
+   displacement, velocity, dB and phase, a dead or copied channel, noise: `MISTAKES`) to name what is
+   wrong, and no search is run. Without such a mistake, a poor nominal fit may be a missing effect's doing
+   (a light host mode at a resonance carries most of the FRF's energy): when one vocabulary effect alone
+   makes the model reproduce most of the data (`rescued_by_one_effect`) the search runs; otherwise the
+   data are another structure and are refused without it.
 2. on the best augmented fit of the search: an effect that ends at the edge of
    its own search range, a free parameter pinned at an absurd value, a fit that still reproduces little
    of the data, or a large structured misfit left after the best vocabulary model (relative error
@@ -36,7 +37,7 @@ from ..identification.adequacy import (Adequacy, Reason, implausible_reason, imp
 from ..identification.adequacy import assess_fit as assess_one
 from ..identification.statistics import POOR_REL_ERROR
 
-__all__ = ["Adequacy", "Reason", "MISTAKES", "assess_fit", "after_search", "effects_at_edge", "inadequate_report",
+__all__ = ["Adequacy", "Reason", "MISTAKES", "assess_fit", "rescued_by_one_effect", "after_search", "effects_at_edge", "inadequate_report",
            "withdraw_if_inadequate", "trusted", "stretched", "drop_stretched", "STRUCTURE_REL_ERROR"]
 
 STRUCTURE_REL_ERROR = 0.15  # misfit left by the best vocabulary model beyond which it is another structure
@@ -49,23 +50,44 @@ MISTAKES = ("sign_convention", "units", "db_phase", "channel", "noise_like")
 
 
 def assess_fit(fit) -> Adequacy:
-    """The verdict of the nominal fit before the search: inadequate only when the data themselves are wrong
-    (a reading that names a mistake, a dead or copied channel, noise: `MISTAKES`). A nominal fit that
-    reproduces little of the data, or needs implausible values, is left to the search: a missing effect
-    can do that (a light host mode at a resonance moves most of the FRF's energy); the best augmented fit
-    is judged again (`after_search`), and the verdict then withdraws what the search found."""
+    """The verdict of the nominal fit before the search: inadequate when it reproduces little of the data
+    (then `FitResult.adequacy`, with the readings that name a mistake). Implausible values alone are left to
+    the search: a missing effect can push the nominal model's free parameters anywhere; the best augmented
+    fit is judged again (`after_search`). A channel that copies another is absent whatever the fit. An
+    inadequate verdict that names no mistake of the data (`MISTAKES`) may still be a missing effect's doing:
+    `rescued_by_one_effect` decides."""
     quick = assess_one(fit, readings=False)
     if any(r.kind == "channel" for r in quick.reasons):
         return quick
     if quick.adequate or not any(r.kind == "poor_fit" for r in quick.reasons):
         return Adequacy(True)
     if fit.adequacy is not None:
-        full = fit.adequacy
-    else:
-        from ..identification import identify
+        return fit.adequacy
+    from ..identification import identify
 
-        full = assess_one(fit, refit=identify)
-    return full if any(r.kind in MISTAKES for r in full.reasons) else Adequacy(True)
+    return assess_one(fit, refit=identify)
+
+
+def rescued_by_one_effect(verdict, search, nominal) -> bool:
+    """Whether a poor nominal fit may be missing physics rather than other data: the verdict names no mistake
+    of the data themselves (`MISTAKES`) and one vocabulary effect alone makes the model reproduce most of
+    them (relative error beyond the noise below ``POOR_REL_ERROR``). A light host mode at a resonance does
+    that; another structure, or a file that is no FRF of a rig, does not, and is refused without the whole
+    search. The single-effect fits stay in ``search``'s cache for the search that follows.
+
+    Parameters
+    ----------
+    verdict : the nominal fit's `Adequacy` (not adequate).
+    search : `select.Search` on the data.
+    nominal : `select.Model` of the nominal fit.
+
+    Returns
+    -------
+    bool
+    """
+    if any(r.kind in MISTAKES for r in verdict.reasons):
+        return False
+    return any(rel_error_beyond_noise(search.add(nominal, c).fit) < POOR_REL_ERROR for c in search.candidates)
 
 
 def effects_at_edge(effects, rig) -> list:

@@ -109,8 +109,7 @@ class DiscoveryReport:
         } | chain | ({"nonlinear": self.nonlinear.to_dict()} if self.nonlinear is not None else {}) | (
             {"set_aside": [{"name": n, "reasons": [r.to_dict() for r in rs]} for n, rs in self.set_aside.items()]}
             if self.set_aside else {}) | (
-            {"withdrawn": [{"name": j.name, "reasons": [r.to_dict() for r in j.reasons]} for j in self.judged
-                           if j.status == "withdrawn"]} if self.withdrawn else {})
+            {"withdrawn": list(self.withdrawn)} if self.withdrawn else {})  # their reasons: adequacy_reasons
 
     def to_json(self, **kw) -> str:
         return json.dumps(self.to_dict(), **kw)

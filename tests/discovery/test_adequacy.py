@@ -263,7 +263,7 @@ def test_another_structure_that_reaches_the_search_stays_inadequate(monkeypatch)
     assert rep.withdrawn and {j.status for j in rep.judged} <= {"withdrawn", "set_aside", "measurement"}
     assert all(j.reasons for j in rep.judged if j.status == "withdrawn")
     assert "withdrawn: " + rep.withdrawn[0] in rep.report()
-    assert [w["name"] for w in rep.to_dict()["withdrawn"]] == rep.withdrawn
+    assert rep.to_dict()["withdrawn"] == rep.withdrawn
 
 
 def test_a_noisy_measurement_of_a_satmd_rig_is_not_called_inadequate():
