@@ -229,7 +229,10 @@ def tuning() -> str:
         f"| concealed k1 + 5 % ({k1['n']} rigs): tuned on the discovered model / on the nominal model | "
         f"max {k1['max_gap_db']:.3f} dB / median {k1['nominal_median_gap_db']:.2f} dB, "
         f"max {k1['nominal_max_gap_db']:.2f} dB above the true optimum |",
-        f"| concealed host mode at 60–120 Hz ({em['n']} rigs): discovered model / nominal model | "
+        f"| concealed host mode at 60–120 Hz ({em['n']} rigs"
+        + (f"; {em['called_inadequate']} called not adequate by discovery, tuned with force"
+           if em.get("called_inadequate") else "")
+        + "): discovered model / nominal model | "
         f"max {em['max_gap_db']:.3f} dB / median {em['nominal_median_gap_db']:.2f} dB, "
         f"max {em['nominal_max_gap_db']:.2f} dB |",
         f"| robust tuning (10 % noise, 128 draws), {rb['n_fresh']} fresh draws of the fit's uncertainty | "

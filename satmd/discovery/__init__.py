@@ -32,8 +32,7 @@ from .._fleet import fleet_map
 from ..identification import identify
 from ..io.frfdata import FRFData, require_data
 from ..physics import Rig
-from .adequacy import (Reason, after_search, assess_fit, drop_stretched, inadequate_report, rescued_by_one_effect,
-                       withdraw_if_inadequate)
+from .adequacy import Reason, after_search, assess_fit, drop_stretched, inadequate_report, withdraw_if_inadequate
 from .budget import bias_note, evidence_beyond_bias
 from .candidates import default_candidates
 from .discrepancy import fit_discrepancy
@@ -179,9 +178,7 @@ def _discover_frf(data: FRFData, rig, free, candidates, channels, alpha, max_eff
 
     nominal_fit = identify(data, rig, free, channels, warn=False)
     verdict = assess_fit(nominal_fit)  # can the SATMD model describe these data at all? (adequacy.py)
-    search = Search(data, rig, free, channels, candidates) if data.has_std else None
-    if not verdict.adequate and not (search is not None and rescued_by_one_effect(verdict, search,
-                                                                                  Model((), [], nominal_fit))):
+    if not verdict.adequate:
         return inadequate_report(verdict, nominal_fit, alpha, t0)
     noise, noise_dof = "given", None
     if data.estimator.get("noise_dof"):  # an estimated std (Welch averages, LPM residuals): F tests keep α
@@ -201,8 +198,7 @@ def _discover_frf(data: FRFData, rig, free, candidates, channels, alpha, max_eff
                                whiteness=test0.whiteness, wall_time=time.perf_counter() - t0)
 
     nominal = Model((), [], nominal_fit)
-    if search is None or search.data is not data:  # the std was estimated: the search runs on the new data
-        search = Search(data, rig, free, channels, candidates)
+    search = Search(data, rig, free, channels, candidates)
 
     def significant(fit):
         return test_mismatch(fit, alpha, noise_dof).significant

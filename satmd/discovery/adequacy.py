@@ -1,17 +1,17 @@
 """The model-adequacy verdict of a discovery (SPEC §9 ``model_adequate``, ``adequacy_reasons``).
 
-Decided in two steps:
+Decided before any effect is named, in two steps:
 
-1. on the nominal fit, before any search (`assess_fit`): a fit that reproduces less than half of the
-   data is read again as the usual mistakes would have left the data (conjugated, in g, mm/s²,
-   displacement, velocity, dB and phase, a dead or copied channel, noise: `MISTAKES`) to name what is
-   wrong, and no search is run. Without such a mistake, a poor nominal fit may be a missing effect's doing
-   (a light host mode at a resonance carries most of the FRF's energy): when one vocabulary effect alone
-   makes the model reproduce most of the data (`rescued_by_one_effect`) the search runs; otherwise the
-   data are another structure and are refused without it.
+1. on the nominal fit (`satmd.identification.adequacy.assess_fit`): a fit that
+   reproduces less than half of the data, or needs absurd parameter values, is
+   no SATMD rig as measured; the data are read again as the usual mistakes
+   would have left them (conjugated, in g, mm/s², displacement, velocity, dB and
+   phase, a dead or copied channel, noise) to name what is wrong. No effect
+   search is run on such data: no vocabulary effect of a plausible size
+   changes an FRF by that much.
 2. on the best augmented fit of the search: an effect that ends at the edge of
-   its own search range, a free parameter pinned at an absurd value, a fit that still reproduces little
-   of the data, or a large structured misfit left after the best vocabulary model (relative error
+   its own search range, a free parameter pinned at an absurd value, or a large
+   structured misfit left after the best vocabulary model (relative error
    ≥ ``STRUCTURE_REL_ERROR`` with most of it smooth) mean that the vocabulary
    does not describe these data: the effects are withdrawn and the verdict
    says why.
@@ -37,25 +37,18 @@ from ..identification.adequacy import (Adequacy, Reason, implausible_reason, imp
 from ..identification.adequacy import assess_fit as assess_one
 from ..identification.statistics import POOR_REL_ERROR
 
-__all__ = ["Adequacy", "Reason", "MISTAKES", "assess_fit", "rescued_by_one_effect", "after_search", "effects_at_edge", "inadequate_report",
+__all__ = ["Adequacy", "Reason", "assess_fit", "after_search", "effects_at_edge", "inadequate_report",
            "withdraw_if_inadequate", "trusted", "stretched", "drop_stretched", "STRUCTURE_REL_ERROR"]
 
 STRUCTURE_REL_ERROR = 0.15  # misfit left by the best vocabulary model beyond which it is another structure
 EDGE = 0.005  # share of a search range (log width for ranges over a decade) that counts as its edge
 
 
-#: Evidence that names what is wrong with the data themselves: no vocabulary effect can answer it, so the
-#: search is not run. A poor or implausible nominal fit alone is not such evidence (see `assess_fit`).
-MISTAKES = ("sign_convention", "units", "db_phase", "channel", "noise_like")
-
-
 def assess_fit(fit) -> Adequacy:
-    """The verdict of the nominal fit before the search: inadequate when it reproduces little of the data
-    (then `FitResult.adequacy`, with the readings that name a mistake). Implausible values alone are left to
-    the search: a missing effect can push the nominal model's free parameters anywhere; the best augmented
-    fit is judged again (`after_search`). A channel that copies another is absent whatever the fit. An
-    inadequate verdict that names no mistake of the data (`MISTAKES`) may still be a missing effect's doing:
-    `rescued_by_one_effect` decides."""
+    """The verdict of the nominal fit before the search: inadequate only when it reproduces little of the
+    data (then `FitResult.adequacy`, with the readings that name a mistake). Implausible values alone are
+    left to the search: a missing effect can push the nominal model's free parameters anywhere; the best
+    augmented fit is judged again (`after_search`). A channel that copies another is absent whatever the fit."""
     quick = assess_one(fit, readings=False)
     if any(r.kind == "channel" for r in quick.reasons):
         return quick
@@ -66,28 +59,6 @@ def assess_fit(fit) -> Adequacy:
     from ..identification import identify
 
     return assess_one(fit, refit=identify)
-
-
-def rescued_by_one_effect(verdict, search, nominal) -> bool:
-    """Whether a poor nominal fit may be missing physics rather than other data: the verdict names no mistake
-    of the data themselves (`MISTAKES`) and one vocabulary effect alone makes the model reproduce most of
-    them (relative error beyond the noise below ``POOR_REL_ERROR``). A light host mode at a resonance does
-    that; another structure, or a file that is no FRF of a rig, does not, and is refused without the whole
-    search. The single-effect fits stay in ``search``'s cache for the search that follows.
-
-    Parameters
-    ----------
-    verdict : the nominal fit's `Adequacy` (not adequate).
-    search : `select.Search` on the data.
-    nominal : `select.Model` of the nominal fit.
-
-    Returns
-    -------
-    bool
-    """
-    if any(r.kind in MISTAKES for r in verdict.reasons):
-        return False
-    return any(rel_error_beyond_noise(search.add(nominal, c).fit) < POOR_REL_ERROR for c in search.candidates)
 
 
 def effects_at_edge(effects, rig) -> list:
