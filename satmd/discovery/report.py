@@ -60,13 +60,13 @@ class DiscoveryReport:
         make (dicts: name, explanation, remedy, corrected)."""
         return list(self.notes) + [j.note for j in self.judged if j.status == "measurement" and j.note]
 
-    def rejudged(self, named_only, status: str, reasons, **changes) -> "DiscoveryReport":
-        """The report with a later rule's verdict: each named candidate that ``named_only(judged)`` picks gets
+    def rejudged(self, applies_to, status: str, reasons, **changes) -> "DiscoveryReport":
+        """The report with a later rule's verdict: each named candidate that ``applies_to(judged)`` picks gets
         ``status`` for ``reasons``; ``changes`` are the other fields that verdict changes.
 
         Parameters
         ----------
-        named_only : predicate on a named `Judged` (True: the rule applies to it).
+        applies_to : predicate on a named `Judged` (True: the rule applies to it).
         status : one of `findings.STATUSES`.
         reasons : the `Reason` objects of the verdict.
         **changes : other fields of the report to set alongside (``nonlinear``, ``adequacy``, ...).
@@ -77,7 +77,7 @@ class DiscoveryReport:
         """
         from dataclasses import replace
 
-        judged = tuple(j.judged(status, reasons) if j.status == "named" and named_only(j) else j for j in self.judged)
+        judged = tuple(j.judged(status, reasons) if j.status == "named" and applies_to(j) else j for j in self.judged)
         return replace(self, judged=judged, **changes)
 
     @property

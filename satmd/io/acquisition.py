@@ -12,7 +12,7 @@ import numpy as np
 
 from .recording import Recording
 
-__all__ = ["acquire", "simulated_recording"]
+__all__ = ["acquire", "described", "simulated_recording"]
 
 #: what every simulated recording holds, in SI units
 UNITS = {"force": "N", "acc1": "m/s^2", "acc2": "m/s^2"}
