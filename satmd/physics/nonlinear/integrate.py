@@ -140,10 +140,12 @@ def upsample(force, k: int, pad: int = 2048) -> np.ndarray:
 
 
 @validate_params({"rig": [Rig], "fs_hz": [Interval(Real, 0, open="lo")], "outputs": [NAMES],
-                  "hold": [Options(("bandlimited", "linear"))], "backend": [Options(("auto", "numba", "numpy"))]})
+                  "hold": [Options(("bandlimited", "linear"))], "backend": [Options(("auto", "numba", "numpy"))],
+                  "extrapolate": [bool]})
 def integrate(rig, force, fs_hz: float, elements=(), outputs=ACCEL_CHANNELS, segments="auto",
               warmup_s="auto", memory_tol: float = 1e-7, corrections: int = 3,
-              hold: str = "bandlimited", backend: str = "auto", oversample: int = 1) -> NonlinearResponse:
+              hold: str = "bandlimited", backend: str = "auto", oversample: int = 1,
+              extrapolate: bool = False) -> NonlinearResponse:
     """Simulate the rig with nonlinear elements for a sampled force on the primary mass, from rest.
 
     Parameters
@@ -165,12 +167,20 @@ def integrate(rig, force, fs_hz: float, elements=(), outputs=ACCEL_CHANNELS, seg
     oversample : integrate at this multiple of fs (the force interpolated band-limited) and return
         every ``oversample``-th sample: the element forces' straight-line hold errs by ~(ωΔ)²/12
         (0.8 % at 100 Hz and 2048 Hz); 4 brings it to 0.05 %.
+    extrapolate : also integrate at twice ``oversample`` and return ``(4 y(2k) - y(k)) / 3`` (Richardson):
+        the hold's leading error, in Δ², cancels (what is left falls as Δ⁴); three times the work.
 
     Returns
     -------
     NonlinearResponse
         Arrays of shape (N,) for a single parameter set, (batch, N) for a batch.
     """
+    if extrapolate and elements:  # without elements the response is exact: nothing to extrapolate
+        k = max(1, int(oversample))
+        fine, coarse = (integrate(rig, force, fs_hz, elements, outputs, segments, warmup_s, memory_tol, corrections,
+                                  hold, backend, j) for j in (2 * k, k))
+        return NonlinearResponse(fine.fs_hz, {n: (4.0 * v - coarse.signals[n]) / 3.0 for n, v in fine.signals.items()},
+                                 {**fine.meta, "oversample": k, "extrapolated": True})
     if int(oversample) > 1:
         k = int(oversample)
         res = integrate(rig, upsample(force, k), fs_hz * k, elements, outputs, segments, warmup_s, memory_tol,
