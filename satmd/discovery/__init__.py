@@ -191,11 +191,12 @@ def _discover_frf(data: FRFData, rig, free, candidates, channels, alpha, max_eff
     test0 = test_mismatch(nominal_fit, alpha, noise_dof)
     before = _fit_summary(nominal_fit)
     p_values = {"global": test0.p_global, "band": test0.p_band}
-    if not test0.significant:
-        return DiscoveryReport(significant_mismatch=False, noise=noise, mismatch_bands_hz=test0.bands_hz,
-                               judged=(), parameters=dict(nominal_fit.values), fit_before=before, fit_after=before,
-                               nominal_fit=nominal_fit, final_fit=nominal_fit, discrepancy=None, p_values=p_values,
-                               whiteness=test0.whiteness, wall_time=time.perf_counter() - t0)
+    if not test0.significant:  # the nominal fit is the best fit: judged as `identify` judges it (one verdict)
+        report = DiscoveryReport(significant_mismatch=False, noise=noise, mismatch_bands_hz=test0.bands_hz,
+                                 judged=(), parameters=dict(nominal_fit.values), fit_before=before, fit_after=before,
+                                 nominal_fit=nominal_fit, final_fit=nominal_fit, discrepancy=None, p_values=p_values,
+                                 whiteness=test0.whiteness, wall_time=time.perf_counter() - t0)
+        return withdraw_if_inadequate(report, after_search(nominal_fit, [], rig))
 
     nominal = Model((), [], nominal_fit)
     search = Search(data, rig, free, channels, candidates)

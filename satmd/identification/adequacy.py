@@ -245,7 +245,7 @@ def _explain_failure(fit, rel, identify) -> list:
         if _design_rel(fit, data_alt) > SCREEN_REL_ERROR:
             continue  # no point of a coarse design over the plausible rigs comes near: not this reading
         alt = _refit(identify, fit, data_alt)
-        if alt is not None and alt.rel_error < GOOD_REL_ERROR and alt.rel_error < MUCH_BETTER * rel:
+        if _explains(alt) and alt.rel_error < MUCH_BETTER * rel:
             out.append(Reason(kind, f"the data look like {label}: read so, the SATMD model fits them with relative "
                                     f"error {alt.rel_error:.3g} instead of {rel:.3g} ({fix})",
                               {"rel_error_as_given": rel, "rel_error_as_read": float(alt.rel_error),
@@ -257,13 +257,19 @@ def _explain_failure(fit, rel, identify) -> list:
             if _design_rel(fit, data.select(rest), rest) > SCREEN_REL_ERROR:
                 continue
             alt = _refit(identify, fit, data.select(rest), rest)
-            if alt is not None and alt.rel_error < GOOD_REL_ERROR:
+            if _explains(alt):
                 out.append(Reason("channel", f"without channel {c} the SATMD model fits the rest (relative error "
                                              f"{alt.rel_error:.3g} instead of {rel:.3g}): {c} is not what the "
                                              "model calls it (a disconnected, missing or mislabelled sensor)",
                                   {"channel": c, "rel_error_without": float(alt.rel_error)}))
                 return out
     return out
+
+
+def _explains(alt) -> bool:
+    """A refit names the mistake only when it reproduces the data well with plausible values: a rig
+    still needing an absurd parameter is no better explained without a channel or read otherwise."""
+    return alt is not None and alt.rel_error < GOOD_REL_ERROR and not implausible_values(alt)
 
 
 def _lag1(*parts) -> float:
