@@ -8,7 +8,7 @@ sample rate (1–10 kHz), the band (lo 5–15 Hz, hi 200–500 Hz ≤ 0.4 fs), t
 RMS on each accelerometer, 0.2–2 % on the force) and the lengths; the rig starts at rest.
 
 Simulators. ``satmd``: the force goes through satmd's own from-rest linear convolution
-(`satmd.io.timesim._convolve`, the machinery of `satmd.simulate_recording`), or, for a logarithmic
+(`satmd.physics.timemodel.LinearRig`, the time model of `satmd.simulate_recording`), or, for a logarithmic
 upward slow sweep, `satmd.simulate_recording(excitation="sweep")` itself makes the force; truth
 `satmd.physics.frf`. ``independent``: `benchmarks/_indep_sim.py` (ODEs integrated with scipy on a
 grid 8x finer, its own anti-aliasing and decimation) with the same force function evaluated on its
@@ -157,7 +157,7 @@ def simulate(sim, family, fs, band, noise, files, info, rig, p, effects, rng, se
     recs = []
     if sim == "satmd":
         from satmd.io import simulate_recording
-        from satmd.io.timesim import _convolve
+        from satmd.physics.timemodel import LinearRig
         from satmd.physics import frf
 
         made = "convolve"
@@ -174,7 +174,7 @@ def simulate(sim, family, fs, band, noise, files, info, rig, p, effects, rng, se
                                          force_noise=noise["force"], seed=seed, excitation="sweep")
                 recs.append(rec)
                 continue
-            out = _convolve(force(n, fs), fs, rig, effects, band[1])
+            out = LinearRig(rig, effects, band[1]).respond(force(n, fs), fs)
             chans = ex.add_noise({k: out[k] for k in ("force", "acc1", "acc2")}, noise, rng)
             recs.append(Recording(fs, chans, units, {"generator": "satmd convolve"}))
 

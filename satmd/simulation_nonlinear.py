@@ -4,7 +4,7 @@ The rig starts at rest; the force is band-limited random noise (``random``, not 
 the record), one log sweep (``sweep``) or an odd random-phase multisine with detection lines
 (``multisine``: ``realisations`` independent phase draws of ``periods`` periods each, every
 realisation started from rest, so its first period holds the transient); the response comes
-from the one integrator (`satmd.physics.integrate`), and white Gaussian noise is added to
+from the one integrator (`satmd.physics.timemodel.NonlinearRig`), and white Gaussian noise is added to
 every channel (``noise`` x RMS on the accelerometers, ``force_noise`` x RMS on the force).
 
 Multisine metadata (what an estimator needs): ``period_samples``, ``periods`` (per
@@ -17,11 +17,12 @@ from typing import Sequence
 
 import numpy as np
 
-from .conventions import ACCEL_CHANNELS, PAPER_BAND_HZ
+from .conventions import PAPER_BAND_HZ
 from .errors import DataError
 from .io.acquisition import acquire, described, simulated_recording
 from .io.recording import Recording
-from .physics import Rig, integrate
+from .physics import Rig
+from .physics.timemodel import NonlinearRig
 from .physics.nonlinear.excitation import log_sweep, odd_multisine, random_force
 
 EXCITATIONS = ("random", "sweep", "multisine")
@@ -86,11 +87,8 @@ def simulate_nonlinear_recording(rig: Rig | None = None, nonlinear: Sequence = (
         forces = level * random_force(n, fs_hz, (lo, hi), rng)[None]
     else:
         forces = level * log_sweep(n, fs_hz, lo, hi, unit_rms=True)[None]
-    # each realisation from rest; 4x and 8x the rate inside, extrapolated: the element forces' hold errs by
-    # ~(ωΔ)⁴ instead of ~1 % (the lab's rig is continuous)
-    r = integrate(rig, forces, fs_hz, list(nonlinear), outputs=ACCEL_CHANNELS, oversample=4 if nonlinear else 1,
-                  extrapolate=bool(nonlinear))
-    clean = {"force": np.ravel(forces), "acc1": np.ravel(r.a1), "acc2": np.ravel(r.a2)}
+    # each realisation from rest (the time model: 4x and 8x the rate inside, extrapolated)
+    clean = {k: np.ravel(v) for k, v in NonlinearRig(rig, tuple(nonlinear)).respond(forces, fs_hz).items()}
     signals = acquire(clean, fs_hz, noise, force_noise, rng)
     how = {"excitation": excitation, "band_hz": f"{lo:g}:{hi:g}", "force_rms": f"{level:g}", "noise": f"{noise:g}",
            "force_noise": f"{force_noise:g}", "burn_in_s": "0", "seed": str(seed), **extra}

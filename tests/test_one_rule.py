@@ -108,3 +108,12 @@ def test_one_acquisition_stage_for_every_simulated_recording():
         text = (SRC / path).read_text()
         assert "acquire(" in text and "simulated_recording(" in text, path
         assert "standard_normal(" not in text and "Recording(" not in text, f"{path} adds noise or builds meta itself"
+
+
+def test_one_time_model_protocol_for_every_recorder():
+    """The recorders drive a time model (`satmd.physics.timemodel`) and nothing else: the linear convolution
+    and the integrator are reached through ``respond``, never called or rewritten beside it."""
+    for path in ("io/timesim.py", "simulation_nonlinear.py"):
+        text = (SRC / path).read_text()
+        assert ".respond(" in text, path
+        assert "integrate(" not in text and "irfft(h" not in text, f"{path} simulates the rig itself"

@@ -15,8 +15,9 @@ Excitation (``excitation=``):
 Response. For ``random`` and ``sweep`` the structure starts at rest ``burn_in_s``
 before the record starts (0 by default, so the start-up transient is in the
 record) and the accelerations are the *linear convolution* of the force with the
-model's impulse response, computed by FFT on a grid long enough that the
-impulse response has decayed to round-off (measured, not assumed). With
+model's impulse response (`satmd.physics.timemodel.LinearRig`, the linear time model),
+computed by FFT on a grid long enough that the impulse response has decayed to
+round-off (measured, not assumed). With
 ``sensor_gain`` and ``time_delay`` effects the sensors report what they do on a
 rig, since the impulse response comes from `satmd.physics.frf` with effects.
 
@@ -46,6 +47,7 @@ import numpy as np
 from ..conventions import ACCEL_CHANNELS, PAPER_BAND_HZ, RECORDING_CHANNELS
 from ..errors import DataError
 from ..physics import Rig, frf
+from ..physics.timemodel import LinearRig
 from ..physics.nonlinear.excitation import log_sweep, random_force
 from .conditions import ForceSpectrum
 from .acquisition import acquire, described, simulated_recording
@@ -147,7 +149,7 @@ def simulate_recording(duration_s: float = 60.0, fs_hz: float = 1000.0, rig: Rig
             force = random_force(total + int(fs_hz), fs_hz, (lo, hi), rng, force_spectrum, unit_rms=False)
         else:
             force = log_sweep(total, fs_hz, lo, hi)
-        clean = {"force": force, **_convolve(force, fs_hz, rig, effects, hi)}  # force: anti-aliased as recorded
+        clean = LinearRig(rig, effects, hi).respond(force, fs_hz)  # force: anti-aliased as recorded
         clean = {k: v[burn:total] for k, v in clean.items()}
     gain = force_rms / np.sqrt(np.mean(clean["force"] ** 2))  # linear: one scale for all channels
     signals = acquire({k: v * gain for k, v in clean.items()}, fs_hz, noise, force_noise, rng, sensor_noise)
@@ -168,55 +170,6 @@ def recording_memory(duration_s: float, fs_hz: float, burn_in_s: float = 0.0) ->
     return 2.0e4 * fs_hz + 400.0 * ((duration_s + burn_in_s) * fs_hz + fs_hz)
 
 
-def _convolve(force, fs_hz, rig, effects, pass_hz=0.0) -> dict:
-    """Accelerations for a force that starts at sample 0 with the rig at rest: linear convolution by FFT."""
-    n = force.size
-    tail = _impulse_length(fs_hz, rig, effects, pass_hz)
-    size = _fast_length(n + tail)
-    f = np.fft.rfftfreq(size, 1.0 / fs_hz)
-    h = _frf_with_dc(f, rig, effects, pass_hz)
-    spectrum = np.fft.rfft(force, size)
-    out = {name: np.fft.irfft(h[ch] * spectrum, size)[:n] for ch, name in _RESPONSES}
-    out["force"] = np.fft.irfft(h["rolloff"] * spectrum, size)[:n]  # the same anti-aliasing as the responses
-    return out
-
-
-def _impulse_length(fs_hz, rig, effects, pass_hz, max_s: float = 120.0) -> int:
-    """Samples after which every impulse response has decayed below 1e-9 of its peak (and stays there)."""
-    size = _fast_length(int(max_s * fs_hz))
-    f = np.fft.rfftfreq(size, 1.0 / fs_hz)
-    h = _frf_with_dc(f, rig, effects, pass_hz)
-    need = int(0.5 * fs_hz)
-    for ch, _ in _RESPONSES:
-        ir = np.abs(np.fft.irfft(h[ch], size))
-        ir[0] = 0.0  # the direct (mass-line) term is not a tail
-        above = np.flatnonzero(ir[: size // 2] > 1e-9 * ir.max())
-        if above.size:
-            need = max(need, int(above[-1]) + 1)
-    return need
-
-
-def _frf_with_dc(f, rig, effects, pass_hz) -> dict:
-    """a1, a2 on an rfft grid from 0 Hz to Nyquist, rolled off smoothly above max(pass_hz, 0.6 Nyquist).
-
-    Accelerations vanish at DC but tend to 1/m1 at high frequency; cut off at
-    Nyquist that step rings through the whole impulse response. The raised-cosine
-    roll-off keeps the impulse response short and leaves the excited band untouched.
-    """
-    r = frf(f[1:], rig, effects, outputs=ACCEL_CHANNELS)
-    nyquist = f[-1]
-    start = max(0.6 * nyquist, pass_hz)
-    x = np.clip((f - start) / max(nyquist - start, 1e-9 * nyquist), 0.0, 1.0)
-    rolloff = 0.5 + 0.5 * np.cos(np.pi * x)
-    out = {}
-    for ch, _ in _RESPONSES:
-        h = np.zeros(f.size, dtype=complex)
-        h[1:] = r.channel(ch) * rolloff[1:]
-        out[ch] = h
-    out["rolloff"] = rolloff
-    return out
-
-
 def _steady_state_multisine(n, fs_hz, rig, effects, lo, hi, rng) -> dict:
     """Periodic random-phase multisine on the record's DFT grid and its exact steady-state response."""
     f = np.fft.rfftfreq(n, 1.0 / fs_hz)
@@ -230,10 +183,3 @@ def _steady_state_multisine(n, fs_hz, rig, effects, lo, hi, rng) -> dict:
         A[band] = response.channel(ch) * F[band]
         spectra[name] = A
     return {name: np.fft.irfft(S, n) for name, S in spectra.items()}
-
-
-def _fast_length(n: int) -> int:
-    """A length >= n made of small primes (fast FFTs)."""
-    from scipy.fft import next_fast_len
-
-    return int(next_fast_len(int(n), real=True))

@@ -245,6 +245,20 @@ class PolynomialOscillator:
                 x[s:s + span - pad] = seg[:, j]
         return x + self.output_offset + self.feedthrough * u
 
+    def respond(self, force, fs_hz: float) -> dict:
+        """The time-model protocol (`satmd.physics.timemodel`): {"force", "y"} from rest, serially.
+
+        Parameters
+        ----------
+        force : (n,) input samples.
+        fs_hz : sample rate [Hz].
+
+        Returns
+        -------
+        dict
+        """
+        return {"force": np.asarray(force, float), "y": self.simulate(force, fs_hz)}
+
     def to_dict(self) -> dict:
         """JSON-ready parameters with the derived natural frequency and damping ratio."""
         return {**asdict(self), "natural_frequency_hz": self.natural_frequency_hz,

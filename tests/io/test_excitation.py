@@ -9,7 +9,7 @@ import pytest
 from satmd.errors import DataError, FormatError
 from satmd.io import Recording, estimate_frf, load_recording
 from satmd.io.excitation import detect_excitation, find_period
-from satmd.io.timesim import _convolve
+from satmd.physics.timemodel import LinearRig
 from satmd.physics import Rig, frf
 
 FS = 1000.0
@@ -19,7 +19,7 @@ F16 = Path(__file__).resolve().parents[3] / "shared" / "data" / "real" / "f16"
 def _record(force, noise=0.01, seed=0, fs=FS):
     """Responses of the paper's rig from rest, white noise on every channel (a share of each one's RMS)."""
     rng = np.random.default_rng(seed)
-    out = _convolve(force, fs, Rig(), ())
+    out = LinearRig(Rig()).respond(force, fs)
     chans = {}
     for name in ("force", "acc1", "acc2"):
         x = out[name]
@@ -147,7 +147,7 @@ def test_a_periodic_chirps_weak_tails_are_not_detection_lines():
 
     fs = 2000.0
     t = np.arange(2000) / fs
-    out = _convolve(np.tile(chirp(t, 13.0, 1.0, 435.0), 16), fs, Rig(), ())
+    out = LinearRig(Rig()).respond(np.tile(chirp(t, 13.0, 1.0, 435.0), 16), fs)
     for seed in range(4):
         rng = np.random.default_rng(seed)
         share = {"force": 0.02, "acc1": 0.002, "acc2": 0.002}  # a noisier force than responses

@@ -205,12 +205,13 @@ def test_default_recording_is_random_not_periodic_and_starts_at_rest():
 
 def test_convolution_from_rest_reaches_the_exact_steady_state():
     """A periodic force repeated: once the transient has died, the response equals the exact steady state."""
-    from satmd.io.timesim import _convolve, _steady_state_multisine
+    from satmd.io.timesim import _steady_state_multisine
+    from satmd.physics.timemodel import LinearRig
 
     rng = np.random.default_rng(0)
     n, fs = 4000, 1000.0
     steady = _steady_state_multisine(n, fs, Rig(), (), 20.0, 200.0, rng)
-    out = _convolve(np.tile(steady["force"], 5), fs, Rig(), (), 200.0)
+    out = LinearRig(Rig(), (), 200.0).respond(np.tile(steady["force"], 5), fs)
     for name in ("acc1", "acc2"):
         err = np.abs(out[name][3 * n:4 * n] - steady[name]).max() / np.abs(steady[name]).max()
         assert err < 1e-9, name
