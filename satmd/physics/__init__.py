@@ -45,6 +45,7 @@ from .nonlinear import (
 )
 from .nonlinear import element as nonlinear_element
 from .effects import effect as _linear_effect
+from .timemodel import LinearRig, NonlinearRig, TimeModel
 
 
 @validate_params({"name": [str]}, error=DataTypeError)
@@ -78,5 +79,5 @@ __all__ = [
     "ParameterOffset", "Parameter", "MatchedFilter", "register", "unregister", "registered_names",
     "NONLINEAR", "NonlinearElement", "CubicAbsorberSpring", "CubicHostSpring", "AbsorberFriction",
     "QuadraticDamping", "InductorSaturation", "nonlinear_element", "nonlinear_names", "integrate", "equivalent_rig",
-    "register_nonlinear", "unregister_nonlinear",
+    "register_nonlinear", "unregister_nonlinear", "TimeModel", "LinearRig", "NonlinearRig",
 ]
