@@ -25,7 +25,7 @@ import numpy as np
 
 from ..conventions import ACCEL_CHANNELS, RECORDING_CHANNELS
 from .model import frf
-from .nonlinear import integrate
+from .nonlinear.integrate import integrate
 from .rig import Rig
 
 __all__ = ["TimeModel", "LinearRig", "NonlinearRig", "fast_length"]
