@@ -32,7 +32,8 @@ from .._fleet import fleet_map
 from ..identification import identify
 from ..io.frfdata import FRFData, require_data
 from ..physics import Rig
-from .adequacy import Reason, after_search, assess_fit, drop_stretched, inadequate_report, withdraw_if_inadequate
+from .adequacy import (Reason, after_search, assess_fit, drop_stretched, inadequate_report, rescued_by_one_effect,
+                       withdraw_if_inadequate)
 from .budget import bias_note, evidence_beyond_bias
 from .candidates import default_candidates
 from .discrepancy import fit_discrepancy
@@ -178,7 +179,9 @@ def _discover_frf(data: FRFData, rig, free, candidates, channels, alpha, max_eff
 
     nominal_fit = identify(data, rig, free, channels, warn=False)
     verdict = assess_fit(nominal_fit)  # can the SATMD model describe these data at all? (adequacy.py)
-    if not verdict.adequate:
+    search = Search(data, rig, free, channels, candidates) if data.has_std else None
+    if not verdict.adequate and not (search is not None and rescued_by_one_effect(verdict, search,
+                                                                                  Model((), [], nominal_fit), rig)):
         return inadequate_report(verdict, nominal_fit, alpha, t0)
     noise, noise_dof = "given", None
     if data.estimator.get("noise_dof"):  # an estimated std (Welch averages, LPM residuals): F tests keep α
@@ -199,7 +202,8 @@ def _discover_frf(data: FRFData, rig, free, candidates, channels, alpha, max_eff
         return withdraw_if_inadequate(report, after_search(nominal_fit, [], rig))
 
     nominal = Model((), [], nominal_fit)
-    search = Search(data, rig, free, channels, candidates)
+    if search is None or search.data is not data:  # the std was estimated: the search runs on the new data
+        search = Search(data, rig, free, channels, candidates)
 
     def significant(fit):
         return test_mismatch(fit, alpha, noise_dof).significant

@@ -7,8 +7,10 @@ Decided before any effect is named, in two steps:
    no SATMD rig as measured; the data are read again as the usual mistakes
    would have left them (conjugated, in g, mm/s², displacement, velocity, dB and
    phase, a dead or copied channel, noise) to name what is wrong. No effect
-   search is run on such data: no vocabulary effect of a plausible size
-   changes an FRF by that much.
+   search is run on such data, with one exception (`rescued_by_one_effect`): when
+   no mistake of the data is named and one vocabulary effect alone makes the fit
+   describe the data with plausible values (as a light host mode at a resonance
+   does, carrying most of the FRF's energy), the search runs.
 2. on the best augmented fit of the search: an effect that ends at the edge of
    its own search range, a free parameter pinned at an absurd value, or a large
    structured misfit left after the best vocabulary model (relative error
@@ -37,11 +39,14 @@ from ..identification.adequacy import (Adequacy, Reason, implausible_reason, imp
 from ..identification.adequacy import assess_fit as assess_one
 from ..identification.statistics import POOR_REL_ERROR
 
-__all__ = ["Adequacy", "Reason", "assess_fit", "after_search", "effects_at_edge", "inadequate_report",
+__all__ = ["Adequacy", "Reason", "MISTAKES", "assess_fit", "rescued_by_one_effect", "after_search", "effects_at_edge", "inadequate_report",
            "withdraw_if_inadequate", "trusted", "stretched", "drop_stretched", "STRUCTURE_REL_ERROR"]
 
 STRUCTURE_REL_ERROR = 0.15  # misfit left by the best vocabulary model beyond which it is another structure
 EDGE = 0.005  # share of a search range (log width for ranges over a decade) that counts as its edge
+
+#: Evidence that names what is wrong with the data themselves: no vocabulary effect can answer it.
+MISTAKES = ("sign_convention", "units", "db_phase", "channel", "noise_like")
 
 
 def assess_fit(fit) -> Adequacy:
@@ -59,6 +64,35 @@ def assess_fit(fit) -> Adequacy:
     from ..identification import identify
 
     return assess_one(fit, refit=identify)
+
+
+def rescued_by_one_effect(verdict, search, nominal, rig) -> bool:
+    """Whether a poor nominal fit is missing physics rather than other data: the verdict names no mistake of
+    the data themselves (`MISTAKES`) and one vocabulary effect alone makes the fit `trusted` (relative error
+    beyond the noise under ``STRUCTURE_REL_ERROR``, every value plausible), not stretched to its search
+    range's edge. A light host mode at a resonance does that; another structure does not with one effect
+    (a chain of five masses came within half of its data with a host mode, and within 15 % only with three
+    effects, one of them offsetting m1), nor does a file that is no FRF of a rig. The single-effect fits stay
+    in ``search``'s cache for the search that follows.
+
+    Parameters
+    ----------
+    verdict : the nominal fit's `Adequacy` (not adequate).
+    search : `select.Search` on the data.
+    nominal : `select.Model` of the nominal fit.
+    rig : the rig of fixed values (for the effects' search ranges).
+
+    Returns
+    -------
+    bool
+    """
+    if any(r.kind in MISTAKES for r in verdict.reasons):
+        return False
+    for c in search.candidates:
+        one = search.add(nominal, c)
+        if trusted(one.fit) and not effects_at_edge(one.effects, rig):
+            return True
+    return False
 
 
 def effects_at_edge(effects, rig) -> list:
