@@ -70,10 +70,10 @@ def rescued_by_one_effect(verdict, search, nominal, rig) -> bool:
     """Whether a poor nominal fit is missing physics rather than other data: the verdict names no mistake of
     the data themselves (`MISTAKES`) and one vocabulary effect alone makes the fit `trusted` (relative error
     beyond the noise under ``STRUCTURE_REL_ERROR``, every value plausible), not stretched to its search
-    range's edge. A light host mode at a resonance does that; another structure does not with one effect
-    (a chain of five masses came within half of its data with a host mode, and within 15 % only with three
-    effects, one of them offsetting m1), nor does a file that is no FRF of a rig. The single-effect fits stay
-    in ``search``'s cache for the search that follows.
+    range's edge. A light host mode at a resonance does that; a file that is no FRF of a rig, or another
+    structure that one effect cannot make the rig, does not, and is refused without the whole search (the
+    later rules judge a rescued fit like any other: `after_search`). The single-effect fits stay in
+    ``search``'s cache for the search that follows.
 
     Parameters
     ----------
