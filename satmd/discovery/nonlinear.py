@@ -278,7 +278,7 @@ def common_frfs(recordings) -> list:
     band = (max(b[0] for b in bands), min(b[1] for b in bands))
     first = estimate_frf(recordings[0], band_hz=band)
     width = first.estimator.get("window_hz") or first.estimator.get("settings", {}).get("window_hz")
-    out = [estimate_frf(r, band_hz=band, width_hz=width) for r in recordings]
+    out = [first] + [estimate_frf(r, band_hz=band, width_hz=width) for r in recordings[1:]]  # the first: as is
     return [_with_model_error(d, r, band, width) if d.estimator.get("method") == "lpm" else d
             for d, r in zip(out, recordings)]
 
