@@ -233,7 +233,7 @@ def hold_shift(coords, x, J, r, data, weights, skip) -> np.ndarray:
     cubic spring's k3 absorbs as a bias of about one σ of a 30 s record. Richardson's extrapolation
     between ``oversample`` and twice it (`integrate`'s ``extrapolate``) removes the Δ² term; the fit
     is moved by the Gauss-Newton step of that change in the residuals, with the fit's Jacobian
-    (the change is 1e-4 of the response: its linearisation is exact to far below the noise). One
+    (the change is a small fraction of a per cent of the response: linear in the parameters). One
     simulation per recording at 2× and 1× the rate, instead of fitting at the finer rate throughout.
 
     Parameters
