@@ -32,8 +32,8 @@ from .._fleet import fleet_map
 from ..identification import identify
 from ..io.frfdata import FRFData, require_data
 from ..physics import Rig
-from .adequacy import (Reason, after_search, assess_fit, drop_stretched, inadequate_report, rescued_by_one_effect,
-                       withdraw_if_inadequate)
+from .adequacy import (Reason, after_search, assess_fit, drop_stretched, implausible_within_noise, inadequate_report,
+                       rescued_by_one_effect, withdraw_if_inadequate)
 from .budget import bias_note, evidence_beyond_bias
 from .candidates import default_candidates
 from .discrepancy import fit_discrepancy
@@ -199,7 +199,7 @@ def _discover_frf(data: FRFData, rig, free, candidates, channels, alpha, max_eff
                                  judged=(), parameters=dict(nominal_fit.values), fit_before=before, fit_after=before,
                                  nominal_fit=nominal_fit, final_fit=nominal_fit, discrepancy=None, p_values=p_values,
                                  whiteness=test0.whiteness, wall_time=time.perf_counter() - t0)
-        return withdraw_if_inadequate(report, after_search(nominal_fit, [], rig))
+        return withdraw_if_inadequate(report, implausible_within_noise(nominal_fit, rig))
 
     nominal = Model((), [], nominal_fit)
     if search is None or search.data is not data:  # the std was estimated: the search runs on the new data

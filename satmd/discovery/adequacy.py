@@ -39,7 +39,8 @@ from ..identification.adequacy import (Adequacy, Reason, implausible_reason, imp
 from ..identification.adequacy import assess_fit as assess_one
 from ..identification.statistics import POOR_REL_ERROR
 
-__all__ = ["Adequacy", "Reason", "MISTAKES", "assess_fit", "rescued_by_one_effect", "after_search", "effects_at_edge", "inadequate_report",
+__all__ = ["Adequacy", "Reason", "MISTAKES", "assess_fit", "rescued_by_one_effect", "implausible_within_noise",
+           "after_search", "effects_at_edge", "inadequate_report",
            "withdraw_if_inadequate", "trusted", "stretched", "drop_stretched", "STRUCTURE_REL_ERROR"]
 
 STRUCTURE_REL_ERROR = 0.15  # misfit left by the best vocabulary model beyond which it is another structure
@@ -95,6 +96,27 @@ def rescued_by_one_effect(verdict, search, nominal, rig) -> bool:
     return False
 
 
+def implausible_within_noise(fit, rig) -> list:
+    """The verdict on a nominal fit within the noise (no mismatch, so no search): `identify`'s (absurd values:
+    not adequate). The values may stand in for an effect the data cannot tell apart from them (a concealed
+    shunt capacitance fits as R ~ 1 kΩ and L ~ 5 H within the noise): the message says so. Empty when the
+    values are plausible.
+
+    Parameters
+    ----------
+    fit : the nominal FitResult.
+    rig : the rig of fixed values.
+
+    Returns
+    -------
+    list of Reason
+    """
+    reasons = after_search(fit, [], rig, who="the fit")
+    tail = (": another structure, data in other units, or an effect these values stand in for that the data "
+            "cannot tell apart from them (a shunt capacitance, say)")
+    return [Reason(r.kind, r.message + tail, r.evidence) if r.kind == "implausible" else r for r in reasons]
+
+
 def effects_at_edge(effects, rig) -> list:
     """A `Reason` for each fitted effect parameter at the edge of its own search range (not at its neutral)."""
     out = []
@@ -125,7 +147,7 @@ def _near(v, b, lo, hi) -> bool:
     return abs(v - b) <= EDGE * (hi - lo)
 
 
-def after_search(fit, effects, rig, discrepancy=None) -> list:
+def after_search(fit, effects, rig, discrepancy=None, who: str = "the best augmented fit") -> list:
     """Evidence against the model from the best augmented fit of the search (see the module docstring).
 
     Parameters
@@ -134,6 +156,7 @@ def after_search(fit, effects, rig, discrepancy=None) -> list:
     effects : its fitted effects.
     rig : the rig of fixed values (for the effects' search ranges).
     discrepancy : the smooth correction fitted to what is left, when the mismatch remained significant.
+    who : how the messages name the fit.
 
     Returns
     -------
@@ -141,12 +164,12 @@ def after_search(fit, effects, rig, discrepancy=None) -> list:
         Empty when the augmented model describes the data.
     """
     out = effects_at_edge(effects, rig)
-    absurd = implausible_reason(fit, "the best augmented fit")
+    absurd = implausible_reason(fit, who)
     if absurd:
         out.append(absurd)
     rel = rel_error_beyond_noise(fit)
     if rel >= POOR_REL_ERROR:
-        out.append(Reason("poor_fit", f"the best augmented fit reproduces little of the data (relative FRF error "
+        out.append(Reason("poor_fit", f"{who} reproduces little of the data (relative FRF error "
                                       f"{rel:.3g})", {"rel_error": rel}))
     elif discrepancy is not None and rel >= STRUCTURE_REL_ERROR and discrepancy.structured_fraction > 0.5:
         out.append(Reason("structure_left", f"after the best vocabulary model {100 * rel:.0f} % of the data is still "

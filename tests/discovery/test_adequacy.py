@@ -127,6 +127,7 @@ def test_a_fit_within_the_noise_with_implausible_values_gets_one_verdict():
     assert not rep.significant_mismatch
     assert fit.model_adequate is False and rep.model_adequate is False
     assert _kinds(rep) == ["implausible"] == [r.kind for r in fit.adequacy.reasons]
+    assert rep.adequacy_reasons[0].message.startswith("the fit needs m2 = ")  # no search ran: not "augmented"
 
 
 def test_an_effect_at_the_edge_of_its_search_range_is_evidence():
