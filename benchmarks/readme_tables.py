@@ -263,6 +263,7 @@ def measured() -> str:
     ns = ide.get("coverage_no_std", {})
     s, r = fwd["satmd"], fwd["ratios"]
     acc, se, se2 = dis["acceptance"], dis["single_effect"], dis["two_effects"]
+    absorbed_inadequate = sum(not c["detectable"] for c in se.get("called_inadequate_cases", []))
     ne, n0, n1 = dis["single_effect_noise_estimated"], dis["null_std_given"], dis["null_noise_estimated"]
     p2, h2 = inv["table2"]["physics"], inv["table2"]["hybrid"]
     train = _cell(inv, "physics", "paper", 0.0)["train_s"]
@@ -316,7 +317,11 @@ def measured() -> str:
         f"{n0['false_positives']} / {n1['false_positives']} | same |",
         f"| discovery, {se['n']} concealed single effects (std given) | {se['correct_of_detectable']}/"
         f"{se['detectable']} of the detectable ones found ({se['n'] - se['detectable']} absorbed by the free "
-        f"parameters); median {se['median_time_s']:.2f} s | same |",
+        f"parameters" + (f", {absorbed_inadequate} of them at absurd values, so called not adequate"
+                         if absorbed_inadequate else "") + ")"
+        + (f"; {se['called_inadequate'] - absorbed_inadequate} detectable ones called not adequate"
+           if se.get("called_inadequate", 0) > absorbed_inadequate else "")
+        + f"; median {se['median_time_s']:.2f} s | same |",
         f"| discovery with noise estimated / two simultaneous effects | {ne['correct_of_detectable']}/"
         f"{ne['detectable']} / {se2['correct_of_detectable']}/{se2['detectable']} of the detectable ones | same |",
         f"| start-up: `import satmd`, `satmd --help` (fresh interpreter each, median of {st['repeats']}) | "
