@@ -42,6 +42,7 @@ from ..validation import Interval, Whole, validate_params
 from ..conventions import RECORDING_CHANNELS, TINY
 from ..errors import DataError
 from .forcefloor import force_noise_floor, true_runs as _runs
+from .memo import ContentMemo, fingerprint
 
 _RESPONSES = RECORDING_CHANNELS
 
@@ -86,9 +87,18 @@ def excited_band(force: np.ndarray, fs_hz: float, smooth_hz: float = 1.0, drop_d
     return band["lo"], band["hi"], band["floor"]["floor"]
 
 
+#: what was found of recordings already read (the same force and settings: the same answer, computed once)
+_EXCITED, _LPM = ContentMemo(), ContentMemo()
+
+
 def _excited(force, fs_hz, smooth_hz=1.0, drop_db=20.0) -> dict:
     """The excited band (bins and Hz) and the force-noise floor verdict (`force_noise_floor`)."""
     force = np.asarray(force, dtype=float)
+    return _EXCITED.answer(fingerprint(force, settings=(float(fs_hz), float(smooth_hz), float(drop_db))),
+                           lambda: _find_excited(force, fs_hz, smooth_hz, drop_db))
+
+
+def _find_excited(force, fs_hz, smooth_hz, drop_db) -> dict:
     n = force.size
     if not np.isfinite(fs_hz) or fs_hz <= 0:
         raise DataError(f"sample rate {fs_hz!r} Hz is not a positive number")
@@ -152,12 +162,21 @@ def lpm(recording, band_hz=None, width_hz: float | None = None, degree: int = 2,
     LPMEstimate
     """
     from ..errors import renamed_keyword
-    from .chain import sharpest_resonance
     from .recdata import check_rate
 
     band_hz = renamed_keyword(band, band_hz, "lpm")
 
     check_rate(recording.meta.get("source", "recording"), recording.fs_hz)  # entry check (time in ms, ...)
+    channels = ["force"] + [c for c in _RESPONSES if c in recording.channels]
+    band_key = None if band_hz is None else tuple(band_hz)
+    settings = (channels, recording.fs_hz, band_key, width_hz, degree, smooth)  # reprs: exact for floats
+    return _LPM.answer(fingerprint(*(recording[c] for c in channels), settings=settings),
+                       lambda: _lpm(recording, band_hz, width_hz, degree, smooth))
+
+
+def _lpm(recording, band_hz, width_hz, degree, smooth) -> LPMEstimate:
+    from .chain import sharpest_resonance
+
     fs, n = recording.fs_hz, recording.n_samples
     x = recording["force"]
     found = _excited(x, fs)

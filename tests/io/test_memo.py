@@ -1,0 +1,85 @@
+"""Each recording is analysed once (issue 36, item 0): the memo of `satmd.io.memo` behind `lpm` and the
+force's excited band answers a question asked before, by the data's content, never with a stale or shared
+answer."""
+from __future__ import annotations
+
+import numpy as np
+
+import satmd
+from satmd.io import lpm as lpm_module
+from satmd.io.lpm import excited_band, lpm
+from satmd.io.memo import ContentMemo, fingerprint
+from satmd.io.timesim import simulate_recording
+from satmd.physics import Rig
+
+
+def _recording(seed=0):
+    return simulate_recording(20.0, 1000.0, rig=Rig(R=30.0, L=0.15), noise=0.02, seed=seed)
+
+
+def _count_fits(monkeypatch):
+    calls = {"band": 0, "lpm": 0}
+    find, fit = lpm_module._find_excited, lpm_module._lpm
+
+    def counted_find(*a):
+        calls["band"] += 1
+        return find(*a)
+
+    def counted_fit(*a):
+        calls["lpm"] += 1
+        return fit(*a)
+
+    monkeypatch.setattr(lpm_module, "_find_excited", counted_find)
+    monkeypatch.setattr(lpm_module, "_lpm", counted_fit)
+    lpm_module._EXCITED.clear()
+    lpm_module._LPM.clear()
+    return calls
+
+
+def test_a_recording_asked_twice_is_analysed_once(monkeypatch):
+    calls = _count_fits(monkeypatch)
+    rec = _recording()
+    first = lpm(rec, band_hz=(30.0, 150.0))
+    second = lpm(rec, band_hz=(30.0, 150.0))
+    excited_band(rec["force"], rec.fs_hz)
+    assert calls == {"band": 1, "lpm": 1}
+    for c in first.frf:
+        np.testing.assert_array_equal(first.frf[c], second.frf[c])
+        np.testing.assert_array_equal(first.std[c], second.std[c])
+    lpm(rec, band_hz=(30.0, 150.0), degree=3)  # other settings: another question
+    assert calls["lpm"] == 2
+
+
+def test_a_changed_recording_or_an_edited_answer_is_never_reused(monkeypatch):
+    calls = _count_fits(monkeypatch)
+    rec = _recording(1)
+    est = lpm(rec)
+    est.frf["a1"][:] = 0.0  # the caller edits what it got: the next caller's answer is not edited
+    again = lpm(rec)
+    assert calls["lpm"] == 1 and np.all(np.abs(again.frf["a1"]) > 0)
+    rec["acc1"][:] *= 2.0  # arrays shared with the caller, changed in place: a new question
+    doubled = lpm(rec)
+    assert calls["lpm"] == 2
+    np.testing.assert_allclose(doubled.frf["a1"], 2.0 * again.frf["a1"], rtol=1e-9)
+
+
+def test_discover_estimates_each_recording_once_per_setting(monkeypatch):
+    calls = _count_fits(monkeypatch)
+    asked = []
+    answer = lpm_module._LPM.answer
+    monkeypatch.setattr(lpm_module._LPM, "answer", lambda key, compute: asked.append(key) or answer(key, compute))
+    satmd.discover([_recording(2), _recording(3)])
+    assert calls["band"] == 2  # one force each: found once, asked for by every stage (15 times before)
+    assert len(asked) > calls["lpm"] == len(set(asked))  # the estimate, its model error, the distortion test's
+
+
+def test_the_fingerprint_tells_data_apart_and_the_memo_stays_small():
+    x = np.arange(10.0)
+    assert fingerprint(x) == fingerprint(x.copy())
+    assert fingerprint(x) != fingerprint(x.astype(np.float32))
+    assert fingerprint(x) != fingerprint(x.reshape(2, 5))
+    assert fingerprint(x, settings=(1.0,)) != fingerprint(x, settings=(1.0 + 1e-15,))
+    memo = ContentMemo(size=2)
+    for k in range(5):
+        assert memo.answer(bytes([k]), lambda k=k: [k]) == [k]
+    assert len(memo._answers) == 2
