@@ -168,8 +168,8 @@ def lpm(recording, band_hz=None, width_hz: float | None = None, degree: int = 2,
 
     check_rate(recording.meta.get("source", "recording"), recording.fs_hz)  # entry check (time in ms, ...)
     channels = ["force"] + [c for c in _RESPONSES if c in recording.channels]
-    band_key = None if band_hz is None else tuple(band_hz)
-    settings = (channels, recording.fs_hz, band_key, width_hz, degree, smooth)  # reprs: exact for floats
+    band_key = None if band_hz is None else tuple(None if b is None else float(b) for b in band_hz)
+    settings = (channels, float(recording.fs_hz), band_key, width_hz, degree, smooth)  # scalars: exact reprs
     return _LPM.answer(fingerprint(*(recording[c] for c in channels), settings=settings),
                        lambda: _lpm(recording, band_hz, width_hz, degree, smooth))
 

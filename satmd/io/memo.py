@@ -22,7 +22,8 @@ import numpy as np
 
 
 def fingerprint(*arrays, settings=()) -> bytes:
-    """A digest of ``arrays`` (their dtype, shape and bytes) and ``settings`` (anything with a stable repr)."""
+    """A digest of ``arrays`` (their dtype, shape and bytes) and ``settings``, whose repr must tell every two
+    settings apart: Python and NumPy scalars, strings and tuples of them (not arrays: their repr rounds)."""
     h = hashlib.blake2b(digest_size=20)
     for a in arrays:
         a = np.ascontiguousarray(a)

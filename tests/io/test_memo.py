@@ -83,3 +83,13 @@ def test_the_fingerprint_tells_data_apart_and_the_memo_stays_small():
     for k in range(5):
         assert memo.answer(bytes([k]), lambda k=k: [k]) == [k]
     assert len(memo._answers) == 2
+
+
+def test_bands_that_differ_in_the_last_digit_are_two_questions(monkeypatch):
+    calls = _count_fits(monkeypatch)
+    rec = _recording(4)
+    lpm(rec, band_hz=(np.float64(30.0), np.float64(150.0)))
+    lpm(rec, band_hz=(30.0, 150.0 + 1e-9))
+    assert calls["lpm"] == 2
+    lpm(rec, band_hz=[30.0, 150.0])  # the same band, as floats in a list: the same question
+    assert calls["lpm"] == 2
