@@ -85,18 +85,20 @@ def solve_plain_into(omega, rig, out: dict, work: "Workspace") -> None:
     Cp = rig["Cp"]
     Z33 = work.get("Z33", shape)  # 1/Cp + iω (R + iωL) = (1/Cp - ω (ωL)) + i ωR
     wL = np.multiply(omega, rig["L"], out=work.get("wL", shape, float))
-    np.subtract(1.0 / Cp, np.multiply(work.full("w", omega, shape, float), wL, out=wL), out=Z33.real)
+    np.subtract(1.0 / Cp, np.multiply(work.tile("w", shape, lambda: omega, omega, dtype=float), wL, out=wL),
+                out=Z33.real)
     np.multiply(omega, rig["R"], out=Z33.imag)
     b = rig["e"] / Cp
     bz = np.divide(b, Z33, out=work.get("bz", shape))
     K = np.multiply(b, bz, out=work.get("K", shape))
     np.subtract(rig["kp"], K.real, out=K.real)  # K = (kp + iω cp) - b bz
-    np.subtract(work.full("wcp", omega * rig["cp"], shape, float), K.imag, out=K.imag)
+    np.subtract(work.tile("wcp", shape, lambda: omega * rig["cp"], omega, rig["cp"], dtype=float), K.imag,
+                out=K.imag)
     M2 = work.get("M2 (real)", shape)  # only its real part is ever written: a real m2 ω² the complex products take
     np.multiply(rig["m2"], w2, out=M2.real)
     KmM = np.subtract(K, M2, out=work.get("KmM", shape))
-    K1 = rig["k1"] - rig["m1"] * w2 + 1j * omega * rig["c1"]
-    inv = np.multiply(work.full("K1", K1, shape), KmM, out=work.get("inv", shape))
+    K1 = work.tile("K1", shape, lambda: host_terms(omega, rig), omega, rig["k1"], rig["m1"], rig["c1"])
+    inv = np.multiply(K1, KmM, out=work.get("inv", shape))
     np.subtract(inv, np.multiply(K, M2, out=work.get("tmp", shape)), out=inv)
     np.divide(rig["F0"], inv, out=inv)  # inv = F0 / (K1 KmM - K M2)
     u1: Any = np.multiply(KmM, inv, out=dest("u1")) if "u1" in out or "a1" in out else None
@@ -104,10 +106,15 @@ def solve_plain_into(omega, rig, out: dict, work: "Workspace") -> None:
     if "q" in out:
         np.multiply(np.multiply(bz, M2, out=work.get("tmp", shape)), inv, out=out["q"])
     if "a1" in out or "a2" in out:
-        mw2 = work.full("g", -w2, shape)
+        mw2 = work.tile("g", shape, lambda: -w2, omega)
         for ch, u in (("a1", u1), ("a2", u2)):
             if ch in out:
                 np.multiply(mw2, u, out=out[ch])
+
+
+def host_terms(omega, rig):
+    """K1 = k1 - m1 ω² + iω c1, the operations of `model.terms` (the same bits)."""
+    return rig["k1"] - rig["m1"] * (omega * omega) + 1j * omega * rig["c1"]
 
 
 #: rig fields whose tangents `plain_dual_terms` writes itself (the model's usual free parameters)
@@ -126,19 +133,22 @@ def plain_dual_terms(omega, rig, wrt: Sequence[str], work: "Workspace") -> Simpl
     Cp = rig["Cp"]
     Z33 = work.get("Z33", shape)  # as in solve_plain_into
     wL = np.multiply(omega, rig["L"], out=work.get("wL", shape, float))
-    np.subtract(1.0 / Cp, np.multiply(work.full("w", omega, shape, float), wL, out=wL), out=Z33.real)
+    np.subtract(1.0 / Cp, np.multiply(work.tile("w", shape, lambda: omega, omega, dtype=float), wL, out=wL),
+                out=Z33.real)
     np.multiply(omega, rig["R"], out=Z33.imag)
     b = rig["e"] / Cp
     bz = np.divide(b, Z33, out=work.get("bz", shape))
     K = np.multiply(b, bz, out=work.get("K", shape))  # Kp - b bz with Kp = kp + iω cp = (kp, ω cp) exactly
     np.subtract(rig["kp"], K.real, out=K.real)
-    np.subtract(work.full("wcp", omega * rig["cp"], shape, float), K.imag, out=K.imag)
+    np.subtract(work.tile("wcp", shape, lambda: omega * rig["cp"], omega, rig["cp"], dtype=float), K.imag,
+                out=K.imag)
     M2 = work.get("M2 (real)", shape)  # complex with a zero imaginary part, as the solve casts it
     np.multiply(rig["m2"], w2, out=M2.real)
     iw = 1j * omega
     dZ33 = {"R": 1.0 * iw, "L": (1.0 * iw) * iw}  # what the duals of R and L come out of `terms` with
     return SimpleNamespace(
-        omega=omega, K1=rig["k1"] - rig["m1"] * w2 + 1j * omega * rig["c1"], b=b, F0=rig["F0"],
+        omega=omega, K1=work.tile("K1", shape, lambda: host_terms(omega, rig), omega, rig["k1"], rig["m1"], rig["c1"]),
+        b=b, F0=rig["F0"],
         Kp=dual.Dual(None, {"kp": 1.0} if "kp" in wrt else {}),  # its value is in bz_K: K = Kp - b bz
         Z33=dual.Dual(Z33, {n: dZ33[n] for n in ("R", "L") if n in wrt}), bz_K=(bz, K),
         M2=dual.Dual(M2, {"m2": 1.0 * w2}) if "m2" in wrt else M2, s1=None, s2=None)
@@ -151,6 +161,7 @@ class Workspace:
         self._buffers = {}
         self._views = {}
         self._tiles = {}
+        self._frequency_tiles = {}
 
     def get(self, name, shape, dtype=complex):
         """The scratch array ``name`` of ``shape`` (its contents are whatever was left there; a new
@@ -163,6 +174,20 @@ class Workspace:
                 buf = self._buffers[name] = np.zeros(size, dtype=dtype)
             view = self._views[name, shape] = buf[:size].reshape(shape)
         return view
+
+    def tile(self, name, shape, make, omega, *fields, dtype=complex):
+        """``make()``, a function of ``omega`` and the rig's ``fields``, as an array of the chunk's ``shape``,
+        made once and kept while ``omega`` (the same object) and the fields (scalars) stay the same: a
+        frequency-only quantity costs nothing per chunk. A field that varies by row (an array) makes it
+        vary by row: made each time, not kept. Exact."""
+        if any(isinstance(x, np.ndarray) for x in fields):
+            return make()
+        kept = self._frequency_tiles.get((name, shape))
+        if kept is None or kept[0] is not omega or kept[1] != fields:
+            tiled = self.get("frequency " + name, shape, dtype)
+            tiled[...] = make()
+            kept = self._frequency_tiles[name, shape] = (omega, fields, tiled)  # omega held: its id stays its own
+        return kept[2]
 
     def full(self, name, x, shape, dtype=complex):
         """``x`` as an array of the chunk's ``shape``. A quantity that
