@@ -19,11 +19,12 @@ every backend. The kernels here evaluate that closed form on NumPy chunks:
 Where the time goes (10⁴ rigs x 60 frequencies, issue 36): the two complex
 divisions (numpy's Smith loop, a third of a chunk), the passes over complex
 arrays, and the kernel's page faults on fresh output memory: the outputs are one
-allocation (`model.frf`), mapped in huge pages, not one per channel.
+allocation (`model.frf`), mapped in huge pages, not one per channel, and reused
+once the caller has let go of them (`buffers.OutputPool`). Scratch buffers live
+in a `buffers.Workspace`.
 """
 from __future__ import annotations
 
-import math
 from types import SimpleNamespace
 from typing import Any, Sequence
 
@@ -31,6 +32,7 @@ import numpy as np
 
 from ..conventions import ACCEL_CHANNELS, DEFAULT_FREE
 from . import dual
+from .buffers import Workspace
 
 
 def solve_into(t, out: dict, work: "Workspace") -> None:
@@ -152,56 +154,6 @@ def plain_dual_terms(omega, rig, wrt: Sequence[str], work: "Workspace") -> Simpl
         Kp=dual.Dual(None, {"kp": 1.0} if "kp" in wrt else {}),  # its value is in bz_K: K = Kp - b bz
         Z33=dual.Dual(Z33, {n: dZ33[n] for n in ("R", "L") if n in wrt}), bz_K=(bz, K),
         M2=dual.Dual(M2, {"m2": 1.0 * w2}) if "m2" in wrt else M2, s1=None, s2=None)
-
-
-class Workspace:
-    """Scratch buffers of one worker thread, kept across chunks."""
-
-    def __init__(self):
-        self._buffers = {}
-        self._views = {}
-        self._tiles = {}
-        self._frequency_tiles = {}
-
-    def get(self, name, shape, dtype=complex):
-        """The scratch array ``name`` of ``shape`` (its contents are whatever was left there; a new
-        buffer starts as zeros, so a complex one of which only ``.real`` is ever written stays real)."""
-        view = self._views.get((name, shape))
-        if view is None:
-            size = math.prod(shape)
-            buf = self._buffers.get(name)
-            if buf is None or buf.size < size:
-                buf = self._buffers[name] = np.zeros(size, dtype=dtype)
-            view = self._views[name, shape] = buf[:size].reshape(shape)
-        return view
-
-    def tile(self, name, shape, make, omega, *fields, dtype=complex):
-        """``make()``, a function of ``omega`` and the rig's ``fields``, as an array of the chunk's ``shape``,
-        made once and kept while ``omega`` (the same object) and the fields (scalars) stay the same: a
-        frequency-only quantity costs nothing per chunk. A field that varies by row (an array) makes it
-        vary by row: made each time, not kept. Exact."""
-        if any(isinstance(x, np.ndarray) for x in fields):
-            return make()
-        kept = self._frequency_tiles.get((name, shape))
-        if kept is None or kept[0] is not omega or kept[1] != fields:
-            tiled = self.get("frequency " + name, shape, dtype)
-            tiled[...] = make()
-            kept = self._frequency_tiles[name, shape] = (omega, fields, tiled)  # omega held: its id stays its own
-        return kept[2]
-
-    def full(self, name, x, shape, dtype=complex):
-        """``x`` as an array of the chunk's ``shape``. A quantity that
-        varies along frequency only (the same in every chunk) is broadcast once
-        and kept while it does not change: operations on whole contiguous
-        arrays run several times faster than on broadcast ones. Exact."""
-        if not isinstance(x, np.ndarray) or x.ndim != 1:
-            return x
-        key = x.tobytes()  # ~1 KB: cheaper to compare than anything else
-        cached = self._tiles.get((name, shape))
-        if cached is None or cached[0] != key:
-            cached = self._tiles[name, shape] = (key, self.get(name, shape, dtype))
-            cached[1][...] = x
-        return cached[1]
 
 
 def solve_with_tangents(t, wrt: Sequence[str], outputs: Sequence[str], out_values: dict, out_jac: dict,
@@ -338,3 +290,4 @@ def _is_one(x):
 
 def _acc(total, x):
     return x if total is None else total + x
+

@@ -33,7 +33,8 @@ from ..validation import NAMES, Interval, Whole, validate_params
 
 from . import dual
 from .effects import Effect
-from .kernels import PLAIN_WRT, Workspace, plain_dual_terms, solve_into, solve_plain_into, solve_with_tangents
+from .buffers import OUTPUTS, Workspace, kept_workspace
+from .kernels import PLAIN_WRT, plain_dual_terms, solve_into, solve_plain_into, solve_with_tangents
 from .rig import Rig
 
 STATES = ("u1", "u2", "q")
@@ -273,10 +274,12 @@ def frf(
     omega = 2.0 * np.pi * freq
 
     # each channel's array is one slab of a single allocation: one large block is mapped in huge pages,
-    # several blocks of a few MB each cost the kernel 4 kB page faults that took as long as a third of the solve
-    block = np.empty((len(outputs), n_rows, n_freq), dtype=complex)
+    # several blocks of a few MB each cost the kernel 4 kB page faults that took as long as a third of the solve;
+    # the block of an earlier call the caller has let go of is reused (`buffers.OutputPool`: no page zeroed again)
+    block = OUTPUTS.empty((len(outputs), n_rows, n_freq))
     out = dict(zip(outputs, block))
-    jac = dict(zip(outputs, np.empty((len(outputs), n_rows, n_freq, len(wrt)), dtype=complex))) if wrt else {}
+    jac_block = OUTPUTS.empty((len(outputs), n_rows, n_freq, len(wrt))) if wrt else None
+    jac = {} if jac_block is None else dict(zip(outputs, jac_block))
     step = max(1, (_CHUNK_ELEMENTS * (2 if wrt else 1)) // max(n_freq, 1))  # a Jacobian's chunks: more work per call
     flat_rig = {n: _flatten(getattr(rig, n), batch) for n in Rig.names()}
     rig_arrays = [n for n, v in flat_rig.items() if isinstance(v, np.ndarray)]
@@ -326,15 +329,18 @@ def frf(
             for f in [pool.submit(worker) for _ in range(n_threads)]:
                 f.result()
     else:
-        work = Workspace()
-        for sl in chunks:
-            run(sl, work)
+        with kept_workspace() as work:
+            for sl in chunks:
+                run(sl, work)
 
     shape = batch + (n_freq,)
     res = Response(freq_hz=freq, wrt=wrt)
     for ch in outputs:
         setattr(res, ch, out[ch].reshape(shape))
     res.jac = {ch: a.reshape(shape + (len(wrt),)) for ch, a in jac.items()}
+    for used in (block, jac_block):
+        if used is not None:
+            OUTPUTS.keep(used)
     return res
 
 

@@ -5,7 +5,8 @@ import numpy as np
 import pytest
 
 from satmd.physics import CHANNELS, PAPER_GRID_HZ, Rig, effect, frf, solve, terms
-from satmd.physics.kernels import Workspace, solve_into
+from satmd.physics.buffers import Workspace
+from satmd.physics.kernels import solve_into
 
 FREQ = np.concatenate([[0.0, 2.0], PAPER_GRID_HZ, [480.0]])
 

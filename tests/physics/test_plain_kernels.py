@@ -12,7 +12,8 @@ import pytest
 from satmd.conventions import DEFAULT_FREE
 from satmd.physics import CHANNELS, PAPER_GRID_HZ, Rig, frf, solve, terms
 from satmd.physics import dual
-from satmd.physics.kernels import PLAIN_WRT, Workspace, plain_dual_terms, solve_plain_into, solve_with_tangents
+from satmd.physics.buffers import Workspace
+from satmd.physics.kernels import PLAIN_WRT, plain_dual_terms, solve_plain_into, solve_with_tangents
 
 FREQ = np.concatenate([[0.0, 2.0], PAPER_GRID_HZ, [480.0]])
 OMEGA = 2 * np.pi * FREQ
