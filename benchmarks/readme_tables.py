@@ -303,9 +303,9 @@ def measured() -> str:
         f"{r['satmd_over_numpy_solve']:.1f}× batched `numpy.linalg.solve`"
         + (" ({:.1f}–{:.1f}× round by round, interquartile)".format(*r["satmd_over_numpy_solve_per_round_quartiles"][::2])
            if "satmd_over_numpy_solve_per_round_quartiles" in r else "")
-        + (f"; {r['satmd_fresh_memory_over_numpy_solve']:.1f}× when every result is still held (no memory reused)"
-           if "satmd_fresh_memory_over_numpy_solve" in r else "")
-        + f", {r['satmd_over_torch_solve_c64']:.1f}× "
+        + (f", {r['satmd_fresh_memory_over_numpy_solve']:.1f}× when the caller still holds every earlier result "
+           f"(no memory reused: `satmd.physics.buffers`);" if "satmd_fresh_memory_over_numpy_solve" in r else ",")
+        + f" {r['satmd_over_torch_solve_c64']:.1f}× "
         f"`torch.linalg.solve` (complex64); 4-parameter Jacobian {s['jacobian4_over_frf_a1a2']:.1f}× one FRF"
         + (f" (same run; {fwd['machine']['cpu_count']}-core CPU at load average "
            f"{fwd['machine']['load_average_1_5_15_before'][0]:.1f})"
