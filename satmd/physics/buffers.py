@@ -87,8 +87,10 @@ class Workspace:
 
 
 #: a thread keeps its workspace between calls only while it holds at most this many bytes (ordinary chunks
-#: hold a few MB; a call with 10⁶ frequencies would otherwise keep hundreds)
+#: hold a few MB; a call with 10⁶ frequencies would otherwise keep hundreds) and buffers (kept tiles have one
+#: per chunk shape: calls on many grids would otherwise pile them up)
 _KEPT_BYTES = 32 * 2**20
+_KEPT_BUFFERS = 512
 _kept = threading.local()
 
 
@@ -104,7 +106,7 @@ def kept_workspace():
     try:
         yield work
     finally:
-        if work.nbytes <= _KEPT_BYTES:
+        if work.nbytes <= _KEPT_BYTES and len(work._buffers) <= _KEPT_BUFFERS:
             _kept.work = work
 
 

@@ -290,4 +290,3 @@ def _is_one(x):
 
 def _acc(total, x):
     return x if total is None else total + x
-

@@ -127,6 +127,10 @@ def test_a_thread_keeps_its_workspace_and_a_call_inside_a_call_gets_another():
         again.get("big", (2**22,))  # 64 MB: more than a thread keeps
     with kept_workspace() as fresh:
         assert fresh is not again and fresh.nbytes == 0
+        for n in range(600):  # many small buffers (a tile per chunk shape, calls on many grids)
+            fresh.get(f"x{n}", (1, 3))
+    with kept_workspace() as other:
+        assert other is not fresh
 
 
 def test_an_outgrown_buffer_lets_go_of_its_old_views():
