@@ -20,8 +20,11 @@ $(STAMP): pyproject.toml $(LOCK)
 demo: $(STAMP)
 	$(VENV)/bin/satmd reproduce --out report
 
+# The suite on every core (pytest-xdist: the tests are independent), one BLAS thread a worker: two
+# workers of two BLAS threads each would fight over two cores.
+TEST_ENV := OMP_NUM_THREADS=1 OPENBLAS_NUM_THREADS=1 MKL_NUM_THREADS=1
 test: $(STAMP)
-	$(PY) -m pytest -q
+	$(TEST_ENV) $(PY) -m pytest -q -n auto
 
 bench: $(STAMP)
 	@for b in benchmarks/*.py; do case $$b in */readme_tables.py|*/_*.py) continue;; esac; \
@@ -53,7 +56,7 @@ docs-check: $(STAMP)
 test-latest:
 	@test -x .venv-latest/bin/python || $(PYTHON) -m venv .venv-latest
 	.venv-latest/bin/pip install -q --disable-pip-version-check --upgrade -c constraints.txt -e '.[all,dev]'
-	.venv-latest/bin/python -m pytest -q
+	$(TEST_ENV) .venv-latest/bin/python -m pytest -q -n auto
 
 clean:
 	rm -rf $(VENV) .venv-lock .venv-latest report .pytest_cache .hypothesis build docs/api/generated docs/auto_examples \

@@ -40,7 +40,8 @@ from pathlib import Path
 import numpy as np
 
 ROOT = Path(__file__).resolve().parents[1]
-SHARED = ROOT.parent / "shared"
+from satmd.io.shared import shared_dir  # noqa: E402
+SHARED = shared_dir() or ROOT.parent / "shared"
 ACCEPTANCE = SHARED / "acceptance" / "discovery"
 SCORER = SHARED / "tools" / "score_discovery.py"
 

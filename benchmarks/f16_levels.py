@@ -23,12 +23,13 @@ import warnings
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
+from satmd.io.shared import shared_dir  # noqa: E402
 sys.path.insert(0, str(ROOT))
 sys.path.insert(0, str(ROOT / "benchmarks"))
 
 from _machine import describe, load_after, machine  # noqa: E402
 
-DATA = ROOT.parent / "shared" / "data" / "real" / "f16"
+DATA = (shared_dir() or ROOT.parent / "shared") / "data" / "real" / "f16"
 OUT = ROOT / "benchmarks" / "results" / "f16_levels.json"
 LEVELS = (1, 3, 5, 7)
 CHANNELS = "force=Force,a1=Acceleration[2],a2=Acceleration[3]"

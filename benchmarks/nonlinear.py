@@ -15,7 +15,7 @@ with satmd), so the tool is not only tested on its own assumptions.
 3. A few full `discover([lo, hi])` runs: no linear physics effect stands in for the nonlinearity
    (no ``parameter_offset`` of the moving parameter, no ``unexplained``), and seconds for two
    90 s recordings at 2048 Hz.
-4. Silverbox (real data, /work/shared; skipped when absent): the 5-level ladder and SNLS80mV.
+4. Silverbox (real data, ../shared or $SATMD_SHARED; skipped when absent): the 5-level ladder and SNLS80mV.
 
 Writes benchmarks/results/nonlinear.json and prints one line of figures.
 Usage: python benchmarks/nonlinear.py [--nulls 200] [--seeds 10] [--duration 90] [--quick]
@@ -33,6 +33,7 @@ from pathlib import Path
 import numpy as np
 
 ROOT = Path(__file__).resolve().parents[1]
+from satmd.io.shared import shared_dir  # noqa: E402
 sys.path.insert(0, str(ROOT))
 sys.path.insert(0, str(ROOT / "benchmarks"))
 
@@ -41,7 +42,7 @@ from _machine import load_after, machine  # noqa: E402
 
 FS = 2048.0
 ELEMENTS = indep.ELEMENTS
-SILVERBOX = Path("/work/shared/data/real/silverbox")
+SILVERBOX = (shared_dir() or ROOT.parent / "shared") / "data" / "real" / "silverbox"
 
 
 def _recording(force, a1, a2, noise, colour, rng):
@@ -352,7 +353,7 @@ def full_discover(duration, seed, kinds=(None,) + ELEMENTS):
 
 # --- 4. Silverbox ---------------------------------------------------------------------------------------------
 def silverbox():
-    """The verdicts on the real Silverbox data (None when /work/shared is absent)."""
+    """The verdicts on the real Silverbox data (None when ../shared is absent)."""
     if not SILVERBOX.exists():
         return None
     from satmd.discovery.nonlinear_silverbox import silverbox_verdicts

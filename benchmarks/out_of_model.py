@@ -43,7 +43,8 @@ from pathlib import Path
 import numpy as np
 
 ROOT = Path(__file__).resolve().parents[1]
-SHARED = ROOT.parent / "shared"
+from satmd.io.shared import shared_dir  # noqa: E402
+SHARED = shared_dir() or ROOT.parent / "shared"
 REAL = SHARED / "data" / "real"
 RESULT = ROOT / "benchmarks" / "results" / "out_of_model.json"
 

@@ -15,7 +15,7 @@ Errors: RMS in mV and in % of the RMS of the measured output over the scored sam
 Anchor: the freq-statespace package's Silverbox example reports 13.2 % (linear) and 0.44 %
 (nonlinear LFR) of the output RMS, on its multisine estimation data.
 
-Writes benchmarks/results/silverbox.json and prints one line. Needs /work/shared/data/real/silverbox
+Writes benchmarks/results/silverbox.json and prints one line. Needs ../shared/data/real/silverbox (or $SATMD_SHARED)
 (or ``--mat PATH``).
 """
 from __future__ import annotations
@@ -28,13 +28,14 @@ from pathlib import Path
 
 import numpy as np
 from scipy.io import loadmat
+from satmd.io.shared import shared_dir  # noqa: E402
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from _machine import describe, load_after, machine  # noqa: E402
 
 from satmd.identification.oscillator import fit_oscillator, rms_error  # noqa: E402
 
-MAT = Path("/work/shared/data/real/silverbox/SNLS80mV.mat")
+MAT = (shared_dir() or Path(__file__).resolve().parents[1].parent / "shared") / "data" / "real" / "silverbox" / "SNLS80mV.mat"
 OUT = Path(__file__).resolve().parent / "results" / "silverbox.json"
 FS = 610.35
 MULTISINE = (40650, 127400)

@@ -25,8 +25,9 @@ import numpy as np
 
 import satmd
 from satmd.io import detect_excitation, estimate_frf, load_recording
+from satmd.io.shared import shared_dir
 
-DATA = Path(__file__).resolve().parents[1].parent / "shared" / "data" / "real" / "f16"
+DATA = (shared_dir() or Path("../shared")) / "data" / "real" / "f16"
 LEVELS = (1, 3, 5, 7)
 CHANNELS = "force=Force,a1=Acceleration[2],a2=Acceleration[3]"
 

@@ -13,18 +13,16 @@ Real data are read from ``../shared``; when that folder is absent the example sa
 """
 
 # %%
-import os
 import warnings
-from pathlib import Path
 
 import matplotlib.pyplot as plt
 import numpy as np
 
 from satmd import discover, load_frf
 from satmd.modal import fit_modes
+from satmd.io.shared import shared_dir
 
-shared = next((p for p in (Path(os.environ.get("SATMD_SHARED", "../shared")), Path("../../shared"))
-               if (p / "data" / "real").is_dir()), None)
+shared = shared_dir()  # ../shared beside the checkout, or $SATMD_SHARED
 path = shared / "data" / "real" / "meas_point_1.txt" if shared else None
 beam = None
 if path is None or not path.is_file():

@@ -19,21 +19,19 @@ says so and stops.
 """
 
 # %%
-import os
-from pathlib import Path
 
 import matplotlib.pyplot as plt
 import numpy as np
 from scipy.io import loadmat
 
 from satmd.identification.oscillator import fit_oscillator, rms_error
+from satmd.io.shared import shared_dir
 
 FS = 610.35                    # Hz (10 MHz / 2^14)
 FIT = (40650, 40650 + 65062)   # the first 75 % of the multisine part
 ARROW = (100, 40575)           # the arrow; its first 50 samples (start-up) are not scored
 
-shared = next((p for p in (Path(os.environ.get("SATMD_SHARED", "../shared")), Path("../../shared"))
-               if (p / "data" / "real").is_dir()), None)
+shared = shared_dir()  # ../shared beside the checkout, or $SATMD_SHARED
 mat = shared / "data" / "real" / "silverbox" / "SNLS80mV.mat" if shared else None
 fit = None
 if mat is None or not mat.is_file():

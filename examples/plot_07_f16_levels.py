@@ -19,21 +19,19 @@ and stops.
 """
 
 # %%
-import os
 import warnings
-from pathlib import Path
 
 import matplotlib.pyplot as plt
 import numpy as np
 
 import satmd
 from satmd.io import detect_excitation, estimate_frf, load_recording
+from satmd.io.shared import shared_dir
 
 LEVELS = (1, 3, 5, 7)
 CHANNELS = "force=Force,a1=Acceleration[2],a2=Acceleration[3]"  # the lab's own variable names
 
-shared = next((p for p in (Path(os.environ.get("SATMD_SHARED", "../shared")), Path("../../shared"))
-               if (p / "data" / "real").is_dir()), None)
+shared = shared_dir()  # ../shared beside the checkout, or $SATMD_SHARED
 folder = shared / "data" / "real" / "f16" if shared else None
 files = [folder / f"F16Data_FullMSine_Level{i}.mat" for i in LEVELS] if folder else []
 recs = []

@@ -18,8 +18,9 @@ import numpy as np
 from scipy.io import loadmat
 
 from satmd.identification.oscillator import fit_oscillator, rms_error
+from satmd.io.shared import shared_dir
 
-MAT = Path(sys.argv[1] if len(sys.argv) > 1 else "/work/shared/data/real/silverbox/SNLS80mV.mat")
+MAT = Path(sys.argv[1]) if len(sys.argv) > 1 else (shared_dir() or Path("../shared")) / "data" / "real" / "silverbox" / "SNLS80mV.mat"
 FS = 610.35                     # Hz (10 MHz / 2^14)
 FIT = (40650, 40650 + 65062)    # the first 75 % of the multisine part (nonlinear_benchmarks split)
 ARROW = (100, 40575)            # the arrow; 50 samples of start-up are not scored

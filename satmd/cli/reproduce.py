@@ -14,21 +14,21 @@ def register(sub):
     p.add_argument("--quick", action="store_true", help="smaller runs (for smoke tests)")
     p.add_argument("--acceptance", default=None, metavar="DIR",
                    help="folder of independent acceptance data (with discovery/) to report on too "
-                        "(default: the first shared/acceptance in the working directory or above it)")
+                        "(default: shared/acceptance beside the checkout, in the working directory or above it, or in $SATMD_SHARED)")
     p.set_defaults(func=run)
 
 
 def acceptance_dir(given):
-    """The acceptance folder: the one given, else ``shared/acceptance`` in the working directory or a parent."""
+    """The acceptance folder: the one given, else ``shared/acceptance`` (`satmd.io.shared`)."""
     if given is not None:
         if not Path(given).is_dir():
             from ..errors import SatmdError
 
             raise SatmdError(f"--acceptance {given}: not a folder")
         return Path(given)
-    here = Path.cwd()
-    return next((d / "shared" / "acceptance" for d in (here, *here.parents) if (d / "shared" / "acceptance").is_dir()),
-                None)
+    from ..io.shared import shared_path
+
+    return shared_path("acceptance")
 
 
 def run(args):

@@ -9,10 +9,11 @@ from __future__ import annotations
 
 import itertools
 import time
+import zlib
 
 import numpy as np
 
-from .skeletons import ShiftedPower, Skeleton, UnitPower, admissible, budgeted, factor_pool, initial, unit_weight
+from .skeletons import Affine, ShiftedPower, Skeleton, UnitPower, admissible, budgeted, factor_pool, initial, unit_weight
 from .varpro import fit, project
 
 #: Tolerance of the fits on the subsample, which only rank products and skeletons (the
@@ -35,6 +36,22 @@ def _grow(parent: tuple, p_parent, new, factors: tuple, p_new) -> np.ndarray:
         i = next(i for i, (g, _) in enumerate(slices) if g == f)
         out.append(slices.pop(i)[1])
     return np.concatenate(out) if out else np.zeros(0)
+
+
+#: R² closer than this (relative to 1) rank as equal, and the tie is broken by the product's text: products
+#: of one data set can tie to the last bits (a factor and its inverse's twin), and which one round-off
+#: puts first must not decide the beam.
+TIE = 1e-9
+
+
+def _rank_key(r2: float, label) -> tuple:
+    """Sort key, best first: R² rounded to `TIE`, then the text of the thing ranked."""
+    return (-round(float(r2) / TIE) if np.isfinite(r2) else np.inf, repr(label))
+
+
+def _structure_seed(seed: int, factors: tuple) -> int:
+    """A product's own seed: from its structure, not from when the beam reached it."""
+    return seed + zlib.crc32(repr(factors).encode()) % 100_003
 
 
 def search(Z, y, *, budget: int = 20, seed: int = 0, time_limit: float | None = 60.0, subsample: int = 500,
@@ -103,7 +120,7 @@ class Beam:
                 if deadline is not None and time.perf_counter() > deadline:
                     break
                 self._rank(factors, parent, new)
-            level = sorted((f for f in grown if f in self.ranked), key=lambda f: -self.ranked[f][0])[:width]
+            level = sorted((f for f in grown if f in self.ranked), key=lambda f: _rank_key(self.ranked[f][0], f))[:width]
 
     def _grown(self, level, pool) -> dict:
         """{product: (parent, new factor)} of the admissible products one factor longer than ``level``'s."""
@@ -120,33 +137,54 @@ class Beam:
     def _rank(self, factors: tuple, parent: tuple, new) -> None:
         """Fit a product with every variable linear (from its parent's constants), re-project each choice
         of linear terms the budget allows and refit the best: that score ranks the product."""
-        Zs, ys, seed = self.Zs, self.ys, self.seed
+        Zs, ys = self.Zs, self.ys
+        seed = _structure_seed(self.seed, factors)
         choices = budgeted(factors, self.d, self.budget, block_extras=False)
         if not choices:
             return
-        warm = _grow(parent, self.fitted[parent], new, factors, initial(Skeleton((new,)), 1, self.rng))
-        first = choices[0] if len(choices) == 1 else Skeleton(factors, tuple(range(self.d)))
-        r2, p, _ = fit(first, Zs, ys, starts=2, seed=seed + self.n_fit, p0=warm if parent else None, tol=RANK_TOL,
-                       max_starts=RANK_STARTS)
         self.n_fit += 1
+        if len(factors) == 1 and isinstance(factors[0], Affine):
+            self._rank_lone_affine(factors[0])
+            return
+        warm = _grow(parent, self.fitted[parent], new, factors, initial(Skeleton((new,)), 1, np.random.default_rng(seed)))
+        first = choices[0] if len(choices) == 1 else Skeleton(factors, tuple(range(self.d)))
+        r2, p, _ = fit(first, Zs, ys, starts=2, seed=seed, p0=warm if parent else None, tol=RANK_TOL,
+                       max_starts=RANK_STARTS)
         if not np.isfinite(r2):
             return
         self.fitted[factors], best = p, (r2, first)
         if len(choices) > 1:
             # the inner constants kept, each choice of linear terms re-projected (cheap), the best refitted
+            sst = float(np.sum((ys - ys.mean()) ** 2)) or 1.0
+
             def projected(sk, p=p):
                 with np.errstate(all="ignore"):
                     r = project(sk.columns(p, Zs), ys - sk.offset(p, Zs), sk.intercept)[0]
-                return float(r @ r) if np.isfinite(r).all() else np.inf
+                return _rank_key(1.0 - float(r @ r) / sst if np.isfinite(r).all() else -np.inf, sk)
             sk = min(choices, key=projected)
-            best = (fit(sk, Zs, ys, starts=1, seed=seed + self.n_fit, p0=p, tol=RANK_TOL)[0], sk)
+            best = (fit(sk, Zs, ys, starts=1, seed=seed, p0=p, tol=RANK_TOL)[0], sk)
         if np.isfinite(best[0]):
             self.ranked[factors] = best
+
+    def _rank_lone_affine(self, factor: Affine) -> None:
+        """A lone affine form beside every variable as a linear term lies in their span: its cost is
+        flat and a fit's constants would be round-off. Its R² is the linear model's, and the
+        constants its children start from are the linear model's direction, ``1 + b·x / scale``."""
+        Zs, ys = self.Zs, self.ys
+        r, c = project([Zs[v] for v in range(self.d)], ys)
+        b0, b = c[0], c[1:][[factor.lead, *factor.cv]]
+        norm = float(np.linalg.norm(b))
+        scale = b0 if abs(b0) >= norm else norm
+        self.fitted[(factor,)] = b / scale if scale else np.zeros(factor.n_params)
+        sst = float(np.sum((ys - ys.mean()) ** 2)) or 1.0
+        self.ranked[(factor,)] = (1.0 - float(r @ r) / sst, Skeleton((factor,), tuple(range(self.d))))
 
     def skeletons(self, expand: int, block_extras: bool) -> list:
         """``[(r2, skeleton, constants), ...]``, best first: every budgeted form of the ``expand`` best
         products fitted on the subsample, each from its product's constants."""
-        best_products = sorted(self.ranked, key=lambda f: -self.ranked[f][0])[:expand]
+        # a lone affine form only seeds the beam: its skeletons are the linear model, fitted flat
+        best_products = sorted((f for f in self.ranked if admissible(f)),
+                               key=lambda f: _rank_key(self.ranked[f][0], f))[:expand]
         scored = []
         forms = ((f, sk) for f in best_products for sk in budgeted(f, self.d, self.budget, block_extras))
         for i, (f, sk) in enumerate(forms):
@@ -156,7 +194,7 @@ class Beam:
                            max_starts=RANK_STARTS)
             if np.isfinite(r2):
                 scored.append((r2, sk, p))
-        scored.sort(key=lambda t: -t[0])
+        scored.sort(key=lambda t: _rank_key(t[0], t[1]))
         return scored
 
 
@@ -167,7 +205,7 @@ def _refit(scored: list, Zt, y, starts: int, seed: int) -> list:
         r2, p, c = fit(sk, Zt, y, starts=starts, seed=seed, max_nfev=100 * (sk.n_inner + 1), p0=p0)
         if p is not None and np.isfinite(r2):
             out.append((r2, sk, p, c))
-    out.sort(key=lambda t: -t[0])
+    out.sort(key=lambda t: _rank_key(t[0], t[1]))
     return out
 
 

@@ -79,13 +79,22 @@ def _kaufman(cols: list, target: np.ndarray, derivatives: list, intercept: bool 
     return R * scale
 
 
-#: Two starts agree on the best when their R² differ by less than this.
+#: Two starts agree on the best when their R² differ by less than this ...
 AGREE = 1e-6
+#: ... and their inner constants by less than this (relative, each constant): the same optimum,
+#: not two points of one degenerate basin (weights running off to 1e5 reach nearly equal R²
+#: from different places, and which of them a start reaches is round-off).
+AGREE_CONSTANTS = 1e-3
 
 
-def _agreed(costs: list, best: float, sst: float) -> bool:
-    """Whether at least two starts reached the best cost (R² within `AGREE`)."""
-    return sum(2.0 * (c - best) <= AGREE * sst for c in costs) >= 2
+def _agreed(ends: list, best, sst: float) -> bool:
+    """Whether another start reached the best one's optimum: R² within `AGREE` and the
+    same inner constants (within `AGREE_CONSTANTS`). ``ends``: every start's solution."""
+    def same(sol):
+        scale = np.maximum(1.0, np.abs(best.x))
+        return (2.0 * (sol.cost - best.cost) <= AGREE * sst
+                and bool(np.all(np.abs(sol.x - best.x) <= AGREE_CONSTANTS * scale)))
+    return sum(same(sol) for sol in ends) >= 2
 
 
 def fit(sk: Skeleton, Zt: np.ndarray, y: np.ndarray, starts: int = 2, seed: int = 0, max_nfev: int | None = None,
@@ -99,7 +108,7 @@ def fit(sk: Skeleton, Zt: np.ndarray, y: np.ndarray, starts: int = 2, seed: int 
     y : (n,) target.
     starts : starts of Levenberg-Marquardt (the best is kept).
     max_starts : with more than ``starts``, starts go on (up to ``max_starts``) until two of
-        them reach the best cost (R² within `AGREE`): a scale-free product has degenerate
+        them reach the same best optimum (`_agreed`): a scale-free product has degenerate
         basins (weights to 0 or to infinity) that one start in four or so falls into, and
         which basin a start falls into can turn on round-off, i.e. on the BLAS and the
         machine. Two starts agreeing on the best makes the result a property of the data.
@@ -136,9 +145,9 @@ def fit(sk: Skeleton, Zt: np.ndarray, y: np.ndarray, starts: int = 2, seed: int 
             J = _kaufman(cols, target, sk.derivatives(p, Zt), sk.intercept)
         return J if np.all(np.isfinite(J)) else np.zeros((y.size, p.size))
 
-    best, costs = None, []
+    best, ends = None, []
     for s in range(max(starts, max_starts or 0)):
-        if s >= starts and best is not None and _agreed(costs, best.cost, sst):
+        if s >= starts and best is not None and _agreed(ends, best, sst):
             break
         try:
             start = np.asarray(p0, float) if (p0 is not None and s == 0) else initial(sk, s, rng)
@@ -146,7 +155,7 @@ def fit(sk: Skeleton, Zt: np.ndarray, y: np.ndarray, starts: int = 2, seed: int 
                                 max_nfev=max_nfev or 25 * (sk.n_inner + 1))
         except (ValueError, np.linalg.LinAlgError):
             continue
-        costs.append(sol.cost)
+        ends.append(sol)
         if best is None or sol.cost < best.cost:
             best = sol
     if best is None:

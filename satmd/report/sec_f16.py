@@ -11,11 +11,10 @@ CHANNELS = "force=Force,a1=Acceleration[2],a2=Acceleration[3]"
 
 
 def data_dir() -> Path | None:
-    """``shared/data/real/f16`` in the working directory or above it, or beside the package's checkout."""
-    here = Path.cwd().resolve()
-    roots = (here, *here.parents, *Path(__file__).resolve().parents)
-    return next((d / "shared" / "data" / "real" / "f16" for d in roots
-                 if (d / "shared" / "data" / "real" / "f16" / "F16Data_FullMSine_Level1.mat").is_file()), None)
+    """``shared/data/real/f16`` (`satmd.io.shared`) when its level-1 file is there, else None."""
+    from ..io.shared import real_data
+
+    return real_data("f16") if real_data("f16", "F16Data_FullMSine_Level1.mat") else None
 
 
 def _figure(levels, recordings, datas):

@@ -13,10 +13,12 @@ from satmd.discovery.adequacy import (Adequacy, Reason, after_search, drop_stret
 from satmd.errors import DataError
 from satmd.identification import identify
 from satmd.io import FRFData, load_frf, save_frf
+from satmd.io.shared import real_data
+from tests.conftest import needs_real
 from satmd.tuning import tune
 
 GRID = np.linspace(40, 130, 60)
-REAL = Path(__file__).resolve().parents[3] / "shared" / "data" / "real" / "meas_point_1.txt"
+REAL = real_data("meas_point_1.txt") or Path("absent")
 
 
 def _rig_data(seed=0, std=True):
@@ -170,7 +172,7 @@ def test_adequacy_result_is_typed_and_says_one_sentence():
     assert Adequacy(True).adding([]).adequate
 
 
-@pytest.mark.skipif(not REAL.is_file(), reason="../shared/data/real not present")
+@needs_real("meas_point_1.txt")
 def test_real_beam_accelerance_is_not_a_satmd_rig():
     rep = discover(load_frf(REAL, freq_axis="0:1"))
     d = rep.to_dict()

@@ -10,12 +10,14 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from satmd.errors import DataError
+from satmd.io.shared import real_data
+from tests.conftest import needs_real
 from satmd.identification.oscillator import fit_oscillator, frf_start, rms_error
 from satmd.physics.oscillator import PolynomialOscillator, fine_input
 
 FS = 200.0
 W = 2 * np.pi * 20.0
-SILVERBOX = Path("/work/shared/data/real/silverbox/SNLS80mV.mat")
+SILVERBOX = real_data("silverbox", "SNLS80mV.mat") or Path("absent")
 
 
 def duffing(k3=3.0, k2=0.0):
@@ -107,7 +109,7 @@ def test_rms_error_in_percent():
     assert r["rms"] == 1.0 and r["pct"] == 50.0 and r["n"] == 2
 
 
-@pytest.mark.skipif(not SILVERBOX.exists(), reason="/work/shared Silverbox record absent")
+@needs_real("silverbox", "SNLS80mV.mat")
 def test_silverbox_cubic_model_beats_the_linear_one_on_the_arrow():
     """Fit on part of one multisine realisation; predict the arrow's first (in-range) part."""
     from scipy.io import loadmat

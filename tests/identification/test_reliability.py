@@ -19,8 +19,10 @@ from satmd.identification.problem import Problem
 from satmd.identification.intervals import _scan, describe_interval, intervals_to_dict
 from satmd.io import DataWarning
 from satmd.io.frfdata import FRFData
+from satmd.io.shared import real_data
+from tests.conftest import needs_real
 
-REAL = Path(__file__).resolve().parents[2].parent / "shared" / "data" / "real"
+REAL = real_data() or Path("absent")
 NAMES = ("m2", "kp", "R", "L")
 
 
@@ -93,7 +95,7 @@ def test_warn_false_keeps_warnings_on_the_result_only():
     assert _poor(fit)
 
 
-@pytest.mark.skipif(not (REAL / "meas_point_1.txt").is_file(), reason="no real data folder")
+@needs_real("meas_point_1.txt")
 def test_real_accelerance_of_another_structure_warns(capsys):
     from satmd.cli import main
 

@@ -8,12 +8,14 @@ import pytest
 
 from satmd.errors import DataError, FormatError
 from satmd.io import Recording, estimate_frf, load_recording
+from satmd.io.shared import real_data
+from tests.conftest import needs_real
 from satmd.io.excitation import detect_excitation, find_period
 from satmd.physics.timemodel import LinearRig
 from satmd.physics import Rig, frf
 
 FS = 1000.0
-F16 = Path(__file__).resolve().parents[3] / "shared" / "data" / "real" / "f16"
+F16 = real_data("f16") or Path("absent")
 
 
 def _record(force, noise=0.01, seed=0, fs=FS):
@@ -256,7 +258,7 @@ def test_mat_with_lab_names_and_rows(tmp_path):
     assert load_recording(tmp_path / "nofs.mat", fs_hz=FS).fs_hz == FS
 
 
-@pytest.mark.skipif(not F16.is_dir(), reason="the F-16 files are not in ../shared")
+@needs_real("f16")
 def test_f16_reads_as_it_is_and_equals_the_periodic_estimate():
     path = F16 / "F16Data_FullMSine_Level1.mat"
     rec = load_recording(path, channel_map="force=Force,a1=Acceleration[2],a2=Acceleration[3]")

@@ -8,10 +8,12 @@ import pytest
 
 from satmd.cli import main
 from satmd.errors import FormatError
+from satmd.io.shared import real_data
+from tests.conftest import needs_real
 from satmd.io import DataWarning, load_frf, load_recording, transmissibility
 
-REAL = Path(__file__).resolve().parents[2].parent / "shared" / "data" / "real"
-pytestmark = pytest.mark.skipif(not REAL.is_dir(), reason=f"no real data folder at {REAL}")
+REAL = real_data() or Path("absent")
+pytestmark = needs_real()
 pytest.importorskip("pyuff")
 
 MPSTD = REAL / "MPSTD_Set001_2024_10_08_10_27_07.uff"

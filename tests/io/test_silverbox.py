@@ -1,4 +1,4 @@
-"""Silverbox loader and the level verdict on the real data (skipped when /work/shared is absent)."""
+"""Silverbox loader and the level verdict on the real data (../shared; skipped when absent)."""
 from __future__ import annotations
 
 from pathlib import Path
@@ -9,8 +9,11 @@ import pytest
 from satmd.errors import FormatError
 from satmd.io.silverbox import load_silverbox_level, load_silverbox_snls, silverbox_levels
 
-DATA = Path("/work/shared/data/real/silverbox")
-needs_data = pytest.mark.skipif(not DATA.exists(), reason="Silverbox data (/work/shared) absent")
+from tests.conftest import needs_real
+from satmd.io.shared import real_data
+
+DATA = real_data("silverbox") or Path("absent")
+needs_data = needs_real("silverbox")
 
 
 def test_missing_folder_is_a_one_line_format_error(tmp_path):

@@ -1,13 +1,12 @@
 """The report's F-16 section: four real levels, each resonance's trend, no SATMD element (issue 35)."""
 from __future__ import annotations
 
-import pytest
 
 from satmd.report import reproduce
-from satmd.report.sec_f16 import data_dir
+from tests.conftest import needs_real
 
 
-@pytest.mark.skipif(data_dir() is None, reason="the F-16 files are not in ../shared")
+@needs_real("f16", "F16Data_FullMSine_Level1.mat")
 def test_f16_section_reads_the_levels_and_names_no_element(tmp_path):
     index = reproduce(tmp_path / "r", only=["f16"], log=lambda *_: None)
     text = index.read_text()
