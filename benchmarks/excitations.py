@@ -156,7 +156,7 @@ def simulate(sim, family, fs, band, noise, files, info, rig, p, effects, rng, se
     units = {"force": "N", "acc1": "m/s^2", "acc2": "m/s^2"}
     recs = []
     if sim == "satmd":
-        from satmd.io import simulate_recording
+        from satmd.simulation import simulate_recording
         from satmd.physics.timemodel import LinearRig
         from satmd.physics import frf
 
@@ -253,8 +253,9 @@ def build(job):
 def run_case(job):
     """One case: (family, sim, seed, effect name or None) -> its row."""
     from satmd import discover
-    from satmd.io import FRFData, estimate_frf
-    from satmd.io.excitation import detect_excitation
+    from satmd.io import FRFData
+    from satmd.signal import estimate_frf
+    from satmd.signal.excitation import detect_excitation
 
     family, sim, seed, name = job
     rng, row, p, recs, truth = build(job)

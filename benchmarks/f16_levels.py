@@ -40,7 +40,8 @@ CITATION = ("J.P. Noël and M. Schoukens, F-16 aircraft benchmark based on groun
 def run(data: Path) -> dict:
     """The discovery of the four levels, JSON-ready."""
     import satmd
-    from satmd.io import detect_excitation, load_recording
+    from satmd.io import load_recording
+    from satmd.signal import detect_excitation
 
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")  # the files' Voltage is not used

@@ -107,8 +107,9 @@ def _api(c, base, work):
     from satmd import identify
     from satmd.discovery import discover, discover_many
     from satmd.identification import identify_many
-    from satmd.io import estimate_frf, is_recording, load_frf, load_recording, save_frf, save_recording
-    from satmd.io import simulate_recording
+    from satmd.io import is_recording, load_frf, load_recording, save_frf, save_recording
+    from satmd.signal import estimate_frf
+    from satmd.simulation import simulate_recording
     from satmd.physics import Rig
 
     op, args, kw = c["op"], _sub(c.get("args", []), base, work), c.get("kwargs", {})

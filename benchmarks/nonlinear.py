@@ -55,7 +55,7 @@ def _recording(force, a1, a2, noise, colour, rng):
 
 
 def _verdict(recs, tests=None):
-    from satmd.discovery.nonlinear_findings import analyse_recordings
+    from satmd.discovery.nonlinear.findings import analyse_recordings
 
     rep = analyse_recordings(recs)
     name = rep.findings[0]["name"] if rep.findings else None
@@ -356,7 +356,7 @@ def silverbox():
     """The verdicts on the real Silverbox data (None when ../shared is absent)."""
     if not SILVERBOX.exists():
         return None
-    from satmd.discovery.nonlinear_silverbox import silverbox_verdicts
+    from satmd.discovery.nonlinear.silverbox import silverbox_verdicts
 
     t0 = time.perf_counter()
     out = silverbox_verdicts(SILVERBOX)

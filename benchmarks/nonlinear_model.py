@@ -8,7 +8,7 @@ accelerometers and 0.5 % on the force. Per element and seed: a rig drawn at rand
 the element at a strength that moves its equivalent parameter by ~12 % (kp, k1, L) or ~3 N·s/m (cp)
 at the top level (friction: ~3 N·s/m of cp at the LOW level, where it acts most), three levels: 1, 4 and
 10 N RMS. Hold-out designs (`designs_for`), each fitted by
-`satmd.identification.nonlinear.fit_nonlinear` (element + m2, kp, R, L) on the first ``--seconds`` s
+`satmd.identification.nonlinear.fit.fit_nonlinear` (element + m2, kp, R, L) on the first ``--seconds`` s
 of its two training recordings:
 
 - ``extrapolate`` (the headline): predict the level where the element acts at its stated strength from
@@ -130,8 +130,8 @@ def _recordings(name, rigs, params, seconds, seed):
 def _clean_error(fit, rec, truth, seconds):
     """Error of the prediction against the noise-free truth, a1 and a2 together, judged as `predict` judges
     the recording (same samples): {"excited", "band", "broadband"}; the excited bins are the recording's."""
-    from satmd.identification.nonlinear import band_error, predict
-    from satmd.identification.nonlinear_signal import excited_bins, valid
+    from satmd.identification.nonlinear.fit import band_error, predict
+    from satmd.identification.nonlinear.drive import excited_bins, valid
 
     p = predict(fit, rec, seconds)
     n = p["a1"].size
@@ -151,8 +151,8 @@ def _truth_error(rec, truth, seconds):
     """Error of the noise-free truth against the noisy recording, judged as `predict` judges a model: the
     noise floor of the comparison ({"excited", "band", "broadband"}); linear error / this is the best ratio
     any model could reach on that recording."""
-    from satmd.identification.nonlinear import band_error, prepare
-    from satmd.identification.nonlinear_signal import excited_error, valid
+    from satmd.identification.nonlinear.fit import band_error, prepare
+    from satmd.identification.nonlinear.drive import excited_error, valid
 
     d = prepare(rec, seconds)
     n = d["acc"].shape[1]
@@ -166,7 +166,7 @@ def _truth_error(rec, truth, seconds):
 
 def _design(name, rig, par, recs, seconds, clean, train, held):
     """One hold-out design: fit on the ``train`` levels, predict the ``held`` level."""
-    from satmd.identification.nonlinear_compare import compare_models
+    from satmd.identification.nonlinear.compare import compare_models
 
     out = compare_models([recs[lv] for lv in train], [recs[held]], name, seconds=seconds)
     nl, lin = out.pop("fits")

@@ -1,7 +1,7 @@
 """Recordings benchmark: discovery and identification from lab-like time recordings, two simulators.
 
 Recordings come from two simulators that share nothing: satmd's own
-(`satmd.io.simulate_recording` with `satmd.io.conditions.lab_conditions`) and an
+(`satmd.simulation.simulate_recording` with `satmd.simulation.conditions.lab_conditions`) and an
 independent one (`benchmarks/_indep_sim.py`: SPEC §2 as ODEs integrated with
 scipy.signal, its own shaker force and sensor noise). Conditions are drawn per
 recording: force flat or rolled off (Butterworth order 2–8), white or pink, a
@@ -78,7 +78,7 @@ def machine_info(workers):
 
 def draw_settings(rng):
     """fs, duration, SNR and lab conditions of one recording (both simulators draw the same way)."""
-    from satmd.io.conditions import lab_conditions
+    from satmd.simulation.conditions import lab_conditions
 
     fs = float(rng.choice([1000, 2000, 2500, 4000, 5000, 8000, 10000]))
     seconds = min(float(rng.uniform(30, 180)), MAX_SAMPLES / fs)
@@ -97,7 +97,8 @@ def describe(fs, seconds, cond, band):
 
 def make_recording(sim, rng, rig, effects, seed):
     """(Recording, true FRF function, true per-bin force-noise power, conditions) from one simulator."""
-    from satmd.io import Recording, simulate_recording
+    from satmd.io import Recording
+    from satmd.simulation import simulate_recording
     from satmd.physics import frf
 
     fs, seconds, cond = draw_settings(rng)
@@ -219,7 +220,7 @@ def run_resonant(job):
     the LPM estimate's std calibration only (a few % of random rigs have a third resonance in band, too few
     points in the null population to tell a bias near it from scatter)."""
     from satmd.discovery.scenarios import random_rig
-    from satmd.io import estimate_frf
+    from satmd.signal import estimate_frf
 
     sim, seed = job
     rng = np.random.default_rng(1000 + seed)
@@ -237,8 +238,8 @@ def run_resonant(job):
 def run_null(job):
     from satmd import discover
     from satmd.discovery.scenarios import random_rig
-    from satmd.io import estimate_frf
-    from satmd.io.lpm import excited_band
+    from satmd.signal import estimate_frf
+    from satmd.signal.lpm import excited_band
 
     sim, seed = job
     rng = np.random.default_rng(1000 + seed)
@@ -273,7 +274,8 @@ def score(report, truth):
 def run_effect(job):
     from satmd import discover
     from satmd.discovery.scenarios import random_effect, random_rig
-    from satmd.io import FRFData, estimate_frf
+    from satmd.io import FRFData
+    from satmd.signal import estimate_frf
 
     sim, name, seed = job
     rng = np.random.default_rng(5000 + seed)
@@ -326,7 +328,8 @@ def _progress(results, label):
 
 def estimator_bias():
     """Relative error at the first resonance of noise-free estimates, against a 2 %-noise std."""
-    from satmd.io import estimate_frf, simulate_recording
+    from satmd.signal import estimate_frf
+    from satmd.simulation import simulate_recording
     from satmd.physics import Rig, frf
 
     clean = simulate_recording(120.0, 1000.0, noise=0.0, force_noise=0.0, seed=1)
@@ -352,7 +355,8 @@ def seconds_per_recording(repeats=3):
     discovery then searches the vocabulary, which costs more than the estimate and the nominal fit.
     """
     from satmd import discover, effect
-    from satmd.io import estimate_frf, simulate_recording
+    from satmd.signal import estimate_frf
+    from satmd.simulation import simulate_recording
 
     hidden = [effect("extra_mode", f_hz=72.0, zeta=0.01, mass_ratio=0.004), effect("time_delay", tau_s=2e-4),
               effect("parameter_offset:k1", value=194e3 * 1.03)]

@@ -35,7 +35,7 @@ Nulls: the same structures, seeds and forces with the joint replaced by its smal
 no resonance may be reported as moving, and no SATMD element named.
 
 The force band is 8–64 Hz, a ratio of 8: on a multisine spanning more than about a decade (5–100 Hz was
-tried first) satmd's excited-line detection (`satmd.io.excitation.excited_lines`, its lone-line filter
+tried first) satmd's excited-line detection (`satmd.signal.excitation.excited_lines`, its lone-line filter
 on relative gaps) leaves out the lowest excited lines, which the distortion test then reads as
 detection lines full of response: linear nulls were flagged nonlinear. Reported as a defect; the band
 keeps the benchmark on what issue 35 measures.

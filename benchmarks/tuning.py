@@ -63,7 +63,7 @@ def true_peak(rig, effects, design):
 
 # --- 1. textbook ---------------------------------------------------------------------------------
 def textbook():
-    from satmd.report.sec_tune import _textbook_rows
+    from satmd.report.parts.tune import _textbook_rows
 
     return [{"check": a, "satmd": b, "exact": c} for a, b, c in _textbook_rows()]
 

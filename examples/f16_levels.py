@@ -24,7 +24,8 @@ from pathlib import Path
 import numpy as np
 
 import satmd
-from satmd.io import detect_excitation, estimate_frf, load_recording
+from satmd.io import load_recording
+from satmd.signal import detect_excitation, estimate_frf
 from satmd.io.shared import shared_dir
 
 DATA = (shared_dir() or Path("../shared")) / "data" / "real" / "f16"

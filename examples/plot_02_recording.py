@@ -28,7 +28,9 @@ import matplotlib.pyplot as plt
 import numpy as np
 
 from satmd import Rig, discover, frf, identify
-from satmd.io import detect_excitation, estimate_frf, load_recording, save_recording, simulate_recording
+from satmd.io import load_recording, save_recording
+from satmd.signal import detect_excitation, estimate_frf
+from satmd.simulation import simulate_recording
 
 truth = Rig()
 rec = simulate_recording(120.0, 1000.0, truth, noise=0.02, force_noise=0.01, seed=1)

@@ -25,7 +25,7 @@ import numpy as np
 
 from satmd import Rig, discover, nonlinear_element, simulate
 from satmd.identification import fit_nonlinear
-from satmd.io import estimate_frf
+from satmd.signal import estimate_frf
 from satmd.tuning.nonlinear import tune_nonlinear
 
 truth = Rig(m2=0.55, kp=1.2e5, R=30.0, L=0.07)

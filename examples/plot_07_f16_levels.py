@@ -25,7 +25,8 @@ import matplotlib.pyplot as plt
 import numpy as np
 
 import satmd
-from satmd.io import detect_excitation, estimate_frf, load_recording
+from satmd.io import load_recording
+from satmd.signal import detect_excitation, estimate_frf
 from satmd.io.shared import shared_dir
 
 LEVELS = (1, 3, 5, 7)

@@ -31,8 +31,10 @@ from pathlib import Path
 
 from satmd import Rig, discover
 from satmd.identification import identify
-from satmd.io import estimate_frf, load_recording, save_frf, save_recording, simulate_recording
-from satmd.io.estimate import describe_estimate
+from satmd.io import load_recording, save_frf, save_recording
+from satmd.signal import estimate_frf
+from satmd.simulation import simulate_recording
+from satmd.signal.estimate import describe_estimate
 
 FREE = ("m2", "kp", "R", "L")
 

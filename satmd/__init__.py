@@ -13,13 +13,17 @@ import importlib
 
 TYPE_CHECKING = False  # typing.TYPE_CHECKING without importing typing (type checkers take the name as true)
 from .version import __version__  # noqa: F401  (re-exported: satmd.__version__)
+from ._moved import install as _install_moved
+
+_install_moved()  # module paths that moved answer one release more, with a warning (issue 48)
 
 # public name -> the module that defines it (imported when the name is first used)
 _EXPORTS = {
     **dict.fromkeys(("DataError", "DataTypeError", "DataWarning", "FormatError", "IdentifiabilityWarning", "PinnedParameterWarning",
                      "PoorFitWarning", "SatmdError"), ".errors"),
     **dict.fromkeys(("FRFData", "load_frf", "save_frf", "Recording", "load_recording", "save_recording",
-                     "estimate_frf"), ".io"),
+                     ), ".io"),
+    "estimate_frf": ".signal",
     **dict.fromkeys(("PAPER_GRID_HZ", "DielectricLoss", "Effect", "ExtraMode", "ParameterOffset", "Rig", "SensorGain",
                      "ShuntCapacitance", "StructuralDamping", "TimeDelay", "effect", "frf", "NonlinearElement",
                      "integrate", "nonlinear_element", "register_nonlinear"), ".physics"),
@@ -38,11 +42,12 @@ if TYPE_CHECKING:  # what type checkers and editors see; at run time `__getattr_
                          PinnedParameterWarning, PoorFitWarning, SatmdError)
     from .identification import FitResult, NonlinearFit, fit_nonlinear, identify, identify_many
     from .inverse import InverseModel
-    from .io import FRFData, Recording, estimate_frf, load_frf, load_recording, save_frf, save_recording
+    from .io import FRFData, Recording, load_frf, load_recording, save_frf, save_recording
     from .modal import fit_modes, follow_modes
     from .physics import (PAPER_GRID_HZ, DielectricLoss, Effect, ExtraMode, NonlinearElement, ParameterOffset, Rig,
                           SensorGain, ShuntCapacitance, StructuralDamping, TimeDelay, effect, frf, integrate,
                           nonlinear_element, register_nonlinear)
+    from .signal import estimate_frf
     from .simulation import simulate
     from .tuning import TuneResult, retune, tune
     from .tuning.nonlinear import tune_nonlinear

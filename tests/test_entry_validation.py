@@ -55,8 +55,8 @@ def test_discover_names_the_wrong_item_of_a_list():
 
 def test_the_time_domain_entry_points_check_their_arguments():
     from satmd import Rig
-    from satmd.identification.nonlinear import fit_nonlinear
-    from satmd.io import estimate_frf
+    from satmd.identification.nonlinear.fit import fit_nonlinear
+    from satmd.signal import estimate_frf
     from satmd.physics import integrate
     from satmd.tuning.nonlinear import tune_nonlinear
 

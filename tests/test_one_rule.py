@@ -12,8 +12,8 @@ INVERSE = re.compile(r"linalg\.p?inv\(")
 # matrix inverses that are no fit's covariance, each with its reason
 NOT_A_COVARIANCE = {
     "satmd/physics/nonlinear/statespace.py": "the modal matrix's eigenvectors (a change of basis)",
-    "satmd/io/lpm.py": "the local polynomial method's own regression (Pintelon et al. 2010)",
-    "satmd/io/sweepfrf.py": "the same local fit on a sweep's windows",
+    "satmd/signal/lpm.py": "the local polynomial method's own regression (Pintelon et al. 2010)",
+    "satmd/signal/sweepfrf.py": "the same local fit on a sweep's windows",
 }
 
 
@@ -54,7 +54,7 @@ def test_the_band_scan_is_written_once():
 def test_a_recordings_drive_level_is_read_one_way():
     """"Level" was the force's std in one place and its RMS in another (issue 36): `numerics.force_level`."""
     level = re.compile(r"np\.(std|sqrt\(np\.mean)\(.*\[\"force\"\]")
-    # satmd/io/timesim.py scales its simulated force to the RMS it is asked for: a setting, not a reading
+    # satmd/simulation/timesim.py scales its simulated force to the RMS it is asked for: a setting, not a reading
     found = [f"{p.relative_to(SRC.parent)}:{i}" for p in SRC.rglob("*.py") if p.name not in ("numerics.py", "timesim.py")
              for i, line in enumerate(p.read_text().splitlines(), 1) if level.search(line)]
     assert not found, f"a drive level read by hand (use satmd.numerics.force_level): {found}"
@@ -63,7 +63,7 @@ def test_a_recordings_drive_level_is_read_one_way():
 def test_one_output_error_fitter():
     """The time-domain fits share `numerics.batched_least_squares` (issue 36: two fitters, each its own
     finite differences)."""
-    for name in ("identification/nonlinear.py", "identification/oscillator.py"):
+    for name in ("identification/nonlinear/fit.py", "identification/oscillator.py"):
         text = (SRC / name).read_text()
         assert "batched_least_squares(" in text and "np.eye(x.size)" not in text, name
 
@@ -88,7 +88,7 @@ def test_a_band_in_hz_is_spelled_band_hz():
 def test_the_former_band_keyword_still_works_and_warns():
     import warnings
 
-    from satmd.discovery.nonlinear_stats import linearity_test
+    from satmd.discovery.nonlinear.stats import linearity_test
 
     rng = np.random.default_rng(1)
     x = rng.standard_normal(4096)
@@ -103,8 +103,8 @@ def test_the_former_band_keyword_still_works_and_warns():
 
 def test_one_acquisition_stage_for_every_simulated_recording():
     """The linear and the nonlinear recorder add their sensors' noise and write their metadata in one place
-    (`satmd.io.acquisition`), so a linear and a nonlinear recording of one rig are taken alike."""
-    for path in ("io/timesim.py", "simulation_nonlinear.py"):
+    (`satmd.simulation.acquisition`), so a linear and a nonlinear recording of one rig are taken alike."""
+    for path in ("simulation/timesim.py", "simulation/nonlinear.py"):
         text = (SRC / path).read_text()
         assert "acquire(" in text and "simulated_recording(" in text, path
         assert "standard_normal(" not in text and "Recording(" not in text, f"{path} adds noise or builds meta itself"
@@ -113,7 +113,7 @@ def test_one_acquisition_stage_for_every_simulated_recording():
 def test_one_time_model_protocol_for_every_recorder():
     """The recorders drive a time model (`satmd.physics.timemodel`) and nothing else: the linear convolution
     and the integrator are reached through ``respond``, never called or rewritten beside it."""
-    for path in ("io/timesim.py", "simulation_nonlinear.py"):
+    for path in ("simulation/timesim.py", "simulation/nonlinear.py"):
         text = (SRC / path).read_text()
         assert ".respond(" in text, path
         assert "integrate(" not in text and "irfft(h" not in text, f"{path} simulates the rig itself"

@@ -318,7 +318,7 @@ def test_no_private_import_across_packages_in_inverse():
 LAYERS = {
     "errors": 0, "conventions": 0, "validation": 0, "numerics": 0, "jsonsafe": 0, "version": 0,
     "_progress": 0, "_fleet": 0,
-    "physics": 1, "io": 2, "simulation": 3, "simulation_nonlinear": 3, "plots": 3, "modal": 3,
+    "_moved": 0, "physics": 1, "io": 2, "signal": 3, "simulation": 3, "plots": 3, "modal": 3,
     "identification": 4, "inverse": 5, "discovery": 5, "tuning": 6, "explain": 7, "report": 8, "cli": 9,
     "satmd": 10, "__main__": 10,
 }
@@ -483,3 +483,49 @@ def test_internal_identify_calls_say_whether_to_warn():
                 if not said:
                     bad.append(f"{MODULES[name].relative_to(ROOT.parent)}:{node.lineno}")
     assert not bad, "identify called without warn= inside satmd:\n" + "\n".join(bad)
+
+
+# --- issue 48: the folders say where a piece of knowledge lives ---------------------------------------
+MAX_MODULES = 20  # modules in one package before it needs subpackages
+
+
+def _prefixed_groups(modules=None) -> list[str]:
+    """Sibling modules whose names share a prefix (``nonlinear_stats``, ``nonlinear_name``, ...): a
+    package that was not made. Three or more siblings with one ``prefix_`` are reported."""
+    groups: dict = {}
+    for name in (MODULES if modules is None else modules):
+        package, _, leaf = name.rpartition(".")
+        if "_" in leaf.strip("_"):
+            groups.setdefault((package, leaf.strip("_").split("_")[0]), []).append(leaf)
+    return [f"{p}: {', '.join(sorted(v))}" for (p, _), v in sorted(groups.items()) if len(v) >= 3]
+
+
+def test_no_module_prefix_stands_for_a_package():
+    bad = _prefixed_groups()
+    assert not bad, "modules sharing a prefix (make the prefix a package):\n" + "\n".join(bad)
+
+
+def test_no_package_of_too_many_modules():
+    counts: dict = {}
+    for name, path in MODULES.items():
+        if path.name != "__init__.py":
+            counts[_package_of(name)] = counts.get(_package_of(name), 0) + 1
+    big = {p: n for p, n in counts.items() if n > MAX_MODULES}
+    assert not big, f"packages over {MAX_MODULES} modules (split them into subpackages): {big}"
+
+
+def test_the_layout_checks_see_what_they_look_for():
+    assert _prefixed_groups(["satmd.d.nonlinear_a", "satmd.d.nonlinear_b", "satmd.d.nonlinear_c", "satmd.d.x"])
+    assert not _prefixed_groups(["satmd.d.nonlinear_a", "satmd.d.nonlinear_b", "satmd.e.nonlinear_c"])
+
+
+def test_files_signals_and_simulators_live_apart():
+    """io reads and writes files and holds the containers; signal estimates; simulation simulates."""
+    def modules_of(package):
+        return {n.rpartition(".")[2] for n in MODULES if _package_of(n) == f"satmd.{package}" and n != f"satmd.{package}"}
+    assert {"lpm", "welch", "periodic", "impact", "excitation", "estimate"} <= modules_of("signal")
+    assert {"timesim", "acquisition", "frf", "nonlinear"} <= modules_of("simulation")
+    assert not modules_of("io") & (modules_of("signal") | modules_of("simulation"))
+    for name in MODULES:  # io never imports an estimator or a simulator
+        if _package_of(name).startswith("satmd.io"):
+            assert not [t for t in GRAPH[name] if _unit(t) in ("signal", "simulation")], name

@@ -21,7 +21,7 @@ def _validated():
     """(name, function) of every validated public function."""
     from satmd.discovery import discover
     from satmd.identification import identify
-    from satmd.io.lpm import lpm
+    from satmd.signal.lpm import lpm
 
     return [("identify", identify), ("lpm", lpm), ("discover", discover)]
 

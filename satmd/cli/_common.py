@@ -313,7 +313,7 @@ from ._text import cli_text, one_line_warnings, safe_text, with_flags  # noqa: E
 
 def estimate_notes(args, estimator: dict, measurement) -> None:
     """The stderr notes on FRFs estimated from a time recording: how, and what the chain did to them."""
-    from ..io.estimate import describe_estimate
+    from ..signal.estimate import describe_estimate
 
     if not estimator:
         return
@@ -332,7 +332,7 @@ def load_data(args):
     ``args.band_flag``, when set, is what the command calls its --band option
     (``tune``: ``--data-band``), so that refusals name the option as typed.
 
-    A time recording is turned into FRFs with `satmd.io.estimate_frf`'s
+    A time recording is turned into FRFs with `satmd.signal.estimate_frf`'s
     defaults (a note on stderr says so; `satmd estimate-frf` gives control).
     """
     from ..io import estimate_frf, is_recording, load_frf

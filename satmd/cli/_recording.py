@@ -17,7 +17,7 @@ def add_recording_options(parser: argparse.ArgumentParser):
 def load_recording_args(args, path):
     """A time recording with --map and --fs applied and its excitation read (--excitation, --period-s)."""
     from ..io import load_recording
-    from ..io.excitation import detect_excitation, with_excitation
+    from ..signal.excitation import detect_excitation, with_excitation
 
     from ..errors import SatmdError
 

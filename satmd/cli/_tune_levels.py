@@ -102,7 +102,7 @@ def run_levels(args, band, model_rig, files) -> int:
         raise DataError("--levels: give one --nonlinear element")
     fit = None
     if files:
-        from ..identification.nonlinear import fit_nonlinear
+        from ..identification.nonlinear.fit import fit_nonlinear
         from ..io import is_recording, load_recording
 
         recs = []

@@ -61,7 +61,7 @@ def run(args):
 
 def _run(args):
     from ..io import FRFData, estimate_frf, load_recording, save_frf, save_transmissibility, transmissibility
-    from ..io.estimate import describe_estimate
+    from ..signal.estimate import describe_estimate
 
     scale = parse_kv(args.scale, "--scale") if args.scale else None
     band = parse_band(args.band)

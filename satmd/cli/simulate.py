@@ -6,7 +6,7 @@ from ..io import CHANNELS, WRITERS, save_frf
 from ..io.atomic import all_or_none
 from ..io.recording import RECORDING_WRITERS
 from ..physics import PAPER_GRID_HZ
-from ..simulation import simulate
+from ..simulation.frf import simulate
 from ._common import (
     MAX_SAMPLES,
     SEED,
@@ -123,7 +123,7 @@ def run(args):
 
 
 def run_time(args, rig, effects):
-    """--time: a simulated recording (satmd.io.simulate_recording)."""
+    """--time: a simulated recording (satmd.simulation.simulate_recording)."""
     from ..io import save_recording, simulate_recording
 
     if args.plot:
@@ -145,7 +145,7 @@ def run_time(args, rig, effects):
         raise SatmdError(f"--duration {args.duration:g} s at --fs {args.fs:g} Hz is {n:.3g} samples per channel; "
                          f"at most {MAX_SAMPLES} (e.g. --duration {MAX_SAMPLES // args.fs:g})")
     from ..io.limits import check_memory, memory_budget
-    from ..io.timesim import recording_memory
+    from ..simulation.timesim import recording_memory
 
     check_memory(f"--fs {args.fs:g} Hz for --duration {args.duration:g} s",
                  recording_memory(args.duration, args.fs), "lower --fs or --duration")
@@ -171,7 +171,7 @@ def run_nonlinear(args, rig, effects, noise, band):
     """--time with --nonlinear, --level or --excitation multisine: the time-domain integrator."""
     from ..io import save_recording
     from ..physics import nonlinear_element
-    from ..simulation_nonlinear import simulate_nonlinear_recording
+    from ..simulation.nonlinear import simulate_nonlinear_recording
 
     if args.level is not None and args.force_rms not in (None, 1.0):
         raise SatmdError("give the drive level once: --level or --force-rms")
@@ -189,7 +189,7 @@ def run_nonlinear(args, rig, effects, noise, band):
     for flag, value in (("--periods", args.periods), ("--realisations", args.realisations)):
         if value is not None and value < 1:
             raise SatmdError(f"{flag} {value}: must be >= 1")
-    if args.excitation == "multisine":  # a period of at least 16 samples (satmd.simulation_nonlinear)
+    if args.excitation == "multisine":  # a period of at least 16 samples (satmd.simulation.nonlinear)
         periods, realisations = args.periods or 3, args.realisations or 4
         if args.duration * args.fs / (periods * realisations) < 16:
             raise SatmdError(f"--realisations {realisations} x --periods {periods} do not fit in --duration "

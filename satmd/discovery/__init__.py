@@ -67,12 +67,12 @@ def discover(
     ----------
     data : FRFData, Recording, or a list of them
         Measured FRFs, or a force/acceleration recording: its FRFs are then
-        estimated by `satmd.io.estimate_frf` (local polynomial method, std from
+        estimated by `satmd.signal.estimate_frf` (local polynomial method, std from
         the recording's own noise). For FRFs estimated from a recording the
         report adds ``estimator`` and the ``measurement`` findings of the chain,
         kept apart from physics. A recording is also tested for nonlinear
         distortion; a list of recordings (or FRFData) of one rig at several
-        levels, or repeats, is judged together (`nonlinear_discover`): the
+        levels, or repeats, is judged together (`satmd.discovery.nonlinear.levels`): the
         report then has a ``nonlinear`` block (SPEC §9).
     rig : values of the fixed parameters (default: the paper's rig).
     free : parameters fitted in every model (default m2, kp, R, L).
@@ -93,15 +93,15 @@ def discover(
 
     check_data(data, "data", (FRFData, Recording), "discover", many=True, hint=LOAD_HINT)
     if isinstance(data, (list, tuple)):  # several recordings of one rig: judged together (issue 26)
-        from .nonlinear_discover import discover_recordings
+        from .nonlinear.levels import discover_recordings
 
         data = [_with_excitation(part) for part in data]
         return discover_recordings(data, discover, rig=rig, free=free, alpha=alpha, candidates=candidates,
                                    channels=channels, max_effects=max_effects)
     recording = data if isinstance(data, Recording) else None
     if recording is not None:
-        from ..io.estimate import estimate_frf
-        from ..io.excitation import detect_excitation, with_excitation
+        from ..signal.estimate import estimate_frf
+        from ..signal.excitation import detect_excitation, with_excitation
 
         # the excitation is read once and travels with the recording: the FRF and the linearity test agree
         recording = data = with_excitation(data, detect_excitation(data))
@@ -114,7 +114,7 @@ def discover(
     report = replace(report, estimator=dict(data.estimator),
                      notes=list(data.estimator.get("measurement", [])) + list(report.notes))
     if recording is not None:  # one recording: is it linear at all? (issue 26)
-        from .nonlinear_discover import check_one
+        from .nonlinear.levels import check_one
 
         report = check_one(report, recording, alpha, rig, free)
     return report
@@ -122,7 +122,7 @@ def discover(
 
 def _with_excitation(part):
     """A recording with its excitation read (FRFData as it is)."""
-    from ..io.excitation import detect_excitation, with_excitation
+    from ..signal.excitation import detect_excitation, with_excitation
     from ..io.recording import Recording
 
     if isinstance(part, Recording) and "force" in part.channels:

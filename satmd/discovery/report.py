@@ -10,7 +10,7 @@ from ..conventions import MIN_DELTA_BIC
 
 if TYPE_CHECKING:
     from ..identification.adequacy import Adequacy
-    from .nonlinear import NonlinearReport
+    from .nonlinear.distortion import NonlinearReport
 
 SCHEMA = "satmd-discovery/1"
 
@@ -122,7 +122,7 @@ class DiscoveryReport:
         noise = ("the std columns of the file" if self.noise == "given"
                  else "an estimate from the residual's roughness (no std in the file)")
         if self.estimator:
-            from ..io.estimate import describe_estimate
+            from ..signal.estimate import describe_estimate
 
             noise = "the std of the FRF estimate (from the recording's own noise)"
             lines = ["[[Missing-physics discovery]]",

@@ -13,7 +13,7 @@ import numpy as np
 from ..conventions import SPEC_RANGES
 from ..physics import Rig
 from ..physics.effects import VOCABULARY_NAMES, Effect, effect
-from ..simulation import simulate
+from ..simulation.frf import simulate
 
 GRIDS = {"paper60": (40.0, 130.0, 60), "lin200": (30.0, 160.0, 200)}
 NOISE = (0.01, 0.002)

@@ -7,8 +7,8 @@
 """
 from .fit import identify
 from .many import identify_many
-from .nonlinear import fit_nonlinear, predict
-from .nonlinear_result import NonlinearFit
+from .nonlinear.fit import fit_nonlinear, predict
+from .nonlinear.result import NonlinearFit
 from .problem import RIG_BOUNDS, SEARCH_RANGES, Problem
 from .result import FitResult
 

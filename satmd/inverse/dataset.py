@@ -112,7 +112,7 @@ class InverseDataset:
     def frfdata(self, i: int, noise: float = 0.0, seed=None):
         """Sample ``i`` as FRFData (with std columns and noise when ``noise`` > 0)."""
         from ..io import FRFData
-        from ..simulation import noise_std
+        from ..simulation.frf import noise_std
 
         chans = {"a1": self.a1[i], "a2": self.a2[i]}
         if not noise:

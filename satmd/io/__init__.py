@@ -1,4 +1,4 @@
-"""Reading and writing FRFs and time recordings.
+"""Files in and out, and the data containers they fill: FRFs (`FRFData`) and time recordings (`Recording`).
 
 ``load_frf(path)`` dispatches on the file's suffix; ``save_frf(data, path)``
 likewise. Readers are registered in ``READERS`` / ``WRITERS`` so that new
@@ -8,7 +8,8 @@ FRF formats: ``.csv`` (SPEC §7), ``.uff``/``.unv`` (UFF 58/58b, function
 type 4), ``.mat`` and ``.npz`` (documented variable names, see
 `satmd.io.matfile`), ``.txt`` (one complex value per line; needs
 ``freq_axis``). Time recordings (`load_recording`): ``.csv``, ``.uff``,
-``.wav``, ``.npz``, ``.mat``; `estimate_frf` turns them into FRFs.
+``.wav``, ``.npz``, ``.mat``; `satmd.signal.estimate_frf` turns them into FRFs. Where the project's
+shared real data lie: `satmd.io.shared`.
 """
 from __future__ import annotations
 
@@ -21,19 +22,9 @@ from ..errors import DataError, DataTypeError, FormatError
 from ..validation import validate_params
 from ._common import DataWarning, writer_for
 from .csvfrf import read_csv, write_csv
-from .estimate import (
-    Transmissibility,
-    default_nperseg,
-    estimate_frf,
-    model_transmissibility,
-    save_transmissibility,
-    transmissibility,
-)
-from .excitation import Excitation, detect_excitation
 from .frfdata import CHANNELS, UNITS, FRFData
 from .matfile import read_frf_variables, write_frf_variables
 from .recording import Recording, clipped_channels, is_recording, load_recording, save_recording
-from .timesim import simulate_recording
 from .txtfrf import read_txt
 from .uff import read_uff, write_uff
 
@@ -122,9 +113,14 @@ def save_frf(data: FRFData, path, **options) -> Path:
     return writer_for(path, WRITERS, "files")(data, path, **options)
 
 
+def __getattr__(name):
+    """Names this package gave before the estimators and simulators moved out (issue 48): warned aliases."""
+    from .._moved import moved_name
+
+    return moved_name(__name__, name)
+
+
 __all__ = [
     "FRFData", "CHANNELS", "UNITS", "load_frf", "save_frf", "READERS", "WRITERS", "DataWarning",
-    "Recording", "load_recording", "save_recording", "is_recording", "clipped_channels", "estimate_frf",
-    "default_nperseg", "transmissibility", "Transmissibility", "model_transmissibility", "save_transmissibility",
-    "simulate_recording", "Excitation", "detect_excitation",
+    "Recording", "load_recording", "save_recording", "is_recording", "clipped_channels",
 ]

@@ -3,7 +3,7 @@
 A *time model* has ``respond(force, fs_hz) -> {signal: array}``: the clean signals a rig driven
 from rest by the force samples would give its sensors, the force itself among them as the
 acquisition records it. satmd's recorders (`satmd.simulate` with ``time=True``) call only that,
-then add the sensors' noise (`satmd.io.acquisition`); anything with the method is a test bed.
+then add the sensors' noise (`satmd.simulation.acquisition`); anything with the method is a test bed.
 
 - `LinearRig`: the SPEC §2 model with effects, by linear convolution with its impulse response
   (FFT on a grid long enough that the response has decayed to 1e-9: measured, not assumed),

@@ -54,14 +54,16 @@ def section_failure(exc: BaseException) -> str:
 
 
 def sections():
-    mods = [importlib.import_module(f"{__name__}.{m.name}")
-            for m in pkgutil.iter_modules(__path__) if m.name.startswith("sec_")]
+    """The report's sections (each module of `satmd.report.parts`), in report order."""
+    from . import parts as package
+
+    mods = [importlib.import_module(f"{package.__name__}.{m.name}") for m in pkgutil.iter_modules(package.__path__)]
     return sorted(mods, key=lambda m: m.ORDER)
 
 
 def section_keys() -> list[str]:
     """The keys `reproduce(only=...)` takes, in report order."""
-    return [m.__name__.rsplit(".sec_", 1)[-1] for m in sections()]
+    return [m.__name__.rsplit(".", 1)[-1] for m in sections()]
 
 
 def reproduce(out, only=None, quick=False, log=print, acceptance=None) -> Path:
@@ -147,7 +149,7 @@ def _build(ctx, only, log) -> str:
     parts = ["# satmd report", "",
              "Produced by `satmd reproduce`: every number and figure below is computed by this run.", ""]
     for mod in sections():
-        key = mod.__name__.rsplit(".sec_", 1)[-1]
+        key = mod.__name__.rsplit(".", 1)[-1]
         if only and key not in only:
             continue
         t0 = time.perf_counter()

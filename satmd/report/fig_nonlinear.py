@@ -39,7 +39,7 @@ def nonlinear_comparison_figure(comparison, path=None, title: str = ""):
 
     Parameters
     ----------
-    comparison : dict from `satmd.identification.nonlinear_compare.compare_models` (or its
+    comparison : dict from `satmd.identification.nonlinear.compare.compare_models` (or its
         ``levels`` list).
     path : PNG/SVG/PDF file to write (None: return the figure unsaved).
     title : figure title (default: the nonlinear model's name).

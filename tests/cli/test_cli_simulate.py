@@ -1,4 +1,4 @@
-"""`satmd simulate`: files equal satmd.simulation.simulate(...) exactly; bad input
+"""`satmd simulate`: files equal satmd.simulation.frf.simulate(...) exactly; bad input
 is one line on stderr, exit status 2, and no file written or destroyed."""
 from __future__ import annotations
 
@@ -14,7 +14,7 @@ import pytest
 from satmd.cli import main
 from satmd.io import load_frf
 from satmd.physics import OFFSET_PARAMETERS, PAPER_GRID_HZ, Rig, effect
-from satmd.simulation import simulate
+from satmd.simulation.frf import simulate
 
 ALL = ("a1", "a2", "u1", "u2", "q")
 

@@ -6,7 +6,7 @@ from satmd import discover, effect
 from satmd.errors import DataError
 from satmd.io import FRFData
 from satmd.physics import Rig
-from satmd.simulation import simulate
+from satmd.simulation.frf import simulate
 
 F = np.linspace(30.0, 160.0, 200)
 

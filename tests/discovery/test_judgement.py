@@ -5,7 +5,7 @@ import pytest
 from satmd import discover, effect
 from satmd.discovery.findings import STATUSES, EffectFinding, Judged
 from satmd.identification.adequacy import Reason
-from satmd.simulation import simulate
+from satmd.simulation.frf import simulate
 
 FINDING = EffectFinding("time_delay", {"tau_s": 1e-4}, [], 50.0, "a delay")
 
@@ -34,7 +34,7 @@ def test_the_report_reads_every_verdict_from_one_list():
 
 def test_a_distorted_recording_sets_its_linear_effects_aside_with_a_reason():
     """The rule `check_one` applies: a named linear effect of a distorted record is set aside, for distortion."""
-    from satmd.discovery.nonlinear_discover import check_one
+    from satmd.discovery.nonlinear.levels import check_one
     from satmd.physics.nonlinear import element
 
     rep = discover(simulate(effects=[effect("time_delay", tau_s=3e-4)], noise=(0.01, 0.002), seed=1))

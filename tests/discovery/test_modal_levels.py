@@ -87,9 +87,9 @@ def test_a_resonance_that_moves_is_read_at_the_detections_level_when_it_is_the_o
     """Null rigs of `benchmarks/structures_levels.py` (1 in 34) were reported moving at the trend tests' 5 %:
     when only the SATMD-parameter test (which says nothing about another structure) detected anything, a
     resonance's move is the detection itself and is read at the tests' level (1e-3)."""
-    from satmd.discovery.nonlinear import NonlinearReport
-    from satmd.discovery.nonlinear_modes import unexplained_by_modes
-    from satmd.discovery.nonlinear_stats import NonlinearTest
+    from satmd.discovery.nonlinear.distortion import NonlinearReport
+    from satmd.discovery.nonlinear.modes import unexplained_by_modes
+    from satmd.discovery.nonlinear.stats import NonlinearTest
     from satmd.modal import follow_modes
 
     f0, _ = chain_modes()

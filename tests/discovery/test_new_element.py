@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 
 from satmd import discover, simulate
-from satmd.identification.nonlinear import fit_nonlinear
+from satmd.identification.nonlinear.fit import fit_nonlinear
 from satmd.physics import Rig
 from satmd.physics.effects.base import Parameter
 from satmd.physics.nonlinear import NonlinearElement, kernel, register_nonlinear, unregister_nonlinear
@@ -70,7 +70,7 @@ def test_new_element_law_written_once_serves_both_integrators(recordings):
     assert np.max(np.abs(compiled.a2 - plain.a2)) < 1e-6 * np.max(np.abs(plain.a2))
     eq = el.equivalent_linear(TRUTH, {"d": 1.5e-4})  # numerical by default: kp + kg P(|d| > gap)
     assert eq.value == pytest.approx(TRUTH.kp + KG * math.erfc(GAP / (math.sqrt(2) * 1.5e-4)), rel=1e-6)
-    from satmd.discovery.nonlinear_findings import regressor_hint
+    from satmd.discovery.nonlinear.findings import regressor_hint
 
     assert "test_gap_spring" in regressor_hint("d:cube")  # the distortion test's hint names it too
 

@@ -5,9 +5,9 @@ import numpy as np
 import pytest
 
 from satmd import simulate
-from satmd.discovery.nonlinear import distortion_test
-from satmd.discovery.nonlinear_findings import analyse_recordings
-from satmd.discovery.nonlinear_stats import distortion_regressors, linearity_test, separate_linearity_test
+from satmd.discovery.nonlinear.distortion import distortion_test
+from satmd.discovery.nonlinear.findings import analyse_recordings
+from satmd.discovery.nonlinear.stats import distortion_regressors, linearity_test, separate_linearity_test
 from satmd.physics import Rig
 from satmd.physics.nonlinear import element, response_rms
 

@@ -6,7 +6,9 @@ import pytest
 
 from satmd import discover, effect, identify
 from satmd.cli import main
-from satmd.io import estimate_frf, load_recording, save_recording, simulate_recording
+from satmd.io import load_recording, save_recording
+from satmd.signal import estimate_frf
+from satmd.simulation import simulate_recording
 from satmd.physics import Rig
 
 

@@ -4,7 +4,7 @@ from satmd.report import Context
 
 
 def test_section_degrades_without_the_inverse_package(monkeypatch, tmp_path):
-    from satmd.report import sec_explain
+    from satmd.report.parts import explain as sec_explain
 
     monkeypatch.setitem(sys.modules, "satmd.inverse", None)  # import satmd.inverse -> ImportError
     model, note = sec_explain._model(Context(tmp_path, quick=True))

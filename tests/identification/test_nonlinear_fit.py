@@ -6,8 +6,8 @@ import pytest
 
 from satmd import simulate
 from satmd.errors import DataError
-from satmd.identification.nonlinear import fit_nonlinear, predict
-from satmd.identification.nonlinear_compare import compare_models
+from satmd.identification.nonlinear.fit import fit_nonlinear, predict
+from satmd.identification.nonlinear.compare import compare_models
 from satmd.io.recording import Recording
 from satmd.physics import Rig, nonlinear_element
 
@@ -92,7 +92,7 @@ def test_inductor_saturation_by_name():
 
 
 def test_error_where_the_response_is_excited():
-    from satmd.identification.nonlinear_signal import band_error, excited_bins, excited_error
+    from satmd.identification.nonlinear.drive import band_error, excited_bins, excited_error
 
     fs, n = 1024.0, 16384
     rng = np.random.default_rng(5)

@@ -70,7 +70,8 @@ def test_predict_takes_lab_grids_and_band(trained, tmp_path, capsys):
 
 
 def test_predict_takes_a_recording(trained, tmp_path, capsys):
-    from satmd.io import save_recording, simulate_recording
+    from satmd.io import save_recording
+    from satmd.simulation import simulate_recording
 
     rec = tmp_path / "rec.npz"
     save_recording(simulate_recording(20.0, rig=Rig(R=30.0, L=0.15), seed=0), rec)

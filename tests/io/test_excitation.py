@@ -7,10 +7,11 @@ import numpy as np
 import pytest
 
 from satmd.errors import DataError, FormatError
-from satmd.io import Recording, estimate_frf, load_recording
+from satmd.io import Recording, load_recording
+from satmd.signal import estimate_frf
 from satmd.io.shared import real_data
 from tests.conftest import needs_real
-from satmd.io.excitation import detect_excitation, find_period
+from satmd.signal.excitation import detect_excitation, find_period
 from satmd.physics.timemodel import LinearRig
 from satmd.physics import Rig, frf
 
@@ -143,9 +144,9 @@ def test_a_periodic_chirps_weak_tails_are_not_detection_lines():
     from scipy.signal import chirp
 
     from satmd import discover
-    from satmd.discovery.nonlinear import multisine_arrays, multisine_test
-    from satmd.discovery.nonlinear_periodic import forced_lines
-    from satmd.io.excitation import with_excitation
+    from satmd.discovery.nonlinear.distortion import multisine_arrays, multisine_test
+    from satmd.discovery.nonlinear.periodic import forced_lines
+    from satmd.signal.excitation import with_excitation
 
     fs = 2000.0
     t = np.arange(2000) / fs
@@ -223,7 +224,7 @@ def test_a_fast_sweep_at_rest_at_both_ends_is_estimated_without_leakage():
 
 
 def test_a_log_sweep_is_recognised_with_its_law():
-    from satmd.io.timesim import log_sweep
+    from satmd.simulation.timesim import log_sweep
 
     rec = _record(log_sweep(int(40 * FS), FS, 15.0, 250.0), noise=0.01)
     exc = detect_excitation(rec)

@@ -11,8 +11,9 @@ import pytest
 import scipy.signal as sg
 
 from satmd.errors import DataError
-from satmd.io import Recording, estimate_frf
-from satmd.io.lpm import _excited, excited_band
+from satmd.io import Recording
+from satmd.signal import estimate_frf
+from satmd.signal.lpm import _excited, excited_band
 
 
 def _force(fs, seconds, order, corner, seed, pink=False, shaker_hz=None, noise=0.01):
@@ -123,8 +124,8 @@ def test_huge_sample_rate_is_handled():
 def test_mains_hum_is_a_measurement_finding_and_leaves_no_mark_on_the_estimate():
     """Hum at 50 Hz and harmonics on both accelerometers (lines the force does not explain): the windows
     carrying them are left out, the rest is calibrated, and the estimate names the hum."""
-    from satmd.io import simulate_recording
-    from satmd.io.conditions import ForceSpectrum, SensorNoise
+    from satmd.simulation import simulate_recording
+    from satmd.simulation.conditions import ForceSpectrum, SensorNoise
     from satmd.physics import frf
 
     rec = simulate_recording(40.3, 1000.0, noise=0.02, seed=3, band_hz=(10.0, 300.0),
@@ -140,12 +141,12 @@ def test_mains_hum_is_a_measurement_finding_and_leaves_no_mark_on_the_estimate()
 
 
 def test_lab_conditions_are_reproducible_and_varied():
-    from satmd.io.conditions import lab_conditions
+    from satmd.simulation.conditions import lab_conditions
 
     assert lab_conditions(3) == lab_conditions(3)
     drawn = [lab_conditions(s) for s in range(40)]
     assert any(c["sensor_noise"].hum for c in drawn) and any(c["sensor_noise"].drift for c in drawn)
     assert {c["force_spectrum"].rolloff_order for c in drawn} >= {0, 2, 8}
     with pytest.raises(DataError, match="rolloff_order"):
-        from satmd.io.conditions import ForceSpectrum
+        from satmd.simulation.conditions import ForceSpectrum
         ForceSpectrum(rolloff_order=-1)

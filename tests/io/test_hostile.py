@@ -164,7 +164,7 @@ def test_glitches_are_refused_or_reported(tmp_path):
 def test_api_names_the_argument_of_the_wrong_type():
     from satmd import identify
     from satmd.discovery import discover_many
-    from satmd.io import estimate_frf
+    from satmd.signal import estimate_frf
 
     with pytest.raises(TypeError, match="data must be FRFData"):
         identify([1, 2, 3])

@@ -1,4 +1,4 @@
-"""Each recording is analysed once (issue 36, item 0): the memo of `satmd.io.memo` behind `lpm` and the
+"""Each recording is analysed once (issue 36, item 0): the memo of `satmd.signal.memo` behind `lpm` and the
 force's excited band answers a question asked before, by the data's content, never with a stale or shared
 answer."""
 from __future__ import annotations
@@ -6,10 +6,10 @@ from __future__ import annotations
 import numpy as np
 
 import satmd
-from satmd.io import lpm as lpm_module
-from satmd.io.lpm import excited_band, lpm
-from satmd.io.memo import ContentMemo, fingerprint
-from satmd.io.timesim import simulate_recording
+from satmd.signal import lpm as lpm_module
+from satmd.signal.lpm import excited_band, lpm
+from satmd.signal.memo import ContentMemo, fingerprint
+from satmd.simulation.timesim import simulate_recording
 from satmd.physics import Rig
 
 

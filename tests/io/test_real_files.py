@@ -10,7 +10,8 @@ from satmd.cli import main
 from satmd.errors import FormatError
 from satmd.io.shared import real_data
 from tests.conftest import needs_real
-from satmd.io import DataWarning, load_frf, load_recording, transmissibility
+from satmd.io import DataWarning, load_frf, load_recording
+from satmd.signal import transmissibility
 
 REAL = real_data() or Path("absent")
 pytestmark = needs_real()

@@ -205,7 +205,7 @@ def test_default_recording_is_random_not_periodic_and_starts_at_rest():
 
 def test_convolution_from_rest_reaches_the_exact_steady_state():
     """A periodic force repeated: once the transient has died, the response equals the exact steady state."""
-    from satmd.io.timesim import _steady_state_multisine
+    from satmd.simulation.timesim import _steady_state_multisine
     from satmd.physics.timemodel import LinearRig
 
     rng = np.random.default_rng(0)

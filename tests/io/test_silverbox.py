@@ -46,8 +46,8 @@ def test_snls_splits_arrow_and_multisine():
 
 @needs_data
 def test_lowest_and_highest_level_show_hardening_at_the_resonance():
-    from satmd.discovery.nonlinear_periodic import multisine_bla, one_mode_fit, periodic_blocks
-    from satmd.discovery.nonlinear_stats import level_dependence
+    from satmd.discovery.nonlinear.periodic import multisine_bla, one_mode_fit, periodic_blocks
+    from satmd.discovery.nonlinear.stats import level_dependence
 
     frfs, stds, fn = [], [], []
     for level in (5, 150):

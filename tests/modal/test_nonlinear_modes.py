@@ -1,11 +1,11 @@
-"""satmd.discovery.nonlinear_modes on levels of a simulated structure: the resonance the joint moves, told."""
+"""satmd.discovery.nonlinear.modes on levels of a simulated structure: the resonance the joint moves, told."""
 from __future__ import annotations
 
 import json
 
 import numpy as np
 
-from satmd.discovery.nonlinear_modes import NOT_SATMD, level_modes, modal_finding
+from satmd.discovery.nonlinear.modes import NOT_SATMD, level_modes, modal_finding
 from satmd.io.frfdata import FRFData
 
 from .test_follow_modes import simulated_levels

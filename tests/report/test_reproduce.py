@@ -13,8 +13,8 @@ def _boom(ctx):
 
 
 def test_a_failing_section_loses_nothing_else(tmp_path, monkeypatch):
-    forward = next(m for m in report.sections() if m.__name__.endswith("sec_forward"))
-    tune = next(m for m in report.sections() if m.__name__.endswith("sec_tune"))
+    forward = next(m for m in report.sections() if m.__name__.endswith(".forward"))
+    tune = next(m for m in report.sections() if m.__name__.endswith(".tune"))
     monkeypatch.setattr(tune, "build", _boom)
     with pytest.raises(report.IncompleteReport) as info:
         report.reproduce(tmp_path / "r", only=["forward", "tune"], quick=True, log=lambda *_: None)
@@ -30,7 +30,7 @@ def test_a_failing_section_loses_nothing_else(tmp_path, monkeypatch):
 
 
 def test_the_cli_exits_1_and_names_the_section(tmp_path, monkeypatch, capsys):
-    tune = next(m for m in report.sections() if m.__name__.endswith("sec_tune"))
+    tune = next(m for m in report.sections() if m.__name__.endswith(".tune"))
     monkeypatch.setattr(tune, "build", _boom)
     code = main(["reproduce", "--out", str(tmp_path / "r"), "--only", "tune", "--quick"])
     err = capsys.readouterr().err
@@ -38,7 +38,7 @@ def test_the_cli_exits_1_and_names_the_section(tmp_path, monkeypatch, capsys):
 
 
 def test_an_interrupt_still_stops_the_run(tmp_path, monkeypatch):
-    tune = next(m for m in report.sections() if m.__name__.endswith("sec_tune"))
+    tune = next(m for m in report.sections() if m.__name__.endswith(".tune"))
 
     def interrupt(ctx):
         raise KeyboardInterrupt

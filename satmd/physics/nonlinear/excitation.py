@@ -25,7 +25,7 @@ def random_force(n: int, fs_hz: float, band_hz, rng, shape=None, unit_rms: bool 
     band_hz : (lo, hi) [Hz].
     rng : numpy Generator.
     shape : the shaker's amplitude response, an object with ``amplitude(f, lo, hi)`` (e.g.
-        `satmd.io.timesim.ForceSpectrum`); default flat, cut at lo and hi.
+        `satmd.simulation.timesim.ForceSpectrum`); default flat, cut at lo and hi.
     unit_rms : scale to unit RMS (else the filtered noise as it is).
 
     Returns

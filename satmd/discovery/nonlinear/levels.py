@@ -1,0 +1,211 @@
+"""`discover` on several recordings of one rig, and the nonlinear check of one recording.
+
+Several recordings (levels or repeats) are judged together: the ``nonlinear``
+block (`findings.analyse_recordings`) says whether they are one
+linear system; the linear vocabulary (`effects`) then runs
+
+- on their pooled FRF (inverse-variance mean) when they are: more data, one answer;
+- on the lowest level, with the parameter the nonlinear finding moves set free,
+  when they are not: the nonlinearity is named once, in its own block, and a
+  linear effect that only stands in for it (``parameter_offset`` of that
+  parameter, ``unexplained``) is dropped from ``effects``;
+- and when the SATMD model is not adequate for them (another structure), no
+  SATMD element is named at all: the finding is ``nonlinear_unexplained`` told
+  per resonance, from a modal fit of every level (`modes`).
+
+A single recording in which distortion is detected keeps the linear effects
+found in ``nonlinear.set_aside`` instead of ``effects``: one level cannot tell a
+linear effect from an equivalent linearisation, and a nonlinear rig must not get
+linear physics for its nonlinearity.
+
+The linear discovery is passed in (``linear``: `satmd.discovery.discover`) so that
+this module does not import the package it serves.
+"""
+from __future__ import annotations
+
+from ...conventions import TINY
+
+from dataclasses import replace
+
+import numpy as np
+
+from ...identification.adequacy import Reason
+from .findings import analyse_recordings
+
+_UNEXPLAINED = "unexplained"
+
+
+def _is_recording(x) -> bool:
+    return hasattr(x, "fs_hz") and hasattr(x, "channels") and "force" in getattr(x, "channels", {})
+
+
+def pooled(datas):
+    """Inverse-variance mean of FRFData on one grid (std of the mean).
+
+    Periodic realisations (``estimator.method`` periodic, three or more) give
+    the best linear approximation: its std is the larger of the noise's and the
+    spread over realisations (noise and the stochastic nonlinear distortion,
+    Pintelon & Schoukens ch. 3), and ``estimator.nonlinear_variance_share``
+    says how much of that spread the noise does not explain.
+    """
+    first = datas[0]
+    k = len(datas)
+    realisations = k >= 3 and all(d.estimator.get("method") == "periodic" for d in datas)
+    chans, std, share = {}, {}, []
+    for c in first.channels:
+        w = np.stack([1.0 / np.maximum(d.std[c], TINY) ** 2 for d in datas])
+        H = np.stack([d.channels[c] for d in datas])
+        chans[c] = np.sum(w * H, axis=0) / w.sum(axis=0)
+        std[c] = 1.0 / np.sqrt(w.sum(axis=0))
+        if realisations:  # the spread over realisations: per part, of the mean
+            spread = np.sqrt(np.sum(np.abs(H - H.mean(axis=0)) ** 2, axis=0) / (k - 1) / k / 2.0)
+            share.append(float(np.median(np.maximum(spread ** 2 - std[c] ** 2, 0.0) / np.maximum(spread ** 2, TINY))))
+            std[c] = np.maximum(std[c], spread)
+    est = dict(first.estimator)
+    if "noise_dof" in est and est["noise_dof"]:
+        est["noise_dof"] = 2.0 * (k - 1) if realisations else float(est["noise_dof"]) * k
+    est["pooled_records"] = k
+    if realisations:
+        est["realisations"] = k
+        est["nonlinear_variance_share"] = round(max(share), 4)
+    return replace(first, channels=chans, std=std, correlation={}, estimator=est)
+
+
+def discover_recordings(items, linear, rig=None, free=None, alpha: float = 1e-3, **kwargs):
+    """Discovery on several recordings (or FRFData with std) of one rig: effects and the nonlinear block.
+
+    Parameters
+    ----------
+    items : list of Recording (force, acc1, acc2) or of FRFData with std, in any level order
+    linear : the linear discovery, ``linear(data, rig=..., free=..., alpha=..., **kwargs)``
+    rig, free, alpha, **kwargs : as `satmd.discovery.discover`
+
+    Returns
+    -------
+    DiscoveryReport
+        With ``nonlinear`` (SPEC §9).
+    """
+    from ...conventions import DEFAULT_FREE
+    from .distortion import common_frfs, on_common_grid
+    from .findings import analyse_frfs
+
+    free = tuple(free or DEFAULT_FREE)
+    items = list(items)
+    hits = repeated_hits(items)
+    if hits is not None:  # hits of one test are repeats, not levels: one FRF over all of them
+        return linear(hits, rig=rig, free=free, alpha=alpha, **kwargs)
+    if all(_is_recording(x) for x in items):
+        unit: str | None = "N RMS"  # the levels are the recordings' force RMS
+        datas = common_frfs(items)
+        nl = analyse_recordings(items, rig, free, alpha, datas=datas)
+        grid = on_common_grid(datas)
+        datas = grid[1] if grid is not None else datas
+        levels = nl.levels
+    else:
+        grid = on_common_grid(items)
+        if grid is None:
+            from ...errors import DataError
+
+            raise DataError("the FRFs share fewer than 4 frequencies: give them on one grid")
+        datas = grid[1]
+        unit = "N RMS" if all("force_rms" in d.meta for d in datas) else None
+        nl = analyse_frfs(datas, rig, free, alpha)
+        levels = nl.levels
+    finding = nl.findings[0] if nl.findings else {}
+    moving = finding.get("moving")
+    if not nl.detected:
+        rep = linear(pooled(datas), rig=rig, free=free, alpha=alpha, **kwargs)
+        return replace(rep, nonlinear=nl)
+    ref = datas[int(np.argmin(levels))] if levels else datas[0]
+    free2 = free + ((moving,) if moving and moving not in free else ())
+    rep = linear(ref, rig=rig, free=free2, alpha=alpha, **kwargs)
+    if not rep.model_adequate:  # another structure: its level dependence is told per resonance, no element named
+        from .modes import unexplained_by_modes
+
+        return replace(rep, nonlinear=unexplained_by_modes(nl, datas, unit))
+    # with the moving parameter free, an effect that restates it (or what is left unexplained) is the
+    # nonlinearity seen at one level; without one, every linear effect may be
+    picked = [j.name for j in rep.judged if j.status == "named" and _stands_in(j, moving, rig)]
+    why = (f"{moving} moves with level ({finding.get('direction', 'changes')}): a linear effect at one level that "
+           "restates it is the nonlinearity seen there" if moving else
+           "the data depend on level: a linear effect fitted at one level stands in for the nonlinearity")
+    return rep.rejudged(lambda j: j.name in picked, "set_aside", [Reason("level_dependence", why, {"moving": moving})],
+                        nonlinear=replace(nl, set_aside=picked))
+
+
+def _stands_in(judged, moving, rig) -> bool:
+    """True when a named candidate may be the nonlinearity seen at one level: the unexplained rest, any effect
+    when no parameter is known to move, else an effect that changes the moving parameter itself."""
+    from ...physics import Rig
+    from ...physics.effects import at_rest
+
+    if judged.name == _UNEXPLAINED or not moving:
+        return True
+    return getattr(at_rest(judged.name, rig or Rig()), "parameter", None) == moving
+
+
+#: Impact files whose median hit heights lie within this factor are repeats of one test, not levels.
+IMPACT_LEVEL_FACTOR = 3.0
+
+
+def repeated_hits(items):
+    """Impact recordings of one test joined end to end (one Recording), or None when they are not that.
+
+    Every item must be an impact recording at one sample rate with the same
+    channels, and their median hit heights within `IMPACT_LEVEL_FACTOR`
+    (farther apart they are levels, judged as such).
+    """
+    from ...signal.excitation import detect_excitation, with_excitation
+    from ...io.recording import Recording
+
+    if len(items) < 2 or not all(_is_recording(x) for x in items):
+        return None
+    excs = [detect_excitation(x) for x in items]
+    if any(e.kind != "impact" for e in excs) or len({x.fs_hz for x in items}) > 1:
+        return None
+    if len({tuple(sorted(x.channels)) for x in items}) > 1:
+        return None
+    heights = [float(np.median([abs(x["force"][p] - np.median(x["force"])) for _, p in e.hits]))
+               for x, e in zip(items, excs)]
+    if max(heights) > IMPACT_LEVEL_FACTOR * min(heights):
+        return None
+    from ...signal.sweepfrf import at_rest_at_the_end
+
+    joined = {c: np.concatenate([x[c] for x in items]) for c in items[0].channels}
+    meta = {"source": " + ".join(str(x.meta.get("source", "recording")) for x in items)}
+    responses = [c for c in ("acc1", "acc2") if c in items[0].channels]
+    if not all(at_rest_at_the_end(x, responses, strict=True) for x in items):  # a file cut mid-ring: no whole-record transient
+        meta["cut_mid_ring"] = "a file ends before its response has rung down"
+    rec = Recording(items[0].fs_hz, joined, dict(items[0].units), meta)
+    return with_excitation(rec, detect_excitation(rec, "impact"))
+
+
+def check_one(report, recording, alpha: float = 1e-3, rig=None, free=None):
+    """Add the nonlinear block to the discovery of one recording; set linear effects aside when distorted.
+
+    Parameters
+    ----------
+    report : DiscoveryReport of the recording
+    recording : the Recording it came from
+    alpha : level of the distortion test
+    rig, free : as `satmd.discovery.discover`
+
+    Returns
+    -------
+    DiscoveryReport
+    """
+    if not _is_recording(recording) or not any(c in recording.channels for c in ("acc1", "acc2")):
+        return report
+    from ...errors import DataError
+
+    try:
+        nl = analyse_recordings([recording], rig, free or (), alpha)
+    except DataError:  # too short or too narrow-band for the test: the linear report stands alone
+        return report
+    if not nl.detected:
+        return replace(report, nonlinear=nl)
+    aside = report.effect_names
+    why = Reason("distortion", "the record is distorted (nonlinear): a linear effect fitted to it stands in for the "
+                               "nonlinearity", {"p_value": min((float(t.p_value) for t in nl.tests if not t.not_run),
+                                                               default=None)})
+    return report.rejudged(lambda j: True, "set_aside", [why], nonlinear=replace(nl, set_aside=aside))

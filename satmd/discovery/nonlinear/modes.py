@@ -1,0 +1,141 @@
+"""The level dependence of a structure the SATMD model cannot describe, told per resonance (SPEC §9).
+
+When several levels of one structure are judged and the SATMD model is not adequate for them, no
+SATMD element may be named: a joint SATMD fit would turn any change into one of its own parameters.
+The finding is ``nonlinear_unexplained`` with ``modes``: the modes of every level from a multi-mode
+fit (`satmd.modal.fit_modes`), fitted level by level from one set of modes (`satmd.modal.follow_modes`); a resonance is
+listed when its frequency or damping moves beyond its uncertainty, and the level-dependence bands are
+put where those resonances move.
+"""
+from __future__ import annotations
+
+from dataclasses import replace
+
+from ...modal import follow_modes
+from ..findings import NonlinearFinding
+from .distortion import UNEXPLAINED_NL
+
+MODES_ALPHA = 0.05  # family-wise level of the trend tests once a test has detected a level dependence
+NOT_SATMD = "the SATMD model does not describe these data, so no SATMD element is named"
+
+
+def level_modes(freq_hz, frfs, stds, levels, alpha: float = 0.05, dof=None) -> list:
+    """The modes of every level followed over the levels (`satmd.modal.follow_modes`).
+
+    Parameters
+    ----------
+    freq_hz : (M,) Hz, the grid of every level
+    frfs : per level {channel: (M,) complex}
+    stds : per level {channel: (M,) std} or None
+    levels : one level figure per FRF
+    alpha : family-wise level of the trend tests
+    dof : degrees of freedom of the stds (their estimator's ``noise_dof``; None: many)
+
+    Returns
+    -------
+    list of TrackedMode
+        Empty when a level has too few frequencies for a modal fit.
+    """
+    try:
+        return follow_modes(freq_hz, frfs, stds, levels, alpha, dof=dof)
+    except ValueError:  # too few frequencies for a modal fit
+        return []
+
+
+def modal_finding(datas, levels, unit: str | None = None, alpha: float = 0.05) -> tuple:
+    """The ``nonlinear_unexplained`` finding with ``modes``, and the bands where the resonances move.
+
+    Parameters
+    ----------
+    datas : list of FRFData on one grid, one per level
+    levels : one level figure per FRF (trends read from the lowest to the highest)
+    unit : the levels' unit in words (e.g. ``N RMS``); None when they are only an order
+    alpha : family-wise level of the trend tests
+
+    Returns
+    -------
+    (NonlinearFinding, list)
+        The finding and ``[[lo, hi], ...]`` Hz around each resonance that moves.
+    """
+    dofs = [float(d.estimator["noise_dof"]) for d in datas if d.estimator.get("noise_dof")]
+    tracks = level_modes(datas[0].freq_hz, [d.channels for d in datas],
+                         [d.std if d.has_std else None for d in datas], levels, alpha, min(dofs) if dofs else None)
+    moving = [t for t in tracks if t.moves]
+    stay = [t for t in tracks if not t.moves]
+    span = _span(levels, unit)
+    if len(moving) == 1:
+        text = f"{_describe(moving[0], levels)} {span}"
+    elif moving:
+        text = f"{span}: " + "; ".join(_describe(t, levels) for t in moving)
+    else:
+        text = (f"the levels differ, but no resonance's frequency or damping moves beyond its uncertainty "
+                f"({len(tracks)} followed over every level)")
+    if moving and stay:
+        text += "; the resonances at " + ", ".join(f"{t.f_hz[0]:.3g}" for t in stay) + " Hz stay within their " \
+                "uncertainty"
+    return _finding([t.to_dict() for t in moving], f"{text}; {NOT_SATMD}"), _bands(moving)
+
+
+def unexplained_by_modes(report, datas, unit: str | None = None):
+    """``report`` (a `NonlinearReport` that detected a level dependence) with its finding told per resonance.
+
+    The trends are read at ``MODES_ALPHA`` when a test other than the SATMD-parameter one (which says
+    nothing about another structure) detected the level dependence; otherwise a resonance that moves is the
+    only evidence, and it is read at the tests' own level.
+
+    Parameters
+    ----------
+    report : NonlinearReport of the levels
+    datas : their FRFData on one grid, in the order of ``report.levels``
+    unit : the levels' unit in words, or None
+
+    Returns
+    -------
+    NonlinearReport
+        One ``nonlinear_unexplained`` finding with ``modes``; the level-dependence tests' bands put
+        where resonances move (unchanged when none does).
+    """
+    # the SATMD-parameter test says nothing about a structure the SATMD model cannot describe: left out
+    kept = [t for t in report.tests if t.name != "level_dependence_parameters"]
+    # where no test that stays detected anything, a resonance that moves is the detection: at the tests' level
+    confirmed = any(t.significant for t in kept)
+    alpha = MODES_ALPHA if confirmed else min([t.alpha for t in report.tests] + [MODES_ALPHA])
+    finding, bands = modal_finding(datas, report.levels, unit, alpha)
+    tests = [replace(t, bands_hz=bands) if bands and t.name.startswith("level_dependence") else t for t in kept]
+    return replace(report, tests=tests, findings=[finding],
+                   detected=any(t.significant for t in tests) or bool(finding.get("modes")))
+
+
+def _finding(modes, explanation) -> NonlinearFinding:
+    return NonlinearFinding(UNEXPLAINED_NL, modes=modes, explanation=explanation)
+
+
+def _span(levels, unit) -> str:
+    lo, hi = min(levels), max(levels)
+    return f"from {lo:.3g} to {hi:.3g} {unit}" if unit else "from the lowest to the highest level"
+
+
+def _describe(track, levels) -> str:
+    """'the 7.32 Hz resonance softens by 2.2 % and its damping rises 4.2x' (lowest to highest level)."""
+    lo, hi = min(range(len(levels)), key=lambda i: levels[i]), max(range(len(levels)), key=lambda i: levels[i])
+    f0, f1, z0, z1 = track.f_hz[lo], track.f_hz[hi], track.zeta[lo], track.zeta[hi]
+    moves = {"softening": f"softens by {100 * (1 - f1 / f0):.2g} %",
+             "hardening": f"stiffens by {100 * (f1 / f0 - 1):.2g} %", "none": "keeps its frequency"}[track.trend]
+    ratio = z1 / z0
+    rises = f"rises {ratio:.2g}x" if ratio >= 1.5 else f"rises by {100 * (ratio - 1):.2g} %"
+    damping = {"rising": f"its damping {rises}", "falling": f"its damping falls by {100 * (1 - ratio):.2g} %",
+               "none": "its damping stays within its uncertainty"}[track.damping_trend]
+    return f"the {f0:.3g} Hz resonance {moves} and {damping}"
+
+
+def _bands(tracks) -> list:
+    """[lo, hi] over each track's frequencies widened by its half-power half-widths; overlaps merged."""
+    spans = sorted([min(f * (1 - z) for f, z in zip(t.f_hz, t.zeta)),
+                    max(f * (1 + z) for f, z in zip(t.f_hz, t.zeta))] for t in tracks)
+    out: list = []
+    for a, b in spans:
+        if out and a <= out[-1][1]:
+            out[-1][1] = max(out[-1][1], b)
+        else:
+            out.append([float(a), float(b)])
+    return out
