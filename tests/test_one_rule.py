@@ -117,3 +117,16 @@ def test_one_time_model_protocol_for_every_recorder():
         text = (SRC / path).read_text()
         assert ".respond(" in text, path
         assert "integrate(" not in text and "irfft(h" not in text, f"{path} simulates the rig itself"
+
+
+def test_the_excitation_is_read_at_one_door():
+    """`detect_excitation` runs in one place, `satmd.signal.excitation.received` (issue 48): every other step
+    reads the excitation the recording carries (`excitation_of`), so the FRF and every test agree on it."""
+    import ast
+
+    callers = []
+    for path in SRC.rglob("*.py"):
+        for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+            if isinstance(node, ast.Call) and getattr(node.func, "id", getattr(node.func, "attr", None)) == "detect_excitation":
+                callers.append(str(path.relative_to(SRC)))
+    assert callers == ["signal/excitation.py"], callers

@@ -17,19 +17,16 @@ def add_recording_options(parser: argparse.ArgumentParser):
 def load_recording_args(args, path):
     """A time recording with --map and --fs applied and its excitation read (--excitation, --period-s)."""
     from ..io import load_recording
-    from ..signal.excitation import detect_excitation, with_excitation
+    from ..signal.excitation import received
 
     from ..errors import SatmdError
 
     try:
         rec = load_recording(path, channel_map=getattr(args, "map", None), fs_hz=getattr(args, "fs", None))
-        if "force" not in rec.channels:
-            return rec
-        exc = detect_excitation(rec, getattr(args, "excitation", "auto") or "auto", getattr(args, "period_s", None))
+        return received(rec, getattr(args, "excitation", "auto") or "auto", getattr(args, "period_s", None))
     except SatmdError as err:
         text = as_typed(str(err))
         raise SatmdError(text if str(path) in text else f"{path}: {text}") from None
-    return with_excitation(rec, exc)
 
 
 #: the library's names for what the command line calls its options

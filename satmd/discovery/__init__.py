@@ -101,10 +101,10 @@ def discover(
     recording = data if isinstance(data, Recording) else None
     if recording is not None:
         from ..signal.estimate import estimate_frf
-        from ..signal.excitation import detect_excitation, with_excitation
+        from ..signal.excitation import received
 
         # the excitation is read once and travels with the recording: the FRF and the linearity test agree
-        recording = data = with_excitation(data, detect_excitation(data))
+        recording = data = received(data)
         data = estimate_frf(data, band_hz=band_hz)
     elif band_hz is not None:
         data = data.band(*band_hz)
@@ -122,12 +122,10 @@ def discover(
 
 def _with_excitation(part):
     """A recording with its excitation read (FRFData as it is)."""
-    from ..signal.excitation import detect_excitation, with_excitation
+    from ..signal.excitation import received
     from ..io.recording import Recording
 
-    if isinstance(part, Recording) and "force" in part.channels:
-        return with_excitation(part, detect_excitation(part))
-    return part
+    return received(part) if isinstance(part, Recording) else part
 
 
 def _discover_one(data, kwargs):

@@ -79,13 +79,13 @@ def estimate_frf(recording: Recording, nperseg: int | None = None, window=None, 
         With ``std``, ``coherence`` and ``estimator`` (method, settings,
         ``noise_dof``, and ``measurement`` findings, see `satmd.signal.chain`).
     """
-    from .excitation import detect_excitation
+    from .excitation import excitation_of, received
 
     check_data(recording, "recording", (Recording,), "estimate_frf", hint=LOAD_HINT)
     band_hz = renamed_keyword(band, band_hz, "estimate_frf")
     source, responses = _check_force(recording)
     welch_given = any(v is not None for v in (nperseg, window, overlap))
-    exc = detect_excitation(recording, excitation, period_s)
+    exc = excitation_of(received(recording, excitation, period_s))
     designed = exc.kind in ("periodic", "impact")
     if exc.kind == "sweep":  # whole transients in the record: no leakage term, however fast the sweep
         from .sweepfrf import at_rest_at_the_end

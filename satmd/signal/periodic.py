@@ -11,12 +11,19 @@ steady periods,
 - the lines the force does not excite hold no FRF: nothing is divided by the
   noise there (they are the detection lines of the distortion test,
   `satmd.discovery.nonlinear.periodic`).
+
+With M random-phase realisations of P periods each (`multisine_bla`; Pintelon & Schoukens ch. 3-4),
+per realisation the mean over periods is the FRF ``G_r(k)`` and the spread over periods its noise
+variance (noise is not periodic; the distortion is); the best linear approximation (BLA) is the mean
+over realisations, and the spread of ``G_r`` over realisations holds noise *and* the stochastic
+nonlinear distortion, so ``var_nl = var_total − var_noise`` (M ≥ 2, P ≥ 2). `multisine_frf` gives a
+multisine recording's BLA as FRFData; `multisine_arrays` its (M, P, N) periods.
 """
 from __future__ import annotations
 
 import numpy as np
 
-from ..conventions import RECORDING_CHANNELS, TINY
+from ..conventions import ACCEL_CHANNELS, RECORDING_CHANNELS, TINY
 from ..errors import DataError
 from .chain import MeasurementFinding
 
@@ -100,3 +107,105 @@ def excitation_findings(excitation) -> list[MeasurementFinding]:
 
 
 __all__ = ["excitation_findings", "periodic_frf", "periodic_spectra"]
+
+
+# --- several realisations: the best linear approximation (moved from discovery, issue 48) ----------------
+def periodic_blocks(x, period: int, periods: int | None = None, skip: int = 1) -> np.ndarray:
+    """(P, period) blocks of a periodic record, dropping the first ``skip`` periods (transient).
+
+    Parameters
+    ----------
+    x : (n,) samples; n a multiple of ``period`` (the rest is dropped)
+    period : samples per period
+    periods : use at most this many periods
+    skip : leading periods to drop
+
+    Returns
+    -------
+    ndarray (P, period)
+    """
+    x = np.asarray(x, float)
+    p = x.size // period
+    blocks = x[: p * period].reshape(p, period)[skip:]
+    return blocks if periods is None else blocks[:periods]
+
+
+def multisine_bla(u, y, lines, fs_hz: float) -> dict:
+    """Best linear approximation with its noise and nonlinear variances apart (see the module docstring).
+
+    Parameters
+    ----------
+    u, y : (M, P, N) input and output periods (M realisations, P periods, N samples)
+    lines : excited DFT lines of one period
+    fs_hz : sample rate
+
+    Returns
+    -------
+    dict
+        ``freq_hz``, ``bla`` (complex), ``var_noise`` and ``var_total`` of the BLA
+        (per line; ``var_total`` NaN when M = 1), ``var_nl`` (≥ 0 where
+        measurable), ``std`` (per Re/Im part of the BLA), ``M``, ``P``.
+    """
+    u, y = np.asarray(u, float), np.asarray(y, float)
+    if u.ndim == 2:
+        u, y = u[None], y[None]
+    M, P, N = u.shape
+    lines = np.asarray(lines, int)
+    U = np.fft.rfft(u, axis=2)[..., lines]
+    Y = np.fft.rfft(y, axis=2)[..., lines]
+    G = Y / U  # (M, P, L)
+    Gr = G.mean(axis=1)
+    var_noise_r = G.var(axis=1, ddof=1) / P if P > 1 else np.full(Gr.shape, np.nan)
+    bla = Gr.mean(axis=0)
+    var_noise = np.nanmean(var_noise_r, axis=0) / M
+    var_total = Gr.var(axis=0, ddof=1) / M if M > 1 else np.full(bla.shape, np.nan)
+    var_nl = np.maximum(var_total - var_noise, 0.0)
+    best = np.where(np.isfinite(var_total), var_total, var_noise)
+    return {"freq_hz": lines * fs_hz / N, "bla": bla, "var_noise": var_noise, "var_total": var_total,
+            "var_nl": var_nl, "std": np.sqrt(best / 2.0), "M": M, "P": P}
+
+
+def is_multisine(recording) -> bool:
+    """True for a periodic multisine recording that says its layout (``period_samples``, ``lines`` in meta)."""
+    meta = getattr(recording, "meta", {}) or {}
+    return "period_samples" in meta and "lines" in meta
+
+
+def multisine_arrays(recording):
+    """(u, {channel: y}, lines): (M, P, N) steady-state periods of a multisine recording (transient dropped)."""
+    meta = recording.meta
+    n = int(meta["period_samples"])
+    per = int(meta.get("periods", recording.n_samples // n))
+    m = int(meta.get("realisations", 1))
+    skip = int(meta.get("transient_periods", 1 if per > 1 else 0))
+    lines = np.array([int(k) for k in str(meta["lines"]).split(",") if k.strip()])
+
+    steady = [int(i) for i in str(meta.get("steady_periods", "")).split(",") if i.strip()]
+
+    def shape(x):
+        blocks = np.asarray(x, float)[: m * per * n].reshape(m, per, n)
+        return blocks[:, steady] if steady and m == 1 else blocks[:, skip:]
+
+    outs = {ch: shape(recording[c]) for c, ch in zip(("acc1", "acc2"), ACCEL_CHANNELS) if c in recording.channels}
+    if not outs:
+        outs = {c: shape(recording[c]) for c in recording.channels if c != "force"}
+    return shape(recording["force"]), outs, lines
+
+
+def multisine_frf(recording):
+    """FRFData: the best linear approximation of a multisine recording, std from noise + distortion."""
+    from ..io.frfdata import FRFData
+
+    u, outs, lines = multisine_arrays(recording)
+    chans, std, info = {}, {}, {}
+    for c, y in outs.items():
+        b = multisine_bla(u, y, lines, recording.fs_hz)
+        chans[c], std[c] = b["bla"], b["std"]
+        share = b["var_nl"] / np.maximum(b["var_total"], TINY)
+        if np.isfinite(share).any():  # one realisation holds no estimate of the distortion's variance
+            info[f"var_nl/var_total {c}"] = float(np.nanmedian(share))
+    meta = {"estimator": "multisine_bla", "realisations": str(u.shape[0]), "periods": str(u.shape[1])}
+    meta.update({k: f"{v:.3g}" for k, v in info.items()})
+    if "force_rms" in recording.meta:
+        meta["force_rms"] = recording.meta["force_rms"]
+    return FRFData(b["freq_hz"], chans, std, meta)

@@ -9,7 +9,8 @@ from satmd.conventions import ACCEL_CHANNELS
 from satmd.discovery.nonlinear.distortion import NonlinearReport, distortion_test
 from satmd.discovery.nonlinear.findings import analyse_frfs, analyse_recordings
 from satmd.discovery.nonlinear.naming import element_for
-from satmd.discovery.nonlinear.periodic import detection_lines_test, multisine_bla, one_mode_fit
+from satmd.discovery.nonlinear.periodic import detection_lines_test, one_mode_fit
+from satmd.signal.periodic import multisine_bla
 from satmd.discovery.nonlinear.stats import band_scan, distortion_regressors, level_dependence, linearity_test
 from satmd.physics import Rig
 from satmd.physics.nonlinear import element

@@ -46,7 +46,8 @@ def test_snls_splits_arrow_and_multisine():
 
 @needs_data
 def test_lowest_and_highest_level_show_hardening_at_the_resonance():
-    from satmd.discovery.nonlinear.periodic import multisine_bla, one_mode_fit, periodic_blocks
+    from satmd.discovery.nonlinear.periodic import one_mode_fit
+    from satmd.signal.periodic import multisine_bla, periodic_blocks
     from satmd.discovery.nonlinear.stats import level_dependence
 
     frfs, stds, fn = [], [], []

@@ -33,19 +33,13 @@ from .distortion import (
     EXPERIMENT_MULTISINE,
     UNEXPLAINED_NL,
     NonlinearReport,
-    common_frfs,
     concentrated_bands,
     distortion_test,
-    is_multisine,
     linear_prediction,
-    multisine_arrays,
-    multisine_frf,
     multisine_test,
-    on_common_grid,
     strongest_regressor,
 )
 from .stats import NonlinearTest
 
-__all__ = ["NonlinearReport", "NonlinearTest", "distortion_test", "multisine_test", "is_multisine", "multisine_arrays",
-           "multisine_frf", "linear_prediction", "strongest_regressor", "common_frfs", "on_common_grid",
-           "concentrated_bands", "UNEXPLAINED_NL", "EXPERIMENT_LEVEL", "EXPERIMENT_MULTISINE"]
+__all__ = ["NonlinearReport", "NonlinearTest", "distortion_test", "multisine_test", "linear_prediction",
+           "strongest_regressor", "concentrated_bands", "UNEXPLAINED_NL", "EXPERIMENT_LEVEL", "EXPERIMENT_MULTISINE"]

@@ -10,7 +10,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ...conventions import ACCEL_CHANNELS, TINY
+from ...conventions import ACCEL_CHANNELS
+from ...signal.periodic import multisine_arrays
 from .stats import (
     NonlinearTest,
     distortion_regressors,
@@ -95,10 +96,10 @@ def distortion_test(recording, band_hz=None, alpha: float = 1e-3, band=None) -> 
     NonlinearTest
     """
     from ...errors import DataError, renamed_keyword
-    from ...signal.excitation import detect_excitation
+    from ...signal.excitation import excitation_of
     from ...signal.lpm import excited_band
 
-    kind = detect_excitation(recording).kind
+    kind = excitation_of(recording).kind
     if kind in ("impact", "sweep"):  # the local regressors need a broadband force at every moment
         raise DataError(f"the distortion test needs a random or periodic force; a{'n' if kind == 'impact' else ''} "
                         f"{kind} record cannot be tested for distortion (record two levels apart to see level "
@@ -133,33 +134,6 @@ def distortion_test(recording, band_hz=None, alpha: float = 1e-3, band=None) -> 
     return linearity_test(x, responses, fs, regs, band_hz=band_hz, alpha=alpha)
 
 
-def is_multisine(recording) -> bool:
-    """True for a periodic multisine recording that says its layout (``period_samples``, ``lines`` in meta)."""
-    meta = getattr(recording, "meta", {}) or {}
-    return "period_samples" in meta and "lines" in meta
-
-
-def multisine_arrays(recording):
-    """(u, {channel: y}, lines): (M, P, N) steady-state periods of a multisine recording (transient dropped)."""
-    meta = recording.meta
-    n = int(meta["period_samples"])
-    per = int(meta.get("periods", recording.n_samples // n))
-    m = int(meta.get("realisations", 1))
-    skip = int(meta.get("transient_periods", 1 if per > 1 else 0))
-    lines = np.array([int(k) for k in str(meta["lines"]).split(",") if k.strip()])
-
-    steady = [int(i) for i in str(meta.get("steady_periods", "")).split(",") if i.strip()]
-
-    def shape(x):
-        blocks = np.asarray(x, float)[: m * per * n].reshape(m, per, n)
-        return blocks[:, steady] if steady and m == 1 else blocks[:, skip:]
-
-    outs = {ch: shape(recording[c]) for c, ch in zip(("acc1", "acc2"), ACCEL_CHANNELS) if c in recording.channels}
-    if not outs:
-        outs = {c: shape(recording[c]) for c in recording.channels if c != "force"}
-    return shape(recording["force"]), outs, lines
-
-
 def multisine_test(recording, alpha: float = 1e-3) -> NonlinearTest:
     """Detection-line test of a multisine recording, every output channel (Bonferroni over them).
 
@@ -189,26 +163,6 @@ def multisine_test(recording, alpha: float = 1e-3) -> NonlinearTest:
     return NonlinearTest("distortion_lines", p, worst.bands_hz, alpha, details)
 
 
-def multisine_frf(recording):
-    """FRFData: the best linear approximation of a multisine recording, std from noise + distortion."""
-    from ...io.frfdata import FRFData
-    from .periodic import multisine_bla
-
-    u, outs, lines = multisine_arrays(recording)
-    chans, std, info = {}, {}, {}
-    for c, y in outs.items():
-        b = multisine_bla(u, y, lines, recording.fs_hz)
-        chans[c], std[c] = b["bla"], b["std"]
-        share = b["var_nl"] / np.maximum(b["var_total"], TINY)
-        if np.isfinite(share).any():  # one realisation holds no estimate of the distortion's variance
-            info[f"var_nl/var_total {c}"] = float(np.nanmedian(share))
-    meta = {"estimator": "multisine_bla", "realisations": str(u.shape[0]), "periods": str(u.shape[1])}
-    meta.update({k: f"{v:.3g}" for k, v in info.items()})
-    if "force_rms" in recording.meta:
-        meta["force_rms"] = recording.meta["force_rms"]
-    return FRFData(b["freq_hz"], chans, std, meta)
-
-
 def linear_prediction(recording, band_hz) -> dict:
     """The accelerations the best linear approximation predicts from the force alone (LPM FRF x force spectrum).
 
@@ -235,85 +189,6 @@ def strongest_regressor(test: NonlinearTest) -> str | None:
     """The regressor group that explains most of the distortion (a hint, not a name)."""
     regs = test.details.get("regressors") or []
     return regs[0] if regs else None
-
-
-# --- FRFs of several recordings on one grid ---------------------------------------------------------------
-def common_frfs(recordings) -> list:
-    """LPM FRFs of several recordings on one frequency grid (same band and window width).
-
-    Parameters
-    ----------
-    recordings : list of Recording (same sample rate and length give the same grid)
-
-    Returns
-    -------
-    list of FRFData
-    """
-    from ...signal.estimate import estimate_frf
-    from ...signal.lpm import excited_band
-
-    if all(is_multisine(r) and (int(r.meta.get("realisations", 1)) > 1
-                                or not {"acc1", "acc2"} & set(r.channels)) for r in recordings):
-        return [multisine_frf(r) for r in recordings]  # several realisations in each file, or a generic output
-    if all(is_multisine(r) for r in recordings):  # periodic: the estimator of the excitation, at its lines
-        return [estimate_frf(r) for r in recordings]
-    bands = [excited_band(r["force"], r.fs_hz)[:2] for r in recordings]
-    band = (max(b[0] for b in bands), min(b[1] for b in bands))
-    first = estimate_frf(recordings[0], band_hz=band)
-    width = first.estimator.get("window_hz") or first.estimator.get("settings", {}).get("window_hz")
-    out = [first] + [estimate_frf(r, band_hz=band, width_hz=width) for r in recordings[1:]]  # the first: as is
-    return [_with_model_error(d, r, band, width) if d.estimator.get("method") == "lpm" else d
-            for d, r in zip(out, recordings)]
-
-
-def _with_model_error(data, recording, band_hz, width):
-    """Attach the local-polynomial model error (degree 2 vs 3 on the same windows) as ``meta['model_error']``."""
-    from dataclasses import replace
-
-    from ...signal.lpm import lpm
-
-    try:
-        e2 = lpm(recording, band_hz=band_hz, width_hz=width, degree=2)
-        e3 = lpm(recording, band_hz=band_hz, width_hz=width, degree=3)
-    except Exception:  # noqa: BLE001 - too few bins for degree 3: no model-error estimate
-        return data
-    if e2.freq_hz.shape != e3.freq_hz.shape or not np.allclose(e2.freq_hz, e3.freq_hz):
-        return data
-    # the difference is bias + noise (nested fits: its noise variance is var3 - var2); keep what stands out
-    err = {c: np.maximum(np.abs(e2.frf[c] - e3.frf[c])
-                         - 3.0 * np.sqrt(2.0 * np.maximum(e3.std[c] ** 2 - e2.std[c] ** 2, 0.0)), 0.0) for c in e2.frf}
-    j = np.searchsorted(e2.freq_hz, data.freq_hz)
-    ok = bool(np.all(j < e2.freq_hz.size)) and np.allclose(e2.freq_hz[np.clip(j, 0, e2.freq_hz.size - 1)],
-                                                           data.freq_hz)
-    if not ok:
-        return data
-    return replace(data, meta=dict(data.meta, model_error={c: v[j] for c, v in err.items()}))
-
-
-def on_common_grid(datas):
-    """Restrict FRFData to the frequencies all of them share (to 1e-9 relative); None if they share < 4."""
-    freq = datas[0].freq_hz
-    keep = np.ones(freq.size, bool)
-    for d in datas[1:]:
-        j = np.searchsorted(d.freq_hz, freq)
-        j = np.clip(j, 0, d.freq_hz.size - 1)
-        ok = np.abs(d.freq_hz[j] - freq) <= 1e-9 * np.maximum(freq, 1.0)
-        keep &= ok
-    if keep.sum() < 4:
-        return None
-    f_keep = freq[keep]
-    return f_keep, [_take(d, f_keep) for d in datas]
-
-
-def _take(d, freqs):
-    """FRFData rows at the given frequencies."""
-    from dataclasses import replace
-
-    j = np.searchsorted(d.freq_hz, freqs)
-    meta = dict(d.meta)
-    if isinstance(meta.get("model_error"), dict):
-        meta["model_error"] = {c: v[j] for c, v in meta["model_error"].items()}
-    return replace(d.take(j), meta=meta)
 
 
 def concentrated_bands(test: NonlinearTest, share: float = 0.25, smooth: int = 7) -> list:

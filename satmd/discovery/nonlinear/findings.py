@@ -17,13 +17,12 @@ from .distortion import (
     EXPERIMENT_MULTISINE,
     UNEXPLAINED_NL,
     NonlinearReport,
-    common_frfs,
     concentrated_bands,
     distortion_test,
-    is_multisine,
     multisine_test,
-    on_common_grid,
 )
+from ...signal.periodic import is_multisine
+from ...signal.several import common_frfs, on_common_grid
 from ..findings import NonlinearFinding
 from .stats import NonlinearTest, level_dependence
 
@@ -51,12 +50,12 @@ def force_levels(recordings) -> list:
 
 def _distortion_tests(recordings, alpha):
     """One distortion test per recording at level alpha / k (Bonferroni), with its bands located."""
-    from ...signal.excitation import detect_excitation
+    from ...signal.excitation import excitation_of
 
     k = len(recordings)
     tests = []
     for i, r in enumerate(recordings):
-        kind = detect_excitation(r).kind
+        kind = excitation_of(r).kind
         if kind in ("impact", "sweep") and not is_multisine(r):  # no broadband force at every moment: says so
             tests.append(NonlinearTest("distortion" if k == 1 else f"distortion#{i + 1}", 1.0, [], alpha / k,
                                        {"reason": f"a{'n' if kind == 'impact' else ''} {kind} record: the distortion "

@@ -23,52 +23,15 @@ this module does not import the package it serves.
 """
 from __future__ import annotations
 
-from ...conventions import TINY
-
 from dataclasses import replace
 
 import numpy as np
 
 from ...identification.adequacy import Reason
+from ...signal.several import common_frfs, is_forced_recording, on_common_grid, pooled, repeated_hits
 from .findings import analyse_recordings
 
 _UNEXPLAINED = "unexplained"
-
-
-def _is_recording(x) -> bool:
-    return hasattr(x, "fs_hz") and hasattr(x, "channels") and "force" in getattr(x, "channels", {})
-
-
-def pooled(datas):
-    """Inverse-variance mean of FRFData on one grid (std of the mean).
-
-    Periodic realisations (``estimator.method`` periodic, three or more) give
-    the best linear approximation: its std is the larger of the noise's and the
-    spread over realisations (noise and the stochastic nonlinear distortion,
-    Pintelon & Schoukens ch. 3), and ``estimator.nonlinear_variance_share``
-    says how much of that spread the noise does not explain.
-    """
-    first = datas[0]
-    k = len(datas)
-    realisations = k >= 3 and all(d.estimator.get("method") == "periodic" for d in datas)
-    chans, std, share = {}, {}, []
-    for c in first.channels:
-        w = np.stack([1.0 / np.maximum(d.std[c], TINY) ** 2 for d in datas])
-        H = np.stack([d.channels[c] for d in datas])
-        chans[c] = np.sum(w * H, axis=0) / w.sum(axis=0)
-        std[c] = 1.0 / np.sqrt(w.sum(axis=0))
-        if realisations:  # the spread over realisations: per part, of the mean
-            spread = np.sqrt(np.sum(np.abs(H - H.mean(axis=0)) ** 2, axis=0) / (k - 1) / k / 2.0)
-            share.append(float(np.median(np.maximum(spread ** 2 - std[c] ** 2, 0.0) / np.maximum(spread ** 2, TINY))))
-            std[c] = np.maximum(std[c], spread)
-    est = dict(first.estimator)
-    if "noise_dof" in est and est["noise_dof"]:
-        est["noise_dof"] = 2.0 * (k - 1) if realisations else float(est["noise_dof"]) * k
-    est["pooled_records"] = k
-    if realisations:
-        est["realisations"] = k
-        est["nonlinear_variance_share"] = round(max(share), 4)
-    return replace(first, channels=chans, std=std, correlation={}, estimator=est)
 
 
 def discover_recordings(items, linear, rig=None, free=None, alpha: float = 1e-3, **kwargs):
@@ -86,7 +49,6 @@ def discover_recordings(items, linear, rig=None, free=None, alpha: float = 1e-3,
         With ``nonlinear`` (SPEC §9).
     """
     from ...conventions import DEFAULT_FREE
-    from .distortion import common_frfs, on_common_grid
     from .findings import analyse_frfs
 
     free = tuple(free or DEFAULT_FREE)
@@ -94,7 +56,7 @@ def discover_recordings(items, linear, rig=None, free=None, alpha: float = 1e-3,
     hits = repeated_hits(items)
     if hits is not None:  # hits of one test are repeats, not levels: one FRF over all of them
         return linear(hits, rig=rig, free=free, alpha=alpha, **kwargs)
-    if all(_is_recording(x) for x in items):
+    if all(is_forced_recording(x) for x in items):
         unit: str | None = "N RMS"  # the levels are the recordings' force RMS
         datas = common_frfs(items)
         nl = analyse_recordings(items, rig, free, alpha, datas=datas)
@@ -144,42 +106,6 @@ def _stands_in(judged, moving, rig) -> bool:
     return getattr(at_rest(judged.name, rig or Rig()), "parameter", None) == moving
 
 
-#: Impact files whose median hit heights lie within this factor are repeats of one test, not levels.
-IMPACT_LEVEL_FACTOR = 3.0
-
-
-def repeated_hits(items):
-    """Impact recordings of one test joined end to end (one Recording), or None when they are not that.
-
-    Every item must be an impact recording at one sample rate with the same
-    channels, and their median hit heights within `IMPACT_LEVEL_FACTOR`
-    (farther apart they are levels, judged as such).
-    """
-    from ...signal.excitation import detect_excitation, with_excitation
-    from ...io.recording import Recording
-
-    if len(items) < 2 or not all(_is_recording(x) for x in items):
-        return None
-    excs = [detect_excitation(x) for x in items]
-    if any(e.kind != "impact" for e in excs) or len({x.fs_hz for x in items}) > 1:
-        return None
-    if len({tuple(sorted(x.channels)) for x in items}) > 1:
-        return None
-    heights = [float(np.median([abs(x["force"][p] - np.median(x["force"])) for _, p in e.hits]))
-               for x, e in zip(items, excs)]
-    if max(heights) > IMPACT_LEVEL_FACTOR * min(heights):
-        return None
-    from ...signal.sweepfrf import at_rest_at_the_end
-
-    joined = {c: np.concatenate([x[c] for x in items]) for c in items[0].channels}
-    meta = {"source": " + ".join(str(x.meta.get("source", "recording")) for x in items)}
-    responses = [c for c in ("acc1", "acc2") if c in items[0].channels]
-    if not all(at_rest_at_the_end(x, responses, strict=True) for x in items):  # a file cut mid-ring: no whole-record transient
-        meta["cut_mid_ring"] = "a file ends before its response has rung down"
-    rec = Recording(items[0].fs_hz, joined, dict(items[0].units), meta)
-    return with_excitation(rec, detect_excitation(rec, "impact"))
-
-
 def check_one(report, recording, alpha: float = 1e-3, rig=None, free=None):
     """Add the nonlinear block to the discovery of one recording; set linear effects aside when distorted.
 
@@ -194,7 +120,7 @@ def check_one(report, recording, alpha: float = 1e-3, rig=None, free=None):
     -------
     DiscoveryReport
     """
-    if not _is_recording(recording) or not any(c in recording.channels for c in ("acc1", "acc2")):
+    if not is_forced_recording(recording) or not any(c in recording.channels for c in ("acc1", "acc2")):
         return report
     from ...errors import DataError
 

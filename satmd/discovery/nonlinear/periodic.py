@@ -1,13 +1,9 @@
-"""Designed excitation: periodic multisines, the best linear approximation, and one-mode level fits.
+"""Designed excitation judged: the detection lines of a multisine, and one-mode level fits.
 
-Multisine records (Pintelon & Schoukens, *System Identification*, ch. 3-4).
-With M random-phase realisations of P periods each, at every excited line k:
+The estimates come from `satmd.signal.periodic` (the mean over periods, the best linear approximation
+over realisations and its noise and nonlinear variances, Pintelon & Schoukens ch. 3-4); here they are
+tested:
 
-- per realisation, the mean over periods is the FRF ``G_r(k)`` and the spread over
-  periods its noise variance (noise is not periodic; the distortion is);
-- the best linear approximation is the mean over realisations; the spread of
-  ``G_r`` over realisations holds noise *and* the stochastic nonlinear
-  distortion, so ``var_nl = var_total − var_noise`` (M ≥ 2, P ≥ 2);
 - at the detection lines (not excited: the odd ones left out of an odd
   multisine, every even one, the lines above the band) a linear system puts
   nothing but noise: ``P |mean_p Y(k)|² / σ²(k)`` is F(2, 2(P−1)) there, and
@@ -24,61 +20,6 @@ from ...conventions import TINY
 import numpy as np
 
 from .stats import NonlinearTest, chi2_score, band_scan
-
-
-def periodic_blocks(x, period: int, periods: int | None = None, skip: int = 1) -> np.ndarray:
-    """(P, period) blocks of a periodic record, dropping the first ``skip`` periods (transient).
-
-    Parameters
-    ----------
-    x : (n,) samples; n a multiple of ``period`` (the rest is dropped)
-    period : samples per period
-    periods : use at most this many periods
-    skip : leading periods to drop
-
-    Returns
-    -------
-    ndarray (P, period)
-    """
-    x = np.asarray(x, float)
-    p = x.size // period
-    blocks = x[: p * period].reshape(p, period)[skip:]
-    return blocks if periods is None else blocks[:periods]
-
-
-def multisine_bla(u, y, lines, fs_hz: float) -> dict:
-    """Best linear approximation with its noise and nonlinear variances apart (see the module docstring).
-
-    Parameters
-    ----------
-    u, y : (M, P, N) input and output periods (M realisations, P periods, N samples)
-    lines : excited DFT lines of one period
-    fs_hz : sample rate
-
-    Returns
-    -------
-    dict
-        ``freq_hz``, ``bla`` (complex), ``var_noise`` and ``var_total`` of the BLA
-        (per line; ``var_total`` NaN when M = 1), ``var_nl`` (≥ 0 where
-        measurable), ``std`` (per Re/Im part of the BLA), ``M``, ``P``.
-    """
-    u, y = np.asarray(u, float), np.asarray(y, float)
-    if u.ndim == 2:
-        u, y = u[None], y[None]
-    M, P, N = u.shape
-    lines = np.asarray(lines, int)
-    U = np.fft.rfft(u, axis=2)[..., lines]
-    Y = np.fft.rfft(y, axis=2)[..., lines]
-    G = Y / U  # (M, P, L)
-    Gr = G.mean(axis=1)
-    var_noise_r = G.var(axis=1, ddof=1) / P if P > 1 else np.full(Gr.shape, np.nan)
-    bla = Gr.mean(axis=0)
-    var_noise = np.nanmean(var_noise_r, axis=0) / M
-    var_total = Gr.var(axis=0, ddof=1) / M if M > 1 else np.full(bla.shape, np.nan)
-    var_nl = np.maximum(var_total - var_noise, 0.0)
-    best = np.where(np.isfinite(var_total), var_total, var_noise)
-    return {"freq_hz": lines * fs_hz / N, "bla": bla, "var_noise": var_noise, "var_total": var_total,
-            "var_nl": var_nl, "std": np.sqrt(best / 2.0), "M": M, "P": P}
 
 
 def detection_lines_test(u, y, lines, fs_hz: float, band_hz=None, alpha: float = 1e-3,

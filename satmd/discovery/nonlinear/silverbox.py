@@ -22,7 +22,8 @@ from ...numerics import force_level
 from ...io.recdata import Recording
 from ...io.silverbox import load_silverbox_level, load_silverbox_snls, silverbox_levels
 from .findings import analyse_generic
-from .periodic import detection_lines_test, multisine_bla, periodic_blocks
+from ...signal.periodic import multisine_bla, periodic_blocks
+from .periodic import detection_lines_test
 from .stats import NonlinearTest, band_scan, distortion_regressors, linearity_test
 
 

@@ -144,7 +144,8 @@ def test_a_periodic_chirps_weak_tails_are_not_detection_lines():
     from scipy.signal import chirp
 
     from satmd import discover
-    from satmd.discovery.nonlinear.distortion import multisine_arrays, multisine_test
+    from satmd.discovery.nonlinear.distortion import multisine_test
+    from satmd.signal.periodic import multisine_arrays
     from satmd.discovery.nonlinear.periodic import forced_lines
     from satmd.signal.excitation import with_excitation
 

@@ -1,0 +1,164 @@
+"""Several recordings of one structure: on one frequency grid, repeats of one test pooled into one FRF.
+
+- `common_frfs`: each recording's FRF on one grid (one band, one LPM window width), so that levels
+  can be compared line by line (`on_common_grid` keeps the frequencies they share);
+- `repeated_hits`: impact files of one test (hits of about one height) joined into one recording,
+  whose FRF is H1 over every hit;
+- `pooled`: the inverse-variance mean of FRFs on one grid; three or more periodic realisations give
+  the best linear approximation, with the spread over realisations in its std.
+"""
+from __future__ import annotations
+
+from dataclasses import replace
+
+import numpy as np
+
+from ..conventions import TINY
+from .periodic import is_multisine, multisine_frf
+
+
+def is_forced_recording(x) -> bool:
+    """A time recording with a force channel (not FRFData)."""
+    return hasattr(x, "fs_hz") and hasattr(x, "channels") and "force" in getattr(x, "channels", {})
+
+
+def pooled(datas):
+    """Inverse-variance mean of FRFData on one grid (std of the mean).
+
+    Periodic realisations (``estimator.method`` periodic, three or more) give
+    the best linear approximation: its std is the larger of the noise's and the
+    spread over realisations (noise and the stochastic nonlinear distortion,
+    Pintelon & Schoukens ch. 3), and ``estimator.nonlinear_variance_share``
+    says how much of that spread the noise does not explain.
+    """
+    first = datas[0]
+    k = len(datas)
+    realisations = k >= 3 and all(d.estimator.get("method") == "periodic" for d in datas)
+    chans, std, share = {}, {}, []
+    for c in first.channels:
+        w = np.stack([1.0 / np.maximum(d.std[c], TINY) ** 2 for d in datas])
+        H = np.stack([d.channels[c] for d in datas])
+        chans[c] = np.sum(w * H, axis=0) / w.sum(axis=0)
+        std[c] = 1.0 / np.sqrt(w.sum(axis=0))
+        if realisations:  # the spread over realisations: per part, of the mean
+            spread = np.sqrt(np.sum(np.abs(H - H.mean(axis=0)) ** 2, axis=0) / (k - 1) / k / 2.0)
+            share.append(float(np.median(np.maximum(spread ** 2 - std[c] ** 2, 0.0) / np.maximum(spread ** 2, TINY))))
+            std[c] = np.maximum(std[c], spread)
+    est = dict(first.estimator)
+    if "noise_dof" in est and est["noise_dof"]:
+        est["noise_dof"] = 2.0 * (k - 1) if realisations else float(est["noise_dof"]) * k
+    est["pooled_records"] = k
+    if realisations:
+        est["realisations"] = k
+        est["nonlinear_variance_share"] = round(max(share), 4)
+    return replace(first, channels=chans, std=std, correlation={}, estimator=est)
+
+#: Impact files whose median hit heights lie within this factor are repeats of one test, not levels.
+IMPACT_LEVEL_FACTOR = 3.0
+
+
+def repeated_hits(items):
+    """Impact recordings of one test joined end to end (one Recording), or None when they are not that.
+
+    Every item must be an impact recording at one sample rate with the same
+    channels, and their median hit heights within `IMPACT_LEVEL_FACTOR`
+    (farther apart they are levels, judged as such).
+    """
+    from .excitation import excitation_of, received
+    from ..io.recording import Recording
+
+    if len(items) < 2 or not all(is_forced_recording(x) for x in items):
+        return None
+    excs = [excitation_of(x) for x in items]
+    if any(e.kind != "impact" for e in excs) or len({x.fs_hz for x in items}) > 1:
+        return None
+    if len({tuple(sorted(x.channels)) for x in items}) > 1:
+        return None
+    heights = [float(np.median([abs(x["force"][p] - np.median(x["force"])) for _, p in e.hits]))
+               for x, e in zip(items, excs)]
+    if max(heights) > IMPACT_LEVEL_FACTOR * min(heights):
+        return None
+    from .sweepfrf import at_rest_at_the_end
+
+    joined = {c: np.concatenate([x[c] for x in items]) for c in items[0].channels}
+    meta = {"source": " + ".join(str(x.meta.get("source", "recording")) for x in items)}
+    responses = [c for c in ("acc1", "acc2") if c in items[0].channels]
+    if not all(at_rest_at_the_end(x, responses, strict=True) for x in items):  # a file cut mid-ring: no whole-record transient
+        meta["cut_mid_ring"] = "a file ends before its response has rung down"
+    rec = Recording(items[0].fs_hz, joined, dict(items[0].units), meta)
+    return received(rec, "impact")
+
+
+# --- FRFs of several recordings on one grid ---------------------------------------------------------------
+def common_frfs(recordings) -> list:
+    """LPM FRFs of several recordings on one frequency grid (same band and window width).
+
+    Parameters
+    ----------
+    recordings : list of Recording (same sample rate and length give the same grid)
+
+    Returns
+    -------
+    list of FRFData
+    """
+    from .estimate import estimate_frf
+    from .lpm import excited_band
+
+    if all(is_multisine(r) and (int(r.meta.get("realisations", 1)) > 1
+                                or not {"acc1", "acc2"} & set(r.channels)) for r in recordings):
+        return [multisine_frf(r) for r in recordings]  # several realisations in each file, or a generic output
+    if all(is_multisine(r) for r in recordings):  # periodic: the estimator of the excitation, at its lines
+        return [estimate_frf(r) for r in recordings]
+    bands = [excited_band(r["force"], r.fs_hz)[:2] for r in recordings]
+    band = (max(b[0] for b in bands), min(b[1] for b in bands))
+    first = estimate_frf(recordings[0], band_hz=band)
+    width = first.estimator.get("window_hz") or first.estimator.get("settings", {}).get("window_hz")
+    out = [first] + [estimate_frf(r, band_hz=band, width_hz=width) for r in recordings[1:]]  # the first: as is
+    return [_with_model_error(d, r, band, width) if d.estimator.get("method") == "lpm" else d
+            for d, r in zip(out, recordings)]
+
+
+def _with_model_error(data, recording, band_hz, width):
+    """Attach the local-polynomial model error (degree 2 vs 3 on the same windows) as ``meta['model_error']``."""
+    from .lpm import lpm
+
+    try:
+        e2 = lpm(recording, band_hz=band_hz, width_hz=width, degree=2)
+        e3 = lpm(recording, band_hz=band_hz, width_hz=width, degree=3)
+    except Exception:  # noqa: BLE001 - too few bins for degree 3: no model-error estimate
+        return data
+    if e2.freq_hz.shape != e3.freq_hz.shape or not np.allclose(e2.freq_hz, e3.freq_hz):
+        return data
+    # the difference is bias + noise (nested fits: its noise variance is var3 - var2); keep what stands out
+    err = {c: np.maximum(np.abs(e2.frf[c] - e3.frf[c])
+                         - 3.0 * np.sqrt(2.0 * np.maximum(e3.std[c] ** 2 - e2.std[c] ** 2, 0.0)), 0.0) for c in e2.frf}
+    j = np.searchsorted(e2.freq_hz, data.freq_hz)
+    ok = bool(np.all(j < e2.freq_hz.size)) and np.allclose(e2.freq_hz[np.clip(j, 0, e2.freq_hz.size - 1)],
+                                                           data.freq_hz)
+    if not ok:
+        return data
+    return replace(data, meta=dict(data.meta, model_error={c: v[j] for c, v in err.items()}))
+
+
+def on_common_grid(datas):
+    """Restrict FRFData to the frequencies all of them share (to 1e-9 relative); None if they share < 4."""
+    freq = datas[0].freq_hz
+    keep = np.ones(freq.size, bool)
+    for d in datas[1:]:
+        j = np.searchsorted(d.freq_hz, freq)
+        j = np.clip(j, 0, d.freq_hz.size - 1)
+        ok = np.abs(d.freq_hz[j] - freq) <= 1e-9 * np.maximum(freq, 1.0)
+        keep &= ok
+    if keep.sum() < 4:
+        return None
+    f_keep = freq[keep]
+    return f_keep, [_take(d, f_keep) for d in datas]
+
+
+def _take(d, freqs):
+    """FRFData rows at the given frequencies."""
+    j = np.searchsorted(d.freq_hz, freqs)
+    meta = dict(d.meta)
+    if isinstance(meta.get("model_error"), dict):
+        meta["model_error"] = {c: v[j] for c, v in meta["model_error"].items()}
+    return replace(d.take(j), meta=meta)
