@@ -529,3 +529,34 @@ def test_files_signals_and_simulators_live_apart():
     for name in MODULES:  # io never imports an estimator or a simulator
         if _package_of(name).startswith("satmd.io"):
             assert not [t for t in GRAPH[name] if _unit(t) in ("signal", "simulation")], name
+
+
+def _page_floors() -> dict:
+    """{package: floor} as docs/architecture.md draws them."""
+    import re
+
+    text = (ROOT.parent / "docs" / "architecture.md").read_text(encoding="utf-8")
+    block = text.split("```text", 1)[1].split("```", 1)[0]
+    floors, floor = {}, None
+    for line in block.splitlines():
+        m = re.match(r"\s*floor (\d+)\s+(.*)", line)
+        if m:
+            floor, rest = int(m.group(1)), m.group(2)
+        elif floor is not None and re.match(r"\s{11}\S", line):
+            rest = line.strip()
+        else:
+            continue
+        head = rest.split("  ")[0]  # the names before the description
+        for name in re.split(r"[, ]+", head.strip()):
+            if name and name in LAYERS:
+                floors[name] = floor
+    return floors
+
+
+def test_the_architecture_page_is_the_code():
+    """docs/architecture.md lists every top-level package on the floor `LAYERS` gives it."""
+    units = {_unit(m) for m in MODULES} - {"satmd", "__main__", "_progress", "_fleet"}
+    floors = _page_floors()
+    assert units <= set(floors), f"on no floor of docs/architecture.md: {sorted(units - set(floors))}"
+    wrong = {u: (floors[u], LAYERS[u]) for u in units if floors[u] != LAYERS[u]}
+    assert not wrong, f"page floor != code rank: {wrong}"
