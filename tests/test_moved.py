@@ -43,3 +43,30 @@ def test_the_public_names_did_not_move():
     from satmd.simulation import simulate
 
     assert satmd.estimate_frf is estimate_frf and satmd.simulate is simulate
+
+
+def test_satmd_itself_uses_no_moved_path():
+    """The aliases are for users' scripts: the package, tests, benchmarks and examples use the new paths."""
+    import ast
+    from pathlib import Path
+
+    root = Path(__file__).resolve().parents[1]
+    moved_names = {(pkg, n) for pkg, names in _moved.NAMES.items() for n in names}
+    bad = []
+    for folder in ("satmd", "tests", "benchmarks", "examples"):
+        for path in (root / folder).rglob("*.py"):
+            if path.name in ("_moved.py", "test_moved.py"):
+                continue
+            parts = path.relative_to(root).with_suffix("").parts
+            package = ".".join(parts[:-1] if parts[-1] == "__init__" else parts[:-1])
+            for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+                if isinstance(node, ast.ImportFrom):
+                    base = package.split(".")
+                    target = ".".join(base[:len(base) - node.level + 1] + ([node.module] if node.module else [])) \
+                        if node.level else node.module
+                    if target in _moved.MODULES or any((target, a.name) in moved_names for a in node.names):
+                        bad.append(f"{path.relative_to(root)}:{node.lineno}: from {target} import ...")
+                elif isinstance(node, ast.Import):
+                    bad += [f"{path.relative_to(root)}:{node.lineno}: import {a.name}" for a in node.names
+                            if a.name in _moved.MODULES]
+    assert not bad, "moved paths used (see satmd/_moved.py for the new ones):\n" + "\n".join(bad)

@@ -335,7 +335,8 @@ def load_data(args):
     A time recording is turned into FRFs with `satmd.signal.estimate_frf`'s
     defaults (a note on stderr says so; `satmd estimate-frf` gives control).
     """
-    from ..io import estimate_frf, is_recording, load_frf
+    from ..io import is_recording, load_frf
+    from ..signal import estimate_frf
 
     command = getattr(args, "command", None) or "satmd"
     if getattr(args, "plot", None):  # every output is checked before the first piece of work

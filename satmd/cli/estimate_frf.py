@@ -23,8 +23,10 @@ def register(sub):
                                    "over steady periods at the excited lines, for impacts H1 over hits (the "
                                    "excitation is detected, or given by --excitation); Welch H1/H2 on request. A "
                                    "recording without force (output-only) gives the transmissibility A2/A1 (Welch).")
-    p.add_argument("recording", metavar="REC", help="time recording (.csv time_s,force,acc1,acc2; .uff; .wav; "
-                                                    ".npz; .mat)")
+    p.add_argument("recordings", nargs="+", metavar="REC",
+                   help="time recording (.csv time_s,force,acc1,acc2; .uff; .wav; .npz; .mat); several files of one "
+                        "test (hits saved one per file, periodic realisations, repeats at one level) give one FRF: "
+                        "H1 over every hit, or the best linear approximation over the realisations")
     p.add_argument("-o", "--out", required=True, metavar="FRF.csv",
                    help="output: FRFs as .csv, .uff, .npz or .mat (coherence kept except in .csv); "
                         "a transmissibility as .csv")
@@ -54,14 +56,16 @@ def run(args):
     from ..io import WRITERS
 
     check_outputs([("-o", args.out, tuple(sorted(WRITERS))), ("--plot", args.plot, args.plot and plot_suffixes())],
-                  inputs=[args.recording])
+                  inputs=list(args.recordings))
     with all_or_none():  # the data file and the figure appear together or not at all
         return _run(args)
 
 
 def _run(args):
-    from ..io import FRFData, estimate_frf, load_recording, save_frf, save_transmissibility, transmissibility
+    from ..io import FRFData, load_recording, save_frf
+    from ..signal import estimate_frf, save_transmissibility, transmissibility
     from ..signal.estimate import describe_estimate
+    from ..signal.several import one_test
 
     scale = parse_kv(args.scale, "--scale") if args.scale else None
     band = parse_band(args.band)
@@ -74,19 +78,28 @@ def _run(args):
         raise SatmdError(f"{', '.join(given)}: Welch settings, they do not apply to --estimator lpm")
     out = Path(args.out)
     with one_line_warnings("estimate-frf"):
-        try:
-            rec = load_recording(args.recording, channel_map=args.map, scale=scale, fs_hz=args.fs)
-        except SatmdError as exc:
-            raise SatmdError(_as_typed(str(exc))) from None
+        recs = []
+        for path in args.recordings:
+            try:
+                recs.append(load_recording(path, channel_map=args.map, scale=scale, fs_hz=args.fs))
+            except SatmdError as exc:
+                raise SatmdError(_as_typed(str(exc))) from None
+        rec = recs[0]
+        args.recording = args.recordings[0] if len(recs) == 1 else " + ".join(args.recordings)
         options = dict(nperseg=args.nperseg, window=args.window, overlap=args.overlap, band_hz=band)
+        if len(recs) > 1 and not all(r.has_force for r in recs):
+            lacking = next(p for p, r in zip(args.recordings, recs) if not r.has_force)
+            raise SatmdError(f"{safe_text(lacking)}: no force channel; several files give one FRF of one test "
+                             "(a transmissibility is estimated from one output-only file)")
         if rec.has_force:
             overlay = [f"--{n}" for n in DEFAULT_FREE if getattr(args, n, None) is not None]
             if overlay:
                 raise SatmdError(f"{', '.join(overlay)}: the model overlay applies to the transmissibility of an "
                                  f"output-only recording; {safe_text(args.recording)} has a force")
             try:
-                data = estimate_frf(rec, estimator=args.estimator, width_hz=args.width, excitation=args.excitation,
-                                    period_s=args.period_s, **options)
+                settings = dict(estimator=args.estimator, width_hz=args.width, excitation=args.excitation,
+                                period_s=args.period_s, **options)
+                data = estimate_frf(rec, **settings) if len(recs) == 1 else one_test(recs, **settings)
             except SatmdError as exc:
                 text = _as_typed(str(exc))
                 where = safe_text(args.recording)
@@ -124,6 +137,10 @@ def _run(args):
     else:
         how = f"Welch {m['estimator']}, nperseg={m['nperseg']} ({m['resolution_hz']} Hz), {m['segments']} averages"
     median = float(np.median(np.concatenate(list(coh.values()))))
+    if isinstance(data, FRFData) and len(args.recordings) > 1:
+        est = data.estimator
+        how += (f", the best linear approximation over {est['realisations']} realisations (files)"
+                if est.get("realisations") else f", one FRF from {len(args.recordings)} files of one test")
     print(f"wrote {safe_text(out)}: {kind}, {len(freq)} points {freq[0]:.6g}..{freq[-1]:.6g} Hz, {how}, "
           f"median coherence {median:.3f}")
     low = {name: float(np.median(g)) for name, g in coh.items() if np.median(g) < LOW_COHERENCE}

@@ -124,7 +124,8 @@ def run(args):
 
 def run_time(args, rig, effects):
     """--time: a simulated recording (satmd.simulation.simulate_recording)."""
-    from ..io import save_recording, simulate_recording
+    from ..io import save_recording
+    from ..simulation import simulate_recording
 
     if args.plot:
         raise SatmdError("--plot does not apply with --time (plot the estimate: satmd estimate-frf REC --plot FIG.png)")

@@ -162,3 +162,68 @@ def _take(d, freqs):
     if isinstance(meta.get("model_error"), dict):
         meta["model_error"] = {c: v[j] for c, v in meta["model_error"].items()}
     return replace(d.take(j), meta=meta)
+
+
+#: Records whose force RMS differ by more than this factor are levels, not repeats of one test (a ground
+#: vibration test steps its level by √2 or more; repeats at one setting agree within a few per cent).
+REPEAT_LEVEL_FACTOR = 1.2
+
+
+def one_test(recordings, **options):
+    """One FRF from the files of one test: hits saved one per file, or periodic realisations, or repeats.
+
+    Impact files of one test are joined and give H1 over every hit (`repeated_hits`); other files are
+    estimated one by one with the same ``options`` and pooled on their shared lines (`pooled`: three or
+    more periodic realisations give the best linear approximation, its std from their spread).
+
+    Parameters
+    ----------
+    recordings : list of Recording with a ``force`` channel, one sample rate and one set of channels.
+    **options : `satmd.signal.estimate_frf`'s keywords, the same for every file.
+
+    Returns
+    -------
+    FRFData
+        With ``estimator["pooled_records"]`` (or the hits over every file) saying what was combined.
+
+    Raises
+    ------
+    DataError
+        Files that are not one test: other channels or sample rates, a file without force, impact files
+        at different heights, or records whose force levels differ by more than `REPEAT_LEVEL_FACTOR`
+        (levels of one structure are compared by `satmd.discover`, not averaged).
+    """
+    from ..errors import DataError
+    from ..numerics import force_level
+    from .estimate import estimate_frf
+
+    items = list(recordings)
+    names = [str(r.meta.get("source", f"recording {i + 1}")) for i, r in enumerate(items)]
+    for name, r in zip(names, items):
+        if not is_forced_recording(r):
+            raise DataError(f"{name}: no force channel; one FRF from several files needs the force in each")
+    if len(items) == 1:
+        return estimate_frf(items[0], **options)
+    first = items[0]
+    for name, r in zip(names[1:], items[1:]):
+        if sorted(r.channels) != sorted(first.channels):
+            raise DataError(f"{name}: channels {', '.join(sorted(r.channels))} differ from {names[0]}'s "
+                            f"({', '.join(sorted(first.channels))}): not one test")
+        if r.fs_hz != first.fs_hz:
+            raise DataError(f"{name}: sampled at {r.fs_hz:g} Hz, {names[0]} at {first.fs_hz:g} Hz: not one test")
+    joined = repeated_hits(items)
+    if joined is not None:
+        data = estimate_frf(joined, **options)
+        return replace(data, estimator=dict(data.estimator, pooled_records=len(items)))
+    levels = [force_level(r["force"]) for r in items]
+    if max(levels) > REPEAT_LEVEL_FACTOR * min(levels):
+        spread = ", ".join(f"{n} {v:.3g}" for n, v in zip(names, levels))
+        raise DataError(f"the files' force levels differ by more than {REPEAT_LEVEL_FACTOR:g}x (RMS: {spread}): "
+                        "they are levels, not repeats of one test; one FRF would average different linear "
+                        "approximations (judge the levels with `satmd discover FILE...`)")
+    datas = [estimate_frf(r, **options) for r in items]
+    grid = on_common_grid(datas)
+    if grid is None:
+        raise DataError("the files' FRFs share fewer than 4 frequencies (other lengths or bands): give records "
+                        "of one length and one band")
+    return pooled(grid[1])

@@ -111,7 +111,7 @@ def _simulate_time(rig, effects, noise, seed, meta, nonlinear, level, options):
         raise DataError("with time=True, noise is one number: sensor noise relative to each channel's RMS")
     excitation = options.get("excitation", "random")
     if not nonlinear and excitation in ("random", "sweep") and not {"periods", "realisations"} & set(options):
-        from ..io import simulate_recording
+        from .timesim import simulate_recording
 
         known = {"duration_s", "fs_hz", "band_hz", "excitation", "force_noise", "burn_in_s"}
         if set(options) - known:

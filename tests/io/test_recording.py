@@ -7,17 +7,9 @@ import numpy as np
 import pytest
 
 from satmd.errors import DataError, FormatError
-from satmd.io import (
-    DataWarning,
-    Recording,
-    default_nperseg,
-    estimate_frf,
-    load_recording,
-    model_transmissibility,
-    save_recording,
-    simulate_recording,
-    transmissibility,
-)
+from satmd.io import DataWarning, Recording, load_recording, save_recording
+from satmd.signal import default_nperseg, estimate_frf, model_transmissibility, transmissibility
+from satmd.simulation import simulate_recording
 from satmd.physics import Rig, effect, frf
 
 

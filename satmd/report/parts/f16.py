@@ -42,7 +42,8 @@ def build(ctx) -> str:
     import warnings
 
     from ...discovery import discover
-    from ...io import estimate_frf, load_recording
+    from ...io import load_recording
+    from ...signal import estimate_frf
 
     folder = data_dir()
     if folder is None:

@@ -38,7 +38,8 @@ def _row(label, rep):
 
 def build(ctx) -> str:
     from ...discovery import discover
-    from ...io import estimate_frf, simulate_recording
+    from ...signal import estimate_frf
+    from ...simulation import simulate_recording
     from ...signal.estimate import describe_estimate
     from ...physics import Rig, effect, frf
 
