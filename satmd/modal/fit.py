@@ -93,9 +93,13 @@ class ModalFit:
 
     def predict(self, freq_hz) -> dict:
         """The fitted model at ``freq_hz``: {channel: complex FRF}."""
-        w = 2 * np.pi * np.asarray(freq_hz, float)
-        C = _design(w, [m.pole for m in self.modes], _centre(self.band_hz))
+        C = self.basis(freq_hz)
         return {c: C @ self.coefficients[c] for c in self.channels}
+
+    def basis(self, freq_hz) -> np.ndarray:
+        """(M, K) complex columns of this fit's model at ``freq_hz``: any FRF on these poles (with the same
+        residual terms) is ``basis @ c`` for real coefficients c (`predict` uses the fitted ones)."""
+        return _design(2 * np.pi * np.asarray(freq_hz, float), [m.pole for m in self.modes], _centre(self.band_hz))
 
     def to_dict(self) -> dict:
         """band_hz, channels, chi2_reduced, weighted, modes."""

@@ -1,0 +1,204 @@
+"""`locate_joint`: between which two sensors (or a sensor and the ground) a joint acts, and its law.
+
+For recordings of one structure at several levels (periodic force, one period length, one set of
+channels), with the lowest level as the linear reference ``H_o = A_o / F`` (its best linear
+approximation), every higher level's change ``E_o = A_o − H_o F`` is, at each excited line and on every
+channel o, the response to the joint's force: ``E_o(ω) = Σ_j T_oj(ω) G_j(ω)``, where ``G_j`` are the
+spectra of the law's terms of the pair's relative motion (`satmd.structure.laws`) and ``T_oj`` are
+unknown transfer functions on the structure's own poles (fitted at the reference level by
+`satmd.modal.fit_modes`): linear in their residues, so each pair and law is one weighted linear
+least-squares fit, all levels at once (the nonlinear force as a feedback input: FNSI, Noël &
+Kerschen 2013, here in the frequency domain with the poles known). The transfer functions are left
+free, not built from the mode shapes: a sensor's column of the structure was never measured, and
+a mass-normalised guess of it would carry the modal fit's error into the ranking.
+
+Evidence: BIC = N ln(RSS/N) + p ln N per pair and law (rows weighted by each line's noise). A pair's
+evidence is its best law's; pairs are ranked by ΔBIC to the best, and those within `EQUIVALENT` are
+listed as equivalent places, never dropped. At the best pair the laws are ranked the same way; the
+``sparse`` library is named only when it beats every named law by more than `EQUIVALENT`.
+"""
+from __future__ import annotations
+
+import itertools
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..conventions import TINY
+from ..errors import DataError
+from .laws import LAWS
+from .spectra import PeriodicSpectra, periodic_spectra
+
+#: ΔBIC within which two places (or two laws) are equally supported (SPEC §11).
+EQUIVALENT = 10.0
+#: A line's noise std is floored at this share of the channel's median |spectrum| (no line weighs infinitely).
+NOISE_FLOOR = 1e-3
+
+
+@dataclass(frozen=True)
+class JointLocation:
+    """Where a joint acts and what it does, with the evidence for every place and law (SPEC §11).
+
+    Attributes
+    ----------
+    between : (a, b) the best pair (``b`` may be ``"ground"``)
+    location : [{"between": [a, b], "delta_bic": x, "law": name}, ...] every pair, best first
+    law : the law named at the best pair
+    laws : [{"law": name, "delta_bic": x}, ...] at the best pair, best first
+    equivalent_places, equivalent_laws : those within `EQUIVALENT` of the best (the best excluded)
+    evidence : BIC of "one linear structure at every level" (no joint) minus the best joint's: a joint is
+        ``detected`` when it is above `EQUIVALENT`
+    reference : the source of the level taken as linear; levels: force RMS of every recording
+    poles_hz : the structure's modes used (f in Hz, ζ)
+    """
+
+    between: tuple
+    location: list
+    law: str
+    laws: list
+    equivalent_places: list
+    equivalent_laws: list
+    reference: str
+    levels: list
+    poles_hz: list = field(default_factory=list)
+    evidence: float = 0.0
+
+    @property
+    def detected(self) -> bool:
+        """Whether a joint explains the change between levels better than noise does (ΔBIC > `EQUIVALENT`)."""
+        return self.evidence > EQUIVALENT
+
+    def to_dict(self) -> dict:
+        """The SPEC §11 fields: between, location, law, equivalent (laws), levels."""
+        return {"name": "joint", "detected": self.detected, "evidence_delta_bic": round(float(self.evidence), 1),
+                "between": list(self.between), "location": self.location, "law": self.law,
+                "equivalent": [{"law": e["law"], "delta_bic": e["delta_bic"]} for e in self.equivalent_laws],
+                "equivalent_places": self.equivalent_places, "reference": self.reference,
+                "levels": self.levels, "modes": [{"f_hz": f, "zeta": z} for f, z in self.poles_hz]}
+
+    def report(self) -> str:
+        """The verdict in words."""
+        a, b = self.between
+        if not self.detected:
+            return (f"no joint: one linear structure explains every level (the best place, {a} and {b}, gains "
+                    f"ΔBIC {self.evidence:.0f} over none)")
+        nxt = self.location[1] if len(self.location) > 1 else None
+        lines = [f"joint between {a} and {b}" + (f" (next: {' and '.join(nxt['between'])}, ΔBIC {nxt['delta_bic']:.0f})"
+                                                if nxt else ""),
+                 f"law: {self.law} ({LAWS[self.law].description})"]
+        if self.equivalent_places:
+            lines.append("equally supported places: " + "; ".join(" and ".join(e["between"]) for e in self.equivalent_places))
+        if self.equivalent_laws:
+            lines.append("equally supported laws: " + ", ".join(e["law"] for e in self.equivalent_laws))
+        return "\n".join(lines)
+
+
+def locate_joint(recordings, laws=None, band_hz=None, channels=None) -> JointLocation:
+    """Between which two sensors a joint acts and which law it follows, from recordings at several levels.
+
+    Parameters
+    ----------
+    recordings : two or more Recordings of one structure (a periodic force, one period length and sample
+        rate, the same channels); the lowest force level is the linear reference.
+    laws : law names to compare (default every law of `satmd.structure.laws.LAWS`)
+    band_hz : (lo, hi) Hz of the excited band to use (default all of it)
+    channels : the response channels (default every channel but the force)
+
+    Returns
+    -------
+    JointLocation
+
+    Raises
+    ------
+    DataError
+        Fewer than two recordings, a force that is not periodic, recordings of another design (period,
+        rate, channels), or fewer than two response channels.
+    """
+    from ..modal import fit_modes
+
+    items = [r if isinstance(r, PeriodicSpectra) else periodic_spectra(r) for r in recordings]
+    if len(items) < 2:
+        raise DataError("locating a joint needs recordings at two or more levels")
+    ref = min(items, key=lambda s: s.level)
+    names = list(channels or ref.responses)
+    for s in items:
+        if s.period_samples != ref.period_samples or s.fs_hz != ref.fs_hz:
+            raise DataError(f"{s.source}: period {s.period_samples} samples at {s.fs_hz:g} Hz, {ref.source}: "
+                            f"{ref.period_samples} at {ref.fs_hz:g} Hz; the levels of one test share one design")
+        missing = [c for c in names if c not in s.responses]
+        if missing:
+            raise DataError(f"{s.source}: no channel {', '.join(missing)} (the other levels have it)")
+    if len(names) < 2:
+        raise DataError("locating a joint between sensors needs two or more response channels")
+    common = np.intersect1d(ref.lines, np.intersect1d(*[s.lines for s in items[:2]]) if len(items) > 1 else ref.lines)
+    for s in items:
+        common = np.intersect1d(common, s.lines)
+    freq = common * ref.fs_hz / ref.period_samples
+    if band_hz is not None:
+        keep = (freq >= (band_hz[0] or 0.0)) & (freq <= (band_hz[1] or np.inf))
+        common, freq = common[keep], freq[keep]
+    if common.size < 8:
+        raise DataError(f"the levels share {common.size} excited lines; at least 8 are needed")
+    rows = {id(s): np.searchsorted(s.lines, common) for s in items}
+    H = {c: ref.responses[c][rows[id(ref)]] / ref.force[rows[id(ref)]] for c in names}
+    modal = fit_modes(freq, H, band_hz=(float(freq[0]), float(freq[-1])))
+    basis = modal.basis(freq)
+    others = [s for s in items if s is not ref]
+    places = [(a, b) for a, b in itertools.combinations(names, 2)] + [(a, "ground") for a in names]
+    chosen = [LAWS[n] for n in (laws or LAWS)]
+    bic = {(p, law_.name): _evidence(p, law_, others, ref, H, names, rows, basis) for p in places for law_ in chosen}
+    bic[None] = _evidence(None, None, others, ref, H, names, rows, basis)
+    return _verdict(bic, places, chosen, ref, items, modal)
+
+
+def _evidence(place, law_, others, ref, H, names, rows, basis) -> float:
+    """BIC of one place and law: every channel, every higher level, one weighted linear least-squares fit each
+    (``place`` None: no joint, the levels one linear structure)."""
+    G: dict = {id(s): [] for s in others}
+    if place is not None:
+        a, b = place
+        (da, va), (db, vb) = ref.motion(a), ref.motion(b)
+        d0, v0 = float(np.std(da - db)) or 1.0, float(np.std(va - vb)) or 1.0
+        for s in others:
+            (da, va), (db, vb) = s.motion(a), s.motion(b)
+            G[id(s)] = [s.at_lines(t)[rows[id(s)]] for t in law_.columns(da - db, va - vb, d0, v0)]
+    rss, n_rows, n_par = 0.0, 0, 0
+    for c in names:
+        X_parts, y_parts = [], []
+        for s in others:
+            k = rows[id(s)]
+            E = s.responses[c][k] - H[c] * s.force[k]
+            sd = np.full(k.size, np.mean(np.abs(s.responses[c][k])))
+            X = (np.hstack([basis * g[:, None] for g in G[id(s)]]) if G[id(s)] else np.zeros((k.size, 0))) / sd[:, None]
+            X_parts += [X.real, X.imag]
+            y_parts += [E.real / sd, E.imag / sd]
+        X, y = np.vstack(X_parts), np.concatenate(y_parts)
+        r = y - X @ np.linalg.lstsq(X, y, rcond=None)[0] if X.shape[1] else y
+        rss += float(r @ r)
+        n_rows += y.size
+        n_par += X.shape[1]
+    return n_rows * np.log(max(rss, TINY) / n_rows) + n_par * np.log(n_rows)
+
+
+def _verdict(bic, places, laws, ref, items, modal) -> JointLocation:
+    per_place = {p: min(((bic[(p, law_.name)], law_.name) for law_ in laws)) for p in places}
+    ranked = sorted(places, key=lambda p: (per_place[p][0], p))
+    best_bic = per_place[ranked[0]][0]
+    location = [{"between": list(p), "delta_bic": round(float(per_place[p][0] - best_bic), 1),
+                 "law": per_place[p][1]} for p in ranked]
+    at = ranked[0]
+    law_bic = sorted(((bic[(at, law_.name)], law_.name) for law_ in laws))
+    named = [x for x in law_bic if x[1] != "sparse"]
+    sparse = [x for x in law_bic if x[1] == "sparse"]
+    if named and not (sparse and sparse[0][0] < named[0][0] - EQUIVALENT):
+        chosen_bic, chosen = named[0]
+    else:
+        chosen_bic, chosen = law_bic[0]
+    laws_out = [{"law": n, "delta_bic": round(float(v - chosen_bic), 1)} for v, n in law_bic]
+    return JointLocation(
+        between=tuple(at), location=location, law=chosen, laws=laws_out,
+        equivalent_places=[e for e in location[1:] if e["delta_bic"] <= EQUIVALENT],
+        equivalent_laws=[e for e in laws_out if e["law"] != chosen and e["delta_bic"] <= EQUIVALENT],
+        reference=ref.source, levels=[round(float(s.level), 6) for s in items],
+        poles_hz=[(round(float(m.f_hz), 4), round(float(m.zeta), 5)) for m in modal.modes],
+        evidence=float(bic[None] - best_bic))

@@ -1,0 +1,103 @@
+"""The steady spectra of a periodic test of a structure, every channel, and two sensors' relative motion.
+
+A ground vibration test's multisine repeats; after the start-up transient every channel is periodic
+(plus noise), so each line's spectrum is the mean over the steady periods (`satmd.signal.periodic`'s
+estimator), and the spread over periods is its noise. Displacements come from the accelerations by
+dividing by -ω² at the lines the force excites (the band where the accelerometers carry the motion).
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..errors import DataError
+from ..numerics import force_level
+from ..signal.excitation import excitation_of, received
+
+
+@dataclass(frozen=True)
+class PeriodicSpectra:
+    """One periodic recording of a structure, at the lines its force excites.
+
+    Attributes
+    ----------
+    source : the recording's name
+    level : force RMS (N)
+    fs_hz, period_samples : sample rate and samples per period
+    lines : (K,) DFT lines of one period the force excites
+    force : (K,) complex mean spectrum of the force
+    responses : {channel: (K,) complex mean spectrum}
+    std : {channel: (K,) std of the mean's real and imaginary parts, from the spread over periods}
+    """
+
+    source: str
+    level: float
+    fs_hz: float
+    period_samples: int
+    lines: np.ndarray
+    force: np.ndarray
+    responses: dict
+    std: dict
+
+    @property
+    def freq_hz(self) -> np.ndarray:
+        return self.lines * self.fs_hz / self.period_samples
+
+    def motion(self, channel: str):
+        """(displacement, velocity) over one period of ``channel`` (zeros for ``"ground"``)."""
+        n = self.period_samples
+        if channel == "ground":
+            return np.zeros(n), np.zeros(n)
+        w = 2 * np.pi * self.freq_hz
+        X = np.zeros(n // 2 + 1, complex)
+        X[self.lines] = self.responses[channel] / -(w ** 2)
+        V = np.zeros(n // 2 + 1, complex)
+        V[self.lines] = self.responses[channel] / (1j * w)
+        return np.fft.irfft(X, n), np.fft.irfft(V, n)
+
+    def at_lines(self, x) -> np.ndarray:
+        """The spectrum of one period of ``x`` at the excited lines (the scaling of `force`)."""
+        return np.fft.rfft(np.asarray(x, float), self.period_samples)[self.lines]
+
+
+def periodic_spectra(recording) -> PeriodicSpectra:
+    """`PeriodicSpectra` of a recording whose force is periodic (a multisine, a periodic chirp, ...).
+
+    Parameters
+    ----------
+    recording : Recording with ``force`` and one or more response channels
+
+    Returns
+    -------
+    PeriodicSpectra
+
+    Raises
+    ------
+    DataError
+        A force that is not periodic, or fewer than two steady periods.
+    """
+    source = str(recording.meta.get("source", "recording"))
+    rec = received(recording)
+    exc = excitation_of(rec)
+    if exc.kind != "periodic":
+        raise DataError(f"{source}: the force is {exc.kind}, not periodic; locating a joint needs a periodic force "
+                        "(a multisine, as a ground vibration test uses) at every level")
+    n, steady = exc.period_samples, list(exc.steady)
+    lines = np.asarray(exc.lines, int)
+
+    def spectra(name):
+        x = np.asarray(rec[name], float)[: exc.periods * n].reshape(exc.periods, n)[steady]
+        return np.fft.rfft(x, axis=1)[:, lines]
+
+    force = spectra("force").mean(axis=0)
+    responses, std = {}, {}
+    for name in rec.channels:
+        if name == "force":
+            continue
+        Y = spectra(name)
+        responses[name] = Y.mean(axis=0)
+        std[name] = np.sqrt(np.var(Y, axis=0, ddof=1) / len(steady) / 2.0)
+    if not responses:
+        raise DataError(f"{source}: no response channel beside the force")
+    return PeriodicSpectra(source, force_level(rec["force"]), float(rec.fs_hz), int(n), lines, force, responses, std)

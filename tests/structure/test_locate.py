@@ -1,0 +1,82 @@
+"""Where a joint acts (issue 47, SPEC §11): ranked over every pair of sensors and the ground, on an independent
+chain and on the F-16 ground vibration test."""
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from satmd.errors import DataError
+from satmd.io import Recording
+from satmd.io.shared import real_data
+from satmd.structure import LAWS, locate_joint
+from satmd.structure.spectra import periodic_spectra
+from tests.conftest import needs_real
+from tests.structure.chain import simulate_chain
+
+
+@pytest.fixture(scope="module")
+def cubic_between_3_and_4():
+    return simulate_chain(joint=(2, 3), law=lambda d, v: 3e9 * d ** 3, seed=1)
+
+
+def test_a_cubic_joint_between_two_masses_is_placed_and_named(cubic_between_3_and_4):
+    loc = locate_joint(cubic_between_3_and_4)
+    assert loc.detected and loc.between == ("acc3", "acc4") and loc.law == "cubic"
+    assert loc.location[1]["delta_bic"] > 100  # the next place is far behind
+    assert {tuple(e["between"]) for e in loc.location} == {  # every pair and every sensor to the ground
+        *[(f"acc{i}", f"acc{j}") for i in range(1, 6) for j in range(i + 1, 6)], *[(f"acc{i}", "ground") for i in range(1, 6)]}
+    d = loc.to_dict()
+    assert d["name"] == "joint" and d["between"] == ["acc3", "acc4"] and d["location"][0]["delta_bic"] == 0.0
+
+
+def test_a_joint_to_the_ground_is_placed_there():
+    recs = simulate_chain(joint=(1, None), law=lambda d, v: 3e9 * d ** 3, levels=(1.0, 4.0), seed=2)
+    loc = locate_joint(recs)
+    assert loc.between == ("acc2", "ground")
+
+
+def test_a_friction_joint_is_placed(cubic_between_3_and_4):
+    recs = simulate_chain(joint=(3, 4), law=lambda d, v: 0.4 * np.tanh(v / 1e-3), seed=3)
+    assert locate_joint(recs).between == ("acc4", "acc5")
+
+
+def test_a_linear_structure_has_no_joint():
+    """No joint: the change between levels is noise; no place explains it better than none."""
+    for seed in (4, 5):
+        loc = locate_joint(simulate_chain(joint=(2, 3), law=lambda d, v: 0.0 * d, levels=(1.0, 4.0), seed=seed))
+        assert not loc.detected, loc.evidence
+        assert loc.report().startswith("no joint") and loc.to_dict()["detected"] is False
+
+
+def test_refusals_name_what_is_wrong(cubic_between_3_and_4):
+    low, high = cubic_between_3_and_4[0], cubic_between_3_and_4[2]
+    with pytest.raises(DataError, match="two or more levels"):
+        locate_joint([low])
+    fewer = Recording(low.fs_hz, {c: high[c] for c in ("force", "acc1", "acc2")}, meta={"source": "fewer.csv"})
+    with pytest.raises(DataError, match="fewer.csv: no channel acc3"):
+        locate_joint([low, fewer], channels=["acc1", "acc2", "acc3"])
+    noise = Recording(low.fs_hz, {"force": np.random.default_rng(0).standard_normal(low.n_samples),
+                                  "acc1": low["acc1"]}, meta={"source": "random.csv"})
+    with pytest.raises(DataError, match="random.csv: the force is random, not periodic"):
+        periodic_spectra(noise)
+    with pytest.raises(DataError, match="unknown joint law"):
+        from satmd.structure import law
+        law("glue")
+    assert set(LAWS) == {"cubic", "softening", "clearance", "friction", "quadratic_damping", "sparse"}
+
+
+@needs_real("f16", "F16Data_FullMSine_Level7.mat")
+def test_f16_joint_is_between_the_wing_and_the_payload():
+    """The F-16's nonlinear interface joins the wing (acc2) and the payload (acc3) (the benchmark's own
+    description): levels 1, 3, 5, 7, the lowest the linear reference."""
+    from scipy.io import loadmat
+
+    recs = []
+    for level in (1, 3, 5, 7):
+        d = loadmat(real_data("f16", f"F16Data_FullMSine_Level{level}.mat"))
+        acc = d["Acceleration"]
+        recs.append(Recording(float(np.ravel(d["Fs"])[0]), {"force": d["Force"].ravel(), "acc1": acc[0], "acc2": acc[1],
+                                                             "acc3": acc[2]}, meta={"source": f"level {level}"}))
+    loc = locate_joint(recs, band_hz=(2.5, 14.5))
+    assert loc.between == ("acc2", "acc3")
+    assert loc.location[1]["delta_bic"] > 1000
