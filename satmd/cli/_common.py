@@ -301,7 +301,8 @@ def add_data_options(parser: argparse.ArgumentParser):
     parser.add_argument("--band", default=None, metavar="LO:HI", help="use only LO <= f <= HI Hz")
     parser.add_argument("--map", default=None, metavar="a1=NODE:DIR,a2=NODE:DIR",
                         help="which record/column is which channel: UFF (a1=NODE:DIR or a1=#N), WAV (#N), .mat/.npz "
-                             "(force=Force,a1=Acceleration[2]: a variable or a row), a lab's CSV (a1=Acc wing)")
+                             "(force=Force,a1=Acceleration[2]: a variable or a row), a lab's CSV (a1=Acc wing); a recording "
+                             "takes a3, a4, ... too (FRFs use a1 and a2)")
     parser.add_argument("--freq-axis", default=None, metavar="START:STEP",
                         help="frequency axis in Hz for .txt files of complex values (one per line)")
     add_recording_options(parser)

@@ -7,7 +7,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..conventions import DEFAULT_FREE
+from ..conventions import DEFAULT_FREE, RECORDING_CHANNELS
 from ..errors import SatmdError
 from ..io.atomic import all_or_none
 from ._common import (add_recording_options, add_rig_options, check_outputs, integer, real, one_line_warnings, parse_band, parse_kv, plot_suffixes,
@@ -42,7 +42,7 @@ def register(sub):
     p.add_argument("--band", default=None, metavar="LO:HI", help="keep only LO <= f <= HI Hz")
     p.add_argument("--map", default=None, metavar="force=#1,a1=NODE:DIR,a2=#3",
                    help="which UFF records / WAV channels / .mat or .npz variables (Name or Name[row]) / CSV columns "
-                        "are force, a1 and a2")
+                        "are force, a1 and a2 (a3, a4, ... are read too; FRFs are estimated for a1 and a2)")
     add_recording_options(p)
     p.add_argument("--scale", default=None, metavar="force=K,acc1=K,...",
                    help="calibration of WAV channels: SI units per stored unit")
@@ -63,6 +63,7 @@ def run(args):
 
 def _run(args):
     from ..io import FRFData, load_recording, save_frf
+    from ..io.recdata import accelerometers
     from ..signal import estimate_frf, save_transmissibility, transmissibility
     from ..signal.estimate import describe_estimate
     from ..signal.several import one_test
@@ -91,6 +92,11 @@ def _run(args):
             lacking = next(p for p, r in zip(args.recordings, recs) if not r.has_force)
             raise SatmdError(f"{safe_text(lacking)}: no force channel; several files give one FRF of one test "
                              "(a transmissibility is estimated from one output-only file)")
+        others = [n for n in accelerometers(rec.channels) if n not in RECORDING_CHANNELS]
+        if others:  # read (satmd info lists them), but the rig's FRFs are A1 and A2
+            print(f"satmd estimate-frf: note: {', '.join(others)} not estimated: the FRFs are A1 = acc1/force and "
+                  f"A2 = acc2/force; map another accelerometer onto a1 or a2 (--map) to estimate its FRF",
+                  file=sys.stderr)
         if rec.has_force:
             overlay = [f"--{n}" for n in DEFAULT_FREE if getattr(args, n, None) is not None]
             if overlay:

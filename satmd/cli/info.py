@@ -5,7 +5,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..conventions import TINY
+from ..conventions import RECORDING_CHANNELS, TINY
 from ..errors import FormatError, SatmdError
 from ._common import one_line_warnings, safe_text
 
@@ -135,7 +135,9 @@ def _txt(path, freq_axis) -> list[str]:
 
 
 def recording_lines(rec, path, channel_map=None) -> list[str]:
+    """Lines on a time recording: every channel (unit, rms, peak, where it came from) and what satmd can do with it."""
     from ..io import clipped_channels
+    from ..io.recdata import accelerometers
 
     cmd = f"satmd estimate-frf {path}" + (f" --map {channel_map}" if channel_map else "")
     lines = [f"time recording: {len(rec.channels)} channel(s), {rec.fs_hz:.6g} Hz, {rec.n_samples} samples "
@@ -147,6 +149,10 @@ def recording_lines(rec, path, channel_map=None) -> list[str]:
                      + (f"  ({rec.labels[name]})" if name in rec.labels else ""))
     for name, count in clipped_channels(rec).items():
         lines.append(f"  clipped? {name}: {count} samples at its extremes")
+    others = [n for n in accelerometers(rec.channels) if n not in RECORDING_CHANNELS]
+    if others:  # read and listed above; the rig's FRFs are A1 and A2 only
+        lines.append(f"{', '.join(others)}: read; FRFs are estimated for acc1 and acc2 (map another accelerometer "
+                     f"onto a1 or a2 with --map to estimate its FRF)")
     if rec.has_force and ("acc1" in rec.channels or "acc2" in rec.channels):
         lines.append(f"force and responses present: estimate FRFs with `{cmd} -o FRF.csv`")
     elif "acc1" in rec.channels and "acc2" in rec.channels:

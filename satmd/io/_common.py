@@ -177,26 +177,38 @@ def parse_dof(text: str):
 
 
 def parse_channel_map(spec, allowed, aliases=None) -> dict:
-    """'a1=1:3,a2=#2' (or a dict) -> {'a1': ('dof', 1, 3), 'a2': ('index', 2, None)}."""
+    """'a1=1:3,a2=#2' (or a dict) -> {'a1': ('dof', 1, 3), 'a2': ('index', 2, None)}.
+
+    ``allowed`` is the channels a map may name, or a naming rule: a function
+    from a key to its channel that raises ValueError for a bad key (a
+    recording's roles, `recdata.role_of`: ``a3`` -> ``acc3`` for any N).
+    """
     aliases = aliases or {}
     items = spec.items() if isinstance(spec, dict) else (
         part.partition("=")[::2] for part in str(spec).split(",") if part.strip())
     out = {}
     for key, value in items:
-        key = aliases.get(key.strip(), key.strip())
-        if key not in allowed:
-            raise ValueError(f"channel_map: unknown channel {key!r} (use {', '.join(allowed)})")
+        entry = f"{str(key).strip()}={str(value).strip()}"
+        if callable(allowed):
+            try:
+                key = allowed(key)
+            except ValueError as exc:
+                raise ValueError(f"channel_map {entry}: {exc}") from None
+        else:
+            key = aliases.get(key.strip(), key.strip())
+            if key not in allowed:
+                raise ValueError(f"channel_map: unknown channel {key!r} (use {', '.join(allowed)})")
         if not str(value).strip():
             raise ValueError(f"channel_map: {key}= needs NODE:DIR or #RECORD")
         if key in out:
-            raise ValueError(f"channel_map: {key} given twice")
+            raise ValueError(f"channel_map {entry}: {key} given twice")
         try:
             out[key] = parse_dof(str(value))
         except ValueError as exc:
             raise ValueError(f"channel_map {key}={str(value).strip()}: {str(exc).split(': ', 1)[-1]}") from None
         same = [k for k, v in out.items() if k != key and _same_source(v, out[key])]
         if same:
-            raise ValueError(f"channel_map: {same[0]} and {key} both name {str(value).strip()} "
+            raise ValueError(f"channel_map {entry}: {same[0]} and {key} both name {str(value).strip()} "
                              "(one record or column cannot be two channels)")
     if not out:
         raise ValueError("channel_map is empty")
@@ -211,7 +223,7 @@ def _same_source(a, b) -> bool:
 
 
 def channel_map_of(path, spec, allowed, aliases=None) -> dict:
-    """`parse_channel_map` for a reader: a malformed map is a `FormatError` naming the file."""
+    """`parse_channel_map` for a reader: a malformed map is a one-line `FormatError` naming the file and the entry."""
     try:
         return parse_channel_map(spec, allowed, aliases)
     except ValueError as exc:

@@ -6,10 +6,9 @@ import re
 
 from ..errors import FormatError
 from ._common import numeric_table, parse_quantity_unit
-from .recdata import ROLES, SI_UNITS, Recording, uniform_rate, warn_clipping
+from .recdata import Recording, is_role, ordered, role_of, si_unit, uniform_rate, warn_clipping
 
 TIME_NAMES = ("time_s", "time", "t", "zeit", "temps")
-ALIASES = {"a1": "acc1", "a2": "acc2", "f": "force"}
 _UNIT = re.compile(r"^(?P<name>.*?)\s*[\[(](?P<unit>[^\])]*)[\])]\s*$")
 
 
@@ -60,21 +59,23 @@ def read_lab_csv(path, header, header_line, rows, meta, channel_map=None) -> Rec
             if not part.strip():
                 continue
             role, eq, column = part.partition("=")
-            role = ALIASES.get(role.strip().lower(), role.strip().lower())
-            if not eq or role not in ROLES:
-                raise FormatError(path, f"map {part.strip()!r}: write force=COLUMN, a1=COLUMN, a2=COLUMN")
+            if not eq:
+                raise FormatError(path, f"map {part.strip()!r}: write force=COLUMN, a1=COLUMN, a2=COLUMN, ...")
+            try:
+                role = role_of(role)
+            except ValueError as exc:
+                raise FormatError(path, f"map {part.strip()}: {exc}") from None
             found = lookup.get(column.strip().lower())
             if found is None:
                 raise FormatError(path, f"map {part.strip()}: no column {column.strip()!r}; columns: "
                                         f"{', '.join(header[1:])}")
             if role in roles or found in roles.values():
-                raise FormatError(path, f"map: {role} or column {column.strip()!r} given twice")
+                raise FormatError(path, f"map {part.strip()}: {role} or column {column.strip()!r} given twice")
             roles[role] = found
     else:
-        for role in ROLES:
-            if role in lookup:
-                roles[role] = lookup[role]
-        if not roles or ("acc1" not in roles and "acc2" not in roles and len(header) > len(roles) + 1):
+        for role in ordered(k for k in lookup if is_role(k)):  # force, acc1, acc2, ...: as the rig's were
+            roles[role] = lookup[role]
+        if not roles or (roles.keys() == {"force"} and len(header) > 2):
             raise FormatError(path, f"no column named acc1 or acc2 (columns: {', '.join(header[1:])}): say "
                                     f"which is which with a channel map, e.g. force={names[1][0]}"
                                     + (f",a1={names[2][0]}" if len(names) > 2 else ""), line=header_line)
@@ -91,7 +92,7 @@ def read_lab_csv(path, header, header_line, rows, meta, channel_map=None) -> Rec
     channels = {role: values[:, j] * _si_factor(path, header[j], role, names[j][1], header_line, j + 1)
                 for role, j in roles.items()}
     meta.update({"source": str(path), "format": "csv"})
-    rec = Recording(fs, channels, {n: SI_UNITS[n] for n in channels}, meta,
+    rec = Recording(fs, channels, {n: si_unit(n) for n in channels}, meta,
                     {n: f"column {j + 1} ({header[j]})" for n, j in roles.items()})
     warn_clipping(path, rec)
     return rec

@@ -1,10 +1,11 @@
 """Time recordings in .mat / .npz files as labs write them: their own names, matrices of signals, any rate variable.
 
-Signals are the variables ``force``, ``acc1``, ``acc2`` (any case), or as a
-channel map says (``"force=Force,a1=Acceleration[2],a2=Acceleration[3]"``: a
+Signals are the variables ``force``, ``acc1``, ``acc2``, ``acc3``, ... (any
+case), or as a channel map says
+(``"force=Force,a1=Acceleration[1],a2=Acceleration[2],a3=Acceleration[3]"``: a
 variable, or one row of a matrix of signals, counted from 1; the long axis of a
-matrix is time). The sample rate is given, or a variable (`FS_NAMES`, any
-case), or a uniform time vector (`TIME_NAMES`).
+matrix is time; any number of accelerometers ``a<N>``). The sample rate is
+given, or a variable (`FS_NAMES`, any case), or a uniform time vector (`TIME_NAMES`).
 """
 from __future__ import annotations
 
@@ -15,11 +16,11 @@ import numpy as np
 from ..errors import FormatError
 from .limits import check_samples
 from .matfile import load_variables, scalar_variable, vector_variable, warn_unused
+from .recdata import accelerometers, is_role, ordered, role_of
 
-RECORDING_NAMES = ("force", "acc1", "acc2")
+RECORDING_NAMES = ("force", "acc1", "acc2")  # the rig's; any acc<N> variable is read too (`recdata.is_role`)
 FS_NAMES = ("fs_hz", "fs", "sample_rate", "samplerate", "sampling_rate", "sampling_frequency", "srate", "sr")
 TIME_NAMES = ("time_s", "time", "t")
-ROLE_ALIASES = {"a1": "acc1", "a2": "acc2", "f": "force"}
 
 
 def _lookup(variables, name):
@@ -54,20 +55,26 @@ def _sample_rate(path, v, fs_hz):
                             f"give the sample rate (fs_hz)")
 
 
-def _signal(path, v, spec, role):
-    """One signal from ``Name`` or ``Name[i]`` (row or column i, from 1, of a matrix: the long axis is time)."""
+def _source(path, spec, role):
+    """``Name`` -> ('Name', None); ``Name[i]`` or ``Name(i)`` -> ('Name', i)."""
     spec = spec.strip()
-    name, index = spec, None
     for open_, close in (("[", "]"), ("(", ")")):
         if spec.endswith(close) and open_ in spec:
             name, _, rest = spec[:-1].partition(open_)
             try:
-                index = int(rest)
+                return name.strip(), int(rest)
             except ValueError:
                 raise FormatError(path, f"map {role}={spec}: {rest!r} is not a row number") from None
-    key = _lookup(v, name.strip())
+    return spec, None
+
+
+def _signal(path, v, spec, role):
+    """One signal from ``Name`` or ``Name[i]`` (row or column i, from 1, of a matrix: the long axis is time)."""
+    spec = spec.strip()
+    name, index = _source(path, spec, role)
+    key = _lookup(v, name)
     if key is None:
-        raise FormatError(path, f"map {role}={spec}: no variable {name.strip()!r}; found: "
+        raise FormatError(path, f"map {role}={spec}: no variable {name!r}; found: "
                                 f"{', '.join(sorted(v)) or 'nothing'}")
     a = np.asarray(v[key])
     if index is None:
@@ -82,20 +89,26 @@ def _signal(path, v, spec, role):
 
 
 def _parse_variable_map(path, spec) -> dict:
-    """'force=Force,a1=Acceleration[2]' -> {'force': 'Force', 'acc1': 'Acceleration[2]'}."""
-    out = {}
+    """'force=Force,a1=Acceleration[2]' -> {'force': 'Force', 'acc1': 'Acceleration[2]'}; any a<N> -> acc<N>."""
+    out: dict = {}
+    sources: dict = {}
     for part in str(spec).split(","):
         if not part.strip():
             continue
         role, eq, source = part.partition("=")
-        role = ROLE_ALIASES.get(role.strip().lower(), role.strip().lower())
         if not eq or not source.strip():
             raise FormatError(path, f"map {part.strip()!r}: write ROLE=VARIABLE or ROLE=VARIABLE[ROW]")
-        if role not in RECORDING_NAMES:
-            raise FormatError(path, f"map {part.strip()!r}: unknown channel {role!r} (use force, a1, a2)")
+        try:
+            role = role_of(role)
+        except ValueError as exc:
+            raise FormatError(path, f"map {part.strip()}: {exc}") from None
         if role in out:
-            raise FormatError(path, f"map: {role} given twice")
-        out[role] = source.strip()
+            raise FormatError(path, f"map {part.strip()}: {role} given twice")
+        name, index = _source(path, source, role)
+        same = sources.get((name.lower(), index))  # one signal cannot be two channels
+        if same:
+            raise FormatError(path, f"map {part.strip()}: {same} and {role} both name {source.strip()}")
+        out[role], sources[(name.lower(), index)] = source.strip(), role
     if not out:
         raise FormatError(path, "map is empty")
     return out
@@ -104,10 +117,10 @@ def _parse_variable_map(path, spec) -> dict:
 def read_recording_variables(path, channel_map=None, fs_hz=None):
     """(fs_hz, {name: series}) from a .mat / .npz recording.
 
-    Signals are the variables ``force``, ``acc1``, ``acc2`` (any case), or as
-    ``channel_map`` says (``"force=Force,a1=Acceleration[2],a2=Acceleration[3]"``:
-    a variable, or one row of a matrix of signals, counted from 1). The sample
-    rate is ``fs_hz``, or a variable (`FS_NAMES`, any case), or a time vector.
+    Signals are the variables ``force``, ``acc1``, ``acc2``, ``acc3``, ... (any
+    case), or as ``channel_map`` says (``"force=Force,a1=Acceleration[2],a3=Acceleration[1]"``:
+    a variable, or one row of a matrix of signals, counted from 1; any ``a<N>``).
+    The sample rate is ``fs_hz``, or a variable (`FS_NAMES`, any case), or a time vector.
     """
     path = Path(path)
     v = load_variables(path)
@@ -117,17 +130,17 @@ def read_recording_variables(path, channel_map=None, fs_hz=None):
     if channel_map:
         roles = _parse_variable_map(path, channel_map)
         signals = {role: _signal(path, v, spec, role) for role, spec in roles.items()}
-        used = {_lookup(v, spec.partition("[")[0].partition("(")[0].strip()) for spec in roles.values()}
+        used = {_lookup(v, _source(path, spec, role)[0]) for role, spec in roles.items()}
     else:
         signals, used = {}, set()
-        for n in RECORDING_NAMES:
+        for n in ordered({k.lower() for k in v if is_role(k.lower())}):  # force, acc1, acc2, ...
             key = _lookup(v, n)
             if key is not None:
                 signals[n] = vector_variable(path, key, v[key])
                 used.add(key)
         matrices = [f"{k} {np.asarray(a).shape}" for k, a in v.items()
                     if np.asarray(a).ndim == 2 and min(np.asarray(a).shape) > 1]
-        if not signals or (matrices and not {"acc1", "acc2"} & set(signals)):
+        if not signals or (matrices and not accelerometers(signals)):
             hint = (f"; it holds {', '.join(matrices)}: say which signal is which, e.g. "
                     f"a channel map force=Force,a1=Acceleration[2],a2=Acceleration[3] (rows from 1)" if matrices else "")
             raise FormatError(path, f"no {'response ' if signals else ''}signal variable (any of "

@@ -1,14 +1,17 @@
 """`Recording`: uniformly sampled time channels, and the checks every recording reader shares.
 
-A `Recording` holds uniformly sampled channels. The channels satmd uses are
-``force`` [N] on the primary mass and ``acc1``, ``acc2`` [m/s²] of the
-primary mass and the absorber; other channels (a microphone, a fourth
-accelerometer) are kept under their own names for inspection. The files
-recordings come in are read and written by `satmd.io.recording`.
+A `Recording` holds uniformly sampled channels. A channel's role is its name:
+``force`` [N] or an accelerometer ``acc1``, ``acc2``, ``acc3``, ... [m/s²]
+(`is_role`; a ground vibration test has one shaker and many accelerometers).
+The SATMD rig's estimators use ``force`` on the primary mass and ``acc1``,
+``acc2`` of the primary mass and the absorber (`ROLES`); other channels (a
+microphone, a voltage) are kept under their own names for inspection. The
+files recordings come in are read and written by `satmd.io.recording`.
 """
 from __future__ import annotations
 
 import math
+import re
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -18,12 +21,105 @@ from ..errors import DataError, FormatError
 from ._common import warn
 from .limits import check_samples
 
-ROLES = ("force", "acc1", "acc2")
+ROLES = ("force", "acc1", "acc2")  # the SATMD rig's channels; any acc<N> is a role too (`is_role`)
 MAX_ABS_SAMPLE = 1e15  # no force (N) or acceleration (m/s²) reaches this; float32's 3.4e38 is a glitch
 GLITCH_RATIO = 1e6  # a sample this many times the channel's 99.9th percentile is a glitch, not a measurement
 MIN_RATE_HZ = 20.0  # a structural FRF needs a Nyquist frequency of at least 10 Hz
-SI_UNITS = {"force": "N", "acc1": "m/s^2", "acc2": "m/s^2"}
-MAP_ALIASES = {ch: name for name, ch in RECORDING_CHANNELS.items()}
+SI_UNITS = {"force": "N", "acc1": "m/s^2", "acc2": "m/s^2"}  # the rig's; `si_unit` for any role
+MAP_ALIASES = {ch: name for name, ch in RECORDING_CHANNELS.items()}  # a1, a2; `role_of` for any a<N>
+_ACC = re.compile(r"acc([1-9][0-9]*)")  # acc1, acc2, ...: no acc0, no acc01 (one name per sensor)
+
+
+# --- channel names ----------------------------------------------------------------
+def is_role(name) -> bool:
+    """Whether ``name`` is a role: ``force`` or an accelerometer ``acc<N>`` (N = 1, 2, ...).
+
+    Parameters
+    ----------
+    name : str
+        A channel name, as a `Recording` holds it (case matters: ``Acc3`` is not a role).
+
+    Returns
+    -------
+    bool
+        True for ``force``, ``acc1``, ``acc2``, ``acc3``, ...; False for anything else
+        (``acc0``, ``acc01``, ``a1``, ``ch1``, ``mic``).
+    """
+    return name == "force" or (isinstance(name, str) and _ACC.fullmatch(name) is not None)
+
+
+def accelerometers(names) -> list[str]:
+    """The accelerometer channels among ``names`` in numeric order (acc1, acc2, ..., acc10).
+
+    Parameters
+    ----------
+    names : iterable of str
+        Channel names (a `Recording`'s ``channels`` will do).
+
+    Returns
+    -------
+    list of str
+        The ``acc<N>`` names, sorted by N (not as text: acc2 before acc10).
+    """
+    return sorted((n for n in names if is_role(n) and n != "force"), key=lambda n: int(n[3:]))
+
+
+def ordered(names) -> list[str]:
+    """``names`` in writing order: ``force``, then `accelerometers`, then the others as given.
+
+    Parameters
+    ----------
+    names : iterable of str
+        Channel names.
+
+    Returns
+    -------
+    list of str
+        The same names, each once: the order satmd writes channels in (CSV, WAV).
+    """
+    names = list(names)
+    accs = accelerometers(names)
+    return ["force"] * ("force" in names) + accs + [n for n in names if n != "force" and n not in accs]
+
+
+def si_unit(name, default: str = "") -> str:
+    """The SI unit of a role: ``N`` for ``force``, ``m/s^2`` for every ``acc<N>``; ``default`` for other names."""
+    if name == "force":
+        return "N"
+    return "m/s^2" if is_role(name) else default
+
+
+def role_of(key: str) -> str:
+    """The role a channel map's key names: ``f``/``force``, ``a<N>``/``acc<N>`` (any case) -> ``force``, ``acc<N>``.
+
+    Parameters
+    ----------
+    key : str
+        The left side of a map entry (``a3`` in ``a3=Acceleration[1]``).
+
+    Returns
+    -------
+    str
+        ``force`` or ``acc<N>``.
+
+    Raises
+    ------
+    ValueError
+        An accelerometer numbered 0 or not by a number (``a0``, ``acc``, ``accx``), or
+        an unknown channel; the message says what the names are (callers name the entry).
+    """
+    name = str(key).strip()
+    k = name.lower()
+    if k in ("f", "force"):
+        return "force"
+    digits = k[3:] if k.startswith("acc") else k[1:] if k.startswith("a") else ""
+    if k.startswith("acc") or digits[:1].isdigit():  # an accelerometer, well numbered or not
+        if not (digits.isascii() and digits.isdigit()):
+            raise ValueError("an accelerometer is a<N> or acc<N> with N = 1, 2, ...")
+        if int(digits) == 0:
+            raise ValueError("accelerometers are numbered from 1 (a1 or acc1, a2, ...)")
+        return f"acc{int(digits)}"
+    raise ValueError(f"unknown channel {name!r} (use force, a1, a2, a3, ... or acc1, acc2, ...)")
 
 
 @dataclass(frozen=True)

@@ -1,24 +1,24 @@
 """Time recordings (force and accelerations) and the files they come in: one suffix dispatch.
 
-A `Recording` (`satmd.io.recdata`) holds uniformly sampled channels. The channels satmd uses are
-``force`` [N] on the primary mass and ``acc1``, ``acc2`` [m/s²] of the
-primary mass and the absorber; other channels (a microphone, a fourth
-accelerometer) are kept under their own names for inspection.
+A `Recording` (`satmd.io.recdata`) holds uniformly sampled channels: ``force`` [N] and any number of
+accelerometers ``acc1``, ``acc2``, ``acc3``, ... [m/s²] (`recdata.is_role`). The SATMD rig's estimators use
+``force`` on the primary mass and ``acc1``, ``acc2`` of the primary mass and the absorber; other
+channels (a microphone, a voltage) are kept under their own names for inspection.
 
 Formats (`load_recording` chooses by suffix; each has its module: `csvrec`, `uffrec`, `wavrec`, `matfile`):
 
 ``.csv``  ``# satmd-recording v1`` (optional), then the header
-          ``time_s,force,acc1,acc2`` (``force`` may be left out: output-only),
-          SI units, uniform sampling.
+          ``time_s,force,acc1,acc2`` (``force`` may be left out: output-only;
+          ``acc3``, ... may follow), SI units, uniform sampling.
 ``.uff``  UFF 58 / 58b time records (function type 1), several in one file,
           ASCII or binary; units stated in the file are converted to SI.
           Roles: one force record (specific data type 13 or 9, or a force
           unit) and two response records become force/acc1/acc2 in file
-          order; otherwise ``channel_map="force=#1,a1=1:+Z,a2=2:+Z"``.
+          order; otherwise ``channel_map="force=#1,a1=1:+Z,a2=2:+Z,a3=3:+Z"``.
 ``.wav``  one channel per column: 3 channels = force, acc1, acc2; 2 channels
-          = acc1, acc2. WAV has no units: integer samples are read as
+          = acc1, acc2; other counts ch1, ch2, ... unless a map names them. WAV has no units: integer samples are read as
           fractions of full scale; pass ``scale={"force": N_per_unit, ...}``.
-``.npz`` / ``.mat``  variables ``force``, ``acc1``, ``acc2`` and a rate (``fs_hz``, ``Fs``, ...), or as a
+``.npz`` / ``.mat``  variables ``force``, ``acc1``, ``acc2``, ... and a rate (``fs_hz``, ``Fs``, ...), or as a
           channel map names them (``force=Force,a1=Acceleration[2]``; `matrec`).
 
 Loaders warn (`DataWarning`) about clipped channels and refuse NaN,
@@ -34,7 +34,16 @@ from ..validation import validate_params
 from ._common import read_text, text_lines, writer_for
 from .limits import MAX_BINARY_BYTES, check_file
 from .csvrec import CSV_MAGIC, read_recording_csv, write_recording_csv
-from .recdata import MAX_ABS_SAMPLE, ROLES, SI_UNITS, Recording, check_rate, clipped_channels, warn_clipping
+from .recdata import (
+    MAX_ABS_SAMPLE,
+    ROLES,
+    SI_UNITS,
+    Recording,
+    check_rate,
+    clipped_channels,
+    si_unit,
+    warn_clipping,
+)
 from .uffrec import read_recording_uff, write_recording_uff
 from .wavrec import read_recording_wav, write_recording_wav
 
@@ -46,7 +55,7 @@ def read_recording_variables(path, channel_map=None, fs_hz=None) -> Recording:
     path = Path(path)
     fs, signals = _read(path, channel_map, fs_hz)
     try:
-        rec = Recording(fs, signals, {n: SI_UNITS[n] for n in signals},
+        rec = Recording(fs, signals, {n: si_unit(n) for n in signals},
                         {"source": str(path), "format": path.suffix.lower().lstrip(".")})
     except DataError as exc:
         raise FormatError(path, str(exc)) from None
@@ -82,7 +91,8 @@ def load_recording(path, channel_map=None, scale=None, fs_hz=None) -> Recording:
         ``"force=#1,a1=1:+Z,a2=2:+Z"`` (UFF), ``"force=#1,a1=#2"`` (WAV) or
         ``"force=Force,a1=Acceleration[2],a2=Acceleration[3]"`` (.mat/.npz: a
         variable, or a row of a matrix of signals counted from 1) or
-        ``"force=Force,a1=Acc wing"`` (a lab's CSV columns).
+        ``"force=Force,a1=Acc wing"`` (a lab's CSV columns). Any number of
+        accelerometers: ``a3`` (or ``acc3``) names channel ``acc3``, and so on.
     scale : dict, optional
         ``{channel: SI units per stored unit}`` (e.g. ``{"force": N_per_unit}``)
         for WAV files, which carry no units; WAV only.
@@ -93,7 +103,7 @@ def load_recording(path, channel_map=None, scale=None, fs_hz=None) -> Recording:
     Returns
     -------
     Recording
-        The channels (``force``, ``acc1``, ``acc2``, others under their own
+        The channels (``force``, ``acc1``, ``acc2``, ..., others under their own
         names) in SI units where the file states or ``scale`` gives them.
         Clipped channels are reported with a `DataWarning`.
 
@@ -136,8 +146,8 @@ def save_recording(rec: Recording, path) -> Path:
     Parameters
     ----------
     rec : Recording
-        The recording to write. CSV holds only ``force``, ``acc1`` and
-        ``acc2``; WAV needs an integer sample rate (writers refuse others with
+        The recording to write, every channel (force, acc1, ..., accN, then
+        the others); WAV needs an integer sample rate (writers refuse others with
         a `DataError`).
     path : str or Path
         Target file: ``.csv``, ``.uff``/``.unv`` (binary UFF 58b), ``.wav``

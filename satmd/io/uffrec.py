@@ -1,9 +1,10 @@
 """Recordings as UFF 58 / 58b time records (function type 1), several in one file, ASCII or binary.
 
 Units stated in the file are converted to SI. Roles: files written by satmd
-name their channels; otherwise one force record (specific data type 13 or 9,
-or a force unit) and two response records become force/acc1/acc2 in file
-order, or ``channel_map="force=#1,a1=1:+Z,a2=2:+Z"`` says which is which.
+name their channels (force, acc1, acc2, acc3, ...); otherwise one force record
+(specific data type 13 or 9, or a force unit) and two response records become
+force/acc1/acc2 in file order, or ``channel_map="force=#1,a1=1:+Z,a2=2:+Z,a3=3:+Z"``
+says which is which (any number of accelerometers ``a<N>``).
 """
 from __future__ import annotations
 
@@ -13,10 +14,10 @@ from pathlib import Path
 from ..errors import DataError, FormatError
 from ._common import channel_map_of, parse_quantity_unit, warn
 from .recdata import (
-    MAP_ALIASES,
-    ROLES,
-    SI_UNITS,
     Recording,
+    is_role,
+    role_of,
+    si_unit,
     snap_rate,
     uniform_rate,
     warn_clipping,
@@ -94,17 +95,17 @@ def _kind(r):
 def _uff_roles(path, times, channel_map) -> dict:
     """{dataset number: channel name}."""
     names = {r.index: f"ch{r.index}" for r in times}
-    if not channel_map and all(r.tag in ROLES for r in times) and len({r.tag for r in times}) == len(times):
+    if not channel_map and all(is_role(r.tag) for r in times) and len({r.tag for r in times}) == len(times):
         return {r.index: r.tag for r in times}  # written by satmd, and no map says otherwise
     if channel_map:
-        wanted = channel_map_of(path, channel_map, ROLES, MAP_ALIASES)
+        wanted = channel_map_of(path, channel_map, role_of)
         for role, (kind, a, b) in wanted.items():
             hits = match_records(times, kind, a, b)
             listing = ", ".join(r.describe() for r in times)
             if len(hits) != 1:
                 what = "no time record" if not hits else f"{len(hits)} time records"
                 raise FormatError(path, f"channel_map {role}: {what} match (records: {listing}); use {role}=#N")
-            if names[hits[0].index] in ROLES:
+            if is_role(names[hits[0].index]):
                 raise FormatError(path, f"channel_map: {names[hits[0].index]} and {role} both name dataset "
                                         f"{hits[0].index}; one record cannot be two channels")
             names[hits[0].index] = role
@@ -126,13 +127,13 @@ def _record_si(path, r, name):
     try:
         q = parse_quantity_unit(label)
     except ValueError:
-        if name in ROLES:
+        if is_role(name):
             warn(path, f"dataset {r.index}: unknown unit {label!r} for {name}; values used as they are")
         return r.data.real.astype(float), label
     if q is None:
-        return r.data.real.astype(float), SI_UNITS.get(name, "")
+        return r.data.real.astype(float), si_unit(name)
     kind, factor = q
-    if name in ("acc1", "acc2") and kind != 2:
+    if is_role(name) and name != "force" and kind != 2:
         raise FormatError(path, f"dataset {r.index} mapped to {name} holds {label!r}, not an acceleration",
                           line=r.line)
     if name == "force" and kind != "force":
@@ -147,11 +148,12 @@ def write_recording_uff(rec: Recording, path, binary: bool = True) -> Path:
     for name, v in rec.channels.items():
         if name == "force":
             ordinate = (13, "Force", "N")
-        elif name in ("acc1", "acc2"):
+        elif is_role(name):
             ordinate = (12, "Acceleration", "m/s^2")
         else:
             ordinate = (1, name, rec.units.get(name) or "NONE")
-        parts.append(dataset58(rec.time_s, v, func_type=1, tag=name, rsp=WRITE_DOF.get(name, (0, 0)),
+        rsp = WRITE_DOF.get(name) or ((int(name[3:]), 3) if is_role(name) else (0, 0))  # acc<N> at node N, +Z
+        parts.append(dataset58(rec.time_s, v, func_type=1, tag=name, rsp=rsp,
                                ordinate=ordinate, abscissa=(17, "Time", "s"), binary=binary,
                                id2="satmd-recording v1"))
     return write_datasets(parts, path)

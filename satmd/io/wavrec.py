@@ -1,5 +1,7 @@
 """Recordings as WAV: one channel per column, 3 channels = force, acc1, acc2; 2 channels = acc1, acc2.
 
+Other counts are ch1, ch2, ... unless a channel map names them
+(``channel_map="force=#1,a1=#2,a2=#3,a3=#4"``: any number of accelerometers).
 WAV has no units: integer samples are read as fractions of full scale; pass
 ``scale={"force": N_per_unit, ...}``. Files written by satmd are 64-bit float
 and name their channels (SI) in a LIST/INFO comment.
@@ -17,7 +19,7 @@ from ..errors import DataError, FormatError
 from ._common import channel_map_of, read_bytes, warn
 from .atomic import atomic_write
 from .limits import MAX_BINARY_BYTES, check_file, check_samples
-from .recdata import MAP_ALIASES, ROLES, SI_UNITS, Recording, warn_clipping
+from .recdata import Recording, is_role, ordered, role_of, si_unit, warn_clipping
 
 _WAV_ROLES = {3: ("force", "acc1", "acc2"), 2: ("acc1", "acc2")}
 _WAV_TAG = "satmd-recording v1"
@@ -69,7 +71,7 @@ def read_recording_wav(path, channel_map=None, scale=None) -> Recording:
         else:
             ours = False
     if channel_map:
-        wanted = channel_map_of(path, channel_map, ROLES, MAP_ALIASES)
+        wanted = channel_map_of(path, channel_map, role_of)
         names = [f"ch{k + 1}" for k in range(n_ch)]
         for role, (kind, a, _) in wanted.items():
             if kind != "index" or not 1 <= a <= n_ch:
@@ -84,8 +86,8 @@ def read_recording_wav(path, channel_map=None, scale=None) -> Recording:
         raise FormatError(path, "scale factors must be finite and non-zero")
     channels = {n: values[:, k] * gains[n] for k, n in enumerate(names)}
     raw_unit = "full scale" if is_int else "as stored"
-    units = {n: SI_UNITS.get(n, "") if (n in scale or ours) else raw_unit for n in names}
-    if not ours and any(n in ROLES and n not in scale for n in names):
+    units = {n: si_unit(n) if (n in scale or ours) else raw_unit for n in names}
+    if not ours and any(is_role(n) and n not in scale for n in names):
         warn(path, f"WAV files carry no units: values are {'fractions of full scale' if is_int else 'as stored'}; "
                    "calibrate with scale (force=N_per_unit, ...) or FRF magnitudes are off")
     meta = {"source": str(path), "format": f"WAV {data.dtype}"}
@@ -100,7 +102,7 @@ def read_recording_wav(path, channel_map=None, scale=None) -> Recording:
 
 
 def write_recording_wav(rec: Recording, path) -> Path:
-    """64-bit float WAV (exact), channels in the order force, acc1, acc2 (then others).
+    """64-bit float WAV (exact), channels in the order force, acc1, acc2, ..., accN (then others).
 
     A LIST/INFO comment ``satmd-recording v1; channels force,acc1,acc2; SI``
     lets `read_recording_wav` restore names and units; other programs ignore it.
@@ -110,7 +112,7 @@ def write_recording_wav(rec: Recording, path) -> Path:
     path = Path(path)
     if abs(rec.fs_hz - round(rec.fs_hz)) > 1e-9 * rec.fs_hz:
         raise DataError(f"WAV needs an integer sample rate, this recording has {rec.fs_hz:g} Hz")
-    order = [n for n in ROLES if n in rec.channels] + [n for n in rec.channels if n not in ROLES]
+    order = ordered(rec.channels)
     buf = _io.BytesIO()
     wavfile.write(buf, int(round(rec.fs_hz)), np.column_stack([rec.channels[n] for n in order]))
     text = f"{_WAV_TAG}; channels {','.join(order)}; SI".encode("ascii") + b"\0"

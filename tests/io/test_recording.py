@@ -56,7 +56,7 @@ def test_csv_errors_name_line_and_column(tmp_path):
     p = tmp_path / "r.csv"
     cases = {
         "time_s,force,acc1\n0,1,2\n0.01,1,2\n0.03,1,2\n0.04,1,2\n": "line 4, column 1 .*non-uniform sampling",
-        "time_s,force,acc9\n0,1,2\n": "unknown column 'acc9'",
+        "time_s,force,acc0\n0,1,2\n": "unknown column 'acc0'",  # acc9 is a role now; acc0 is not
         "time_s,force,acc1\n0,1,2\n0.01,1\n": "line 3: 2 fields",
         "time_s,force,acc1\n0,1,2\n0.01,nan,2\n": "line 3, column 2 \\(force\\)",
         "force,acc1\n1,2\n": "first column must be time_s",
