@@ -34,8 +34,26 @@ def _load():
     return [round(x, 2) for x in os.getloadavg()] if hasattr(os, "getloadavg") else None
 
 
+def _commit() -> dict:
+    """The commit the figures were measured at (and whether the tree had changes), and when."""
+    import subprocess
+    import time
+
+    root = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+    out = {"date": time.strftime("%Y-%m-%d %H:%M:%S")}
+    try:
+        out["commit"] = subprocess.run(["git", "rev-parse", "--short", "HEAD"], cwd=root, capture_output=True,
+                                       text=True, timeout=10).stdout.strip() or None
+        dirty = subprocess.run(["git", "status", "--porcelain", "--untracked-files=no"], cwd=root,
+                               capture_output=True, text=True, timeout=10).stdout.strip()
+        out["tree_changed"] = bool(dirty)
+    except (OSError, subprocess.SubprocessError):
+        out["commit"] = None
+    return out
+
+
 def machine(device: str = "cpu", threads: int | None = None) -> dict:
-    """Device, library versions, thread counts and load average, JSON-ready."""
+    """Device, library versions, thread counts, load average, and the commit and date of the run, JSON-ready."""
     import numpy as np
 
     cpus = os.cpu_count()
@@ -53,6 +71,7 @@ def machine(device: str = "cpu", threads: int | None = None) -> dict:
         "load_average_1_5_15_before": _load(),
         "note": ("a load average above cpu_count means other processes shared the cores; "
                  "ratios are measured in the same run, interleaved"),
+        **_commit(),
     }
     if importlib.util.find_spec("torch") is not None:
         import torch

@@ -11,6 +11,9 @@ do at a level that was not tested. This package answers the first two:
 - `locate`: `locate_joint`, between which two sensors (or one sensor and the ground) a joint acts and
   which law it follows, ranked by evidence (ΔBIC) over every pair.
 
+The joint's model in time and the prediction of levels that were not measured (SPEC §11's
+`StructureModel`, `satmd predict`) will live here too (`model`); they are not built yet.
+
 How (`locate`): the nonlinear force of a joint is a feedback input to the linear structure (nonlinear
 subspace identification, FNSI: Noël & Kerschen 2013). With the structure's poles from its lowest level,
 the response at a higher level minus the lowest level's FRF times its force is, at every line and on

@@ -114,6 +114,18 @@ def locate_joint(recordings, laws=None, band_hz=None, channels=None) -> JointLoc
         Fewer than two recordings, a force that is not periodic, recordings of another design (period,
         rate, channels), or fewer than two response channels.
     """
+    ref, others, names, rows, H, basis, modal = prepare(recordings, band_hz, channels)
+    items = [ref, *others]
+    places = [(a, b) for a, b in itertools.combinations(names, 2)] + [(a, "ground") for a in names]
+    chosen = [LAWS[n] for n in (laws or LAWS)]
+    bic: dict = {(p, law_.name): _evidence(p, law_, others, ref, H, names, rows, basis) for p in places for law_ in chosen}
+    bic[None] = _evidence(None, None, others, ref, H, names, rows, basis)
+    return _verdict(bic, places, chosen, ref, items, modal)
+
+
+def prepare(recordings, band_hz=None, channels=None):
+    """What locating and fitting share: (reference, other levels, channels, rows of the common lines in each,
+    the reference FRF per channel, the poles' basis there, the modal fit)."""
     from ..modal import fit_modes
 
     items = [r if isinstance(r, PeriodicSpectra) else periodic_spectra(r) for r in recordings]
@@ -130,7 +142,7 @@ def locate_joint(recordings, laws=None, band_hz=None, channels=None) -> JointLoc
             raise DataError(f"{s.source}: no channel {', '.join(missing)} (the other levels have it)")
     if len(names) < 2:
         raise DataError("locating a joint between sensors needs two or more response channels")
-    common = np.intersect1d(ref.lines, np.intersect1d(*[s.lines for s in items[:2]]) if len(items) > 1 else ref.lines)
+    common = ref.lines
     for s in items:
         common = np.intersect1d(common, s.lines)
     freq = common * ref.fs_hz / ref.period_samples
@@ -144,11 +156,7 @@ def locate_joint(recordings, laws=None, band_hz=None, channels=None) -> JointLoc
     modal = fit_modes(freq, H, band_hz=(float(freq[0]), float(freq[-1])))
     basis = modal.basis(freq)
     others = [s for s in items if s is not ref]
-    places = [(a, b) for a, b in itertools.combinations(names, 2)] + [(a, "ground") for a in names]
-    chosen = [LAWS[n] for n in (laws or LAWS)]
-    bic = {(p, law_.name): _evidence(p, law_, others, ref, H, names, rows, basis) for p in places for law_ in chosen}
-    bic[None] = _evidence(None, None, others, ref, H, names, rows, basis)
-    return _verdict(bic, places, chosen, ref, items, modal)
+    return ref, others, names, rows, H, basis, modal
 
 
 def _evidence(place, law_, others, ref, H, names, rows, basis) -> float:
@@ -156,12 +164,9 @@ def _evidence(place, law_, others, ref, H, names, rows, basis) -> float:
     (``place`` None: no joint, the levels one linear structure)."""
     G: dict = {id(s): [] for s in others}
     if place is not None:
-        a, b = place
-        (da, va), (db, vb) = ref.motion(a), ref.motion(b)
-        d0, v0 = float(np.std(da - db)) or 1.0, float(np.std(va - vb)) or 1.0
+        d0, v0 = ref.scales(*place)
         for s in others:
-            (da, va), (db, vb) = s.motion(a), s.motion(b)
-            G[id(s)] = [s.at_lines(t)[rows[id(s)]] for t in law_.columns(da - db, va - vb, d0, v0)]
+            G[id(s)] = [s.at_lines(t)[rows[id(s)]] for t in law_.columns(*s.relative(*place), d0, v0)]
     rss, n_rows, n_par = 0.0, 0, 0
     for c in names:
         X_parts, y_parts = [], []

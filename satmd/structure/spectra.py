@@ -46,19 +46,44 @@ class PeriodicSpectra:
 
     def motion(self, channel: str):
         """(displacement, velocity) over one period of ``channel`` (zeros for ``"ground"``)."""
-        n = self.period_samples
         if channel == "ground":
-            return np.zeros(n), np.zeros(n)
-        w = 2 * np.pi * self.freq_hz
-        X = np.zeros(n // 2 + 1, complex)
-        X[self.lines] = self.responses[channel] / -(w ** 2)
-        V = np.zeros(n // 2 + 1, complex)
-        V[self.lines] = self.responses[channel] / (1j * w)
-        return np.fft.irfft(X, n), np.fft.irfft(V, n)
+            return np.zeros(self.period_samples), np.zeros(self.period_samples)
+        return motion(self.responses[channel], self.lines, self.fs_hz, self.period_samples)
+
+    def relative(self, a: str, b: str):
+        """(d, v): the relative displacement and velocity of sensor a to sensor b (or the ground) over one period."""
+        (da, va), (db, vb) = self.motion(a), self.motion(b)
+        return da - db, va - vb
+
+    def scales(self, a: str, b: str):
+        """(RMS stroke, RMS relative velocity) of a to b: the scales a joint law is written in."""
+        d, v = self.relative(a, b)
+        return float(np.std(d)) or 1.0, float(np.std(v)) or 1.0
 
     def at_lines(self, x) -> np.ndarray:
         """The spectrum of one period of ``x`` at the excited lines (the scaling of `force`)."""
         return np.fft.rfft(np.asarray(x, float), self.period_samples)[self.lines]
+
+
+def motion(accel, lines, fs_hz: float, period_samples: int):
+    """(displacement, velocity) over one period from an acceleration's spectrum at ``lines`` (zero elsewhere).
+
+    Parameters
+    ----------
+    accel : (K,) complex spectrum (one period's rfft scaling) at ``lines``
+    lines : (K,) DFT lines of one period
+    fs_hz, period_samples : sample rate and samples per period
+
+    Returns
+    -------
+    (ndarray, ndarray)
+    """
+    w = 2 * np.pi * np.asarray(lines) * fs_hz / period_samples
+    X = np.zeros(period_samples // 2 + 1, complex)
+    V = np.zeros(period_samples // 2 + 1, complex)
+    X[lines] = accel / -(w ** 2)
+    V[lines] = accel / (1j * w)
+    return np.fft.irfft(X, period_samples), np.fft.irfft(V, period_samples)
 
 
 def periodic_spectra(recording) -> PeriodicSpectra:
