@@ -13,15 +13,17 @@ from satmd.io import Recording
 
 
 def chain_matrices(n, m=1.0, k=4e4, zeta=0.01):
-    M = np.full(n, m)
+    """Mass vector, stiffness and damping matrices; ``m`` and ``k`` a value or one per mass (k[0]: to the ground)."""
+    M = np.broadcast_to(np.asarray(m, float), (n,)).copy()
+    ks = np.broadcast_to(np.asarray(k, float), (n,))
     K = np.zeros((n, n))
-    K[0, 0] += k
+    K[0, 0] += ks[0]
     for i in range(n - 1):
-        K[i, i] += k
-        K[i + 1, i + 1] += k
-        K[i, i + 1] -= k
-        K[i + 1, i] -= k
-    w1 = np.sqrt(np.linalg.eigvalsh(K / m)[0])
+        K[i, i] += ks[i + 1]
+        K[i + 1, i + 1] += ks[i + 1]
+        K[i, i + 1] -= ks[i + 1]
+        K[i + 1, i] -= ks[i + 1]
+    w1 = np.sqrt(np.min(np.linalg.eigvals(np.linalg.solve(np.diag(M), K)).real))
     C = 2 * zeta / w1 * K  # stiffness-proportional damping
     return M, K, C
 
@@ -35,9 +37,9 @@ def multisine(period, fs, lo, hi, seed):
 
 
 def simulate_chain(n=5, joint=(2, 3), law=lambda d, v: 3e9 * d ** 3, levels=(1.0, 3.0, 8.0), fs=256.0,
-                   period=1024, periods=5, band=(3.0, 60.0), noise=0.01, seed=0):
+                   period=1024, periods=5, band=(3.0, 60.0), noise=0.01, seed=0, m=1.0, k=4e4):
     """Recordings (force, acc1..accN) of the chain at each level; ``joint`` = (i, j) masses (0-based), j None: ground."""
-    M, K, C = chain_matrices(n)
+    M, K, C = chain_matrices(n, m, k)
     i, j = joint
     rng = np.random.default_rng(seed)
     u = multisine(period, fs, *band, seed=seed)
