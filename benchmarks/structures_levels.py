@@ -108,7 +108,7 @@ def judge(rig, recs) -> dict:
     findings = list(nl.findings) if nl is not None else []
     names = [f["name"] for f in findings]
     modes = [m for f in findings for m in (f.get("modes") or [])]
-    named = [n for n in names if n != UNEXPLAINED] + list(rep.effect_names)
+    named = [n for n in names if n not in (UNEXPLAINED, "joint")] + list(rep.effect_names)  # a joint is no SATMD element
     res = {"seconds": seconds, "model_adequate": bool(rep.model_adequate),
            "detected": bool(nl.detected) if nl is not None else False, "findings": names, "named": named,
            "moving": [{"f_hz": [round(x, 4) for x in m["f_hz"]], "zeta": [round(x, 5) for x in m["zeta"]],

@@ -61,8 +61,8 @@ class UnexplainedFinding(EffectFinding):
     n_terms: int = 0
 
 
-_NONLINEAR_KEYS = ("name", "parameters", "ci95", "equivalent", "equivalent_linear", "character", "modes",
-                   "explanation", "moving", "direction")
+_NONLINEAR_KEYS = ("name", "between", "location", "law", "parameters", "ci95", "equivalent", "equivalent_linear",
+                   "character", "modes", "explanation", "moving", "direction")
 
 
 @dataclass(frozen=True)
@@ -79,6 +79,8 @@ class NonlinearFinding:
     moving, direction : the linear parameter that moves with level and which way (named elements).
     character : hardening / softening / level-dependent damping (a generic system).
     modes : per resonance, how it changes with level (a structure the SATMD model cannot describe).
+    between, location, law : a structure's joint (``name`` ``joint``, SPEC §11): the two sensors (or a sensor
+        and ``ground``) it acts between, every place ranked by ΔBIC, and its law.
 
     Read access by the JSON keys (``finding["name"]``, ``finding.get("modes")``) is kept, as for
     `EffectFinding`; the optional fields that are None are absent there.
@@ -94,6 +96,9 @@ class NonlinearFinding:
     direction: str | None = None
     character: str | None = None
     modes: list | None = None
+    between: list | None = None
+    location: list | None = None
+    law: str | None = None
 
     def to_dict(self) -> dict:
         """The SPEC §9 entry (the optional fields when set)."""

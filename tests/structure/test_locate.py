@@ -80,3 +80,26 @@ def test_f16_joint_is_between_the_wing_and_the_payload():
     loc = locate_joint(recs, band_hz=(2.5, 14.5))
     assert loc.between == ("acc2", "acc3")
     assert loc.location[1]["delta_bic"] > 1000
+
+
+def test_discover_says_where_the_joint_acts(cubic_between_3_and_4):
+    """`discover` on the levels of a structure with five accelerometers: the SATMD model is not adequate, the
+    change with level is told per resonance and placed between the two sensors the joint joins (SPEC §11)."""
+    from satmd import discover
+
+    rep = discover(cubic_between_3_and_4)
+    d = rep.to_dict()["nonlinear"]
+    assert d["detected"] and [f["name"] for f in d["findings"]] == ["joint"]
+    joint = d["findings"][0]
+    assert joint["between"] == ["acc3", "acc4"] and joint["law"] == "cubic"
+    assert joint["location"][0]["between"] == ["acc3", "acc4"] and "modes" in joint
+    assert "joint between acc3 and acc4" in rep.report()
+
+
+def test_discover_refuses_a_sensor_missing_at_one_level(cubic_between_3_and_4):
+    from satmd import discover
+
+    low, mid, high = cubic_between_3_and_4
+    fewer = Recording(high.fs_hz, {c: high[c] for c in high.channels if c != "acc5"}, meta={"source": "L3.csv"})
+    with pytest.raises(DataError, match="L3.csv: its channels differ from level 1's \\(no acc5\\)"):
+        discover([low, mid, fewer])

@@ -51,7 +51,8 @@ class NonlinearReport:
 
     def to_dict(self) -> dict:
         """The SPEC §9 ``nonlinear`` block (plus ``experiments``)."""
-        keys = ("name", "parameters", "ci95", "equivalent", "equivalent_linear", "character", "modes", "explanation")
+        keys = ("name", "between", "location", "law", "parameters", "ci95", "equivalent", "equivalent_linear", "character",
+                "modes", "explanation")
         out = {"detected": bool(self.detected), "tests": [t.to_dict() for t in self.tests],
                "findings": [{k: f[k] for k in keys if k in f} for f in self.findings],  # typed or plain dicts
                "experiments": list(self.experiments)}

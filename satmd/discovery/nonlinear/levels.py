@@ -57,6 +57,7 @@ def discover_recordings(items, linear, rig=None, free=None, alpha: float = 1e-3,
     if hits is not None:  # hits of one test are repeats, not levels: one FRF over all of them
         return linear(hits, rig=rig, free=free, alpha=alpha, **kwargs)
     if all(is_forced_recording(x) for x in items):
+        _same_sensors(items)
         unit: str | None = "N RMS"  # the levels are the recordings' force RMS
         datas = common_frfs(items)
         nl = analyse_recordings(items, rig, free, alpha, datas=datas)
@@ -82,9 +83,12 @@ def discover_recordings(items, linear, rig=None, free=None, alpha: float = 1e-3,
     free2 = free + ((moving,) if moving and moving not in free else ())
     rep = linear(ref, rig=rig, free=free2, alpha=alpha, **kwargs)
     if not rep.model_adequate:  # another structure: its level dependence is told per resonance, no element named
-        from .modes import unexplained_by_modes
+        from .modes import unexplained_by_modes, with_joint
 
-        return replace(rep, nonlinear=unexplained_by_modes(nl, datas, unit))
+        told = unexplained_by_modes(nl, datas, unit)
+        if all(is_forced_recording(x) for x in items):  # many sensors: where the joint acts (SPEC §11)
+            told = with_joint(told, items)
+        return replace(rep, nonlinear=told)
     # with the moving parameter free, an effect that restates it (or what is left unexplained) is the
     # nonlinearity seen at one level; without one, every linear effect may be
     picked = [j.name for j in rep.judged if j.status == "named" and _stands_in(j, moving, rig)]
@@ -93,6 +97,23 @@ def discover_recordings(items, linear, rig=None, free=None, alpha: float = 1e-3,
            "the data depend on level: a linear effect fitted at one level stands in for the nonlinearity")
     return rep.rejudged(lambda j: j.name in picked, "set_aside", [Reason("level_dependence", why, {"moving": moving})],
                         nonlinear=replace(nl, set_aside=picked))
+
+
+def _same_sensors(recordings) -> None:
+    """Levels of one test carry one set of sensors: a channel missing at one level is refused, named."""
+    from ...errors import DataError
+
+    first = recordings[0]
+    name0 = first.meta.get("source", "recording 1")
+    for i, r in enumerate(recordings[1:], start=2):
+        if set(r.channels) != set(first.channels):
+            name = r.meta.get("source", f"recording {i}")
+            missing = sorted(set(first.channels) - set(r.channels))
+            extra = sorted(set(r.channels) - set(first.channels))
+            what = "; ".join(x for x in (f"no {', '.join(missing)}" if missing else "",
+                                          f"{', '.join(extra)} that {name0} has not" if extra else "") if x)
+            raise DataError(f"{name}: its channels differ from {name0}'s ({what}): the levels of one test are "
+                            "recorded with one set of sensors")
 
 
 def _stands_in(judged, moving, rig) -> bool:

@@ -139,3 +139,43 @@ def _bands(tracks) -> list:
         else:
             out.append([float(a), float(b)])
     return out
+
+
+def with_joint(report, recordings):
+    """``report`` (told per resonance) with the structure's joint located among its sensors (SPEC §11), when the
+    recordings are periodic tests of two or more response channels and a joint explains the change between their
+    levels (`satmd.structure.locate_joint`); unchanged otherwise.
+
+    Parameters
+    ----------
+    report : NonlinearReport with one ``nonlinear_unexplained`` finding (`unexplained_by_modes`)
+    recordings : the Recordings of the levels
+
+    Returns
+    -------
+    NonlinearReport
+    """
+    from ...errors import DataError
+    from ...structure import locate_joint
+
+    responses = [c for c in recordings[0].channels if c != "force"] if recordings else []
+    if len(recordings) < 2 or len(responses) < 2 or not report.findings:
+        return report
+    try:
+        loc = locate_joint(recordings)
+    except DataError:  # not periodic tests, or too few shared lines: the account per resonance stands
+        return report
+    if not loc.detected:
+        return report
+    a, b = loc.between
+    near = [e for e in loc.location[1:] if e["delta_bic"] <= 10.0]
+    explanation = (f"a joint between {a} and {b} ({loc.law}): its relative motion explains the change between "
+                   f"the levels (ΔBIC {loc.location[1]['delta_bic']:.0f} to the next place, "
+                   f"{' and '.join(loc.location[1]['between'])})" if len(loc.location) > 1 else f"a joint between {a} and {b}")
+    if near:
+        explanation += "; as well supported: " + "; ".join(" and ".join(e["between"]) for e in near)
+    old = report.findings[0]
+    joint = NonlinearFinding("joint", between=[a, b], location=loc.location, law=loc.law,
+                             equivalent=[{"law": e["law"], "delta_bic": e["delta_bic"]} for e in loc.equivalent_laws],
+                             modes=old.get("modes"), explanation=explanation + (f". {old.explanation}" if old.explanation else ""))
+    return replace(report, findings=[joint])
