@@ -12,7 +12,11 @@ Kerschen 2013, here in the frequency domain with the poles known). The transfer 
 free, not built from the mode shapes: a sensor's column of the structure was never measured, and
 a mass-normalised guess of it would carry the modal fit's error into the ranking.
 
-Evidence: BIC = N ln(RSS/N) + p ln N per pair and law (rows weighted by each line's noise). A pair's
+Evidence: BIC = N ln(RSS/N) + p ln N per pair and law. Rows are weighted by each channel's mean response
+at that level, not by each line's noise: between levels far above the noise the misfit is the model's
+(the poles of one level, the joint's terms from the in-band motion), which scales with the response, and
+weighting by the noise let the quietest lines decide (on the F-16 it put the joint between acc2 and the
+ground). A pair's
 evidence is its best law's; pairs are ranked by ΔBIC to the best, and those within `EQUIVALENT` are
 listed as equivalent places, never dropped. At the best pair the laws are ranked the same way; the
 ``sparse`` library is named only when it beats every named law by more than `EQUIVALENT`.
@@ -31,8 +35,6 @@ from .spectra import PeriodicSpectra, periodic_spectra
 
 #: ΔBIC within which two places (or two laws) are equally supported (SPEC §11).
 EQUIVALENT = 10.0
-#: A line's noise std is floored at this share of the channel's median |spectrum| (no line weighs infinitely).
-NOISE_FLOOR = 1e-3
 
 
 @dataclass(frozen=True)
