@@ -6,8 +6,8 @@ Reads the four full-multisine levels of the F-16 benchmark (Noël & Schoukens 20
 cite it when you report results on it; ``../shared/data/real/f16`` unless ``--data``), with the force at the
 shaker and the two accelerometers at the nonlinear payload interface (wing and payload side). satmd detects
 the periodic multisine and estimates the FRF at the excited lines; `satmd.discover` judges the four levels
-together. The aircraft is not a SATMD rig, so no SATMD element is named: the finding is
-``nonlinear_unexplained``, told per resonance (SPEC §9). The script prints, per resonance that moves, its
+together. The aircraft is not a SATMD rig, so no SATMD element is named: the finding is a
+``joint`` between the two sensors (SPEC §11), told per resonance (SPEC §9). The script prints, per resonance that moves, its
 frequency and damping ratio at every level with 95 % intervals and the two trends, and draws |A1| and |A2|
 per level with those resonances marked, and how they move with the force.
 

@@ -10,8 +10,9 @@ the wing, a2 on the payload next to it.
 
 `satmd.discover` detects the multisine from the force, estimates the FRFs at the excited lines,
 judges the four levels together, finds the SATMD model not adequate and names no SATMD element:
-one ``nonlinear_unexplained`` finding, told per resonance (frequency and damping ratio at every
-level, with 95 % intervals, and their trends). ``python examples/f16_levels.py`` prints the full
+one ``joint`` finding between the wing and the payload sensors (SPEC §11; the
+:ref:`joint example <sphx_glr_auto_examples_plot_11_structure_joint.py>` reads all three accelerometers),
+told per resonance (frequency and damping ratio at every level, with 95 % intervals, and their trends). ``python examples/f16_levels.py`` prints the full
 table; ``benchmarks/f16_levels.py`` records it for the results page.
 
 Real data are read from ``../shared/data/real/f16``; when that folder is absent the example says so

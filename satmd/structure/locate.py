@@ -78,6 +78,12 @@ class JointLocation:
                 "equivalent_places": self.equivalent_places, "reference": self.reference,
                 "levels": self.levels, "modes": [{"f_hz": f, "zeta": z} for f, z in self.poles_hz]}
 
+    def plot(self, path, title: str = ""):
+        """The sensors with the joint drawn between two of them, and ΔBIC per place (`figures.joint_figure`)."""
+        from .figures import joint_figure
+
+        return joint_figure(self, path, title)
+
     def report(self) -> str:
         """The verdict in words."""
         a, b = self.between

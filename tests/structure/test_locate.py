@@ -103,3 +103,9 @@ def test_discover_refuses_a_sensor_missing_at_one_level(cubic_between_3_and_4):
     fewer = Recording(high.fs_hz, {c: high[c] for c in high.channels if c != "acc5"}, meta={"source": "L3.csv"})
     with pytest.raises(DataError, match="L3.csv: its channels differ from level 1's \\(no acc5\\)"):
         discover([low, mid, fewer])
+
+
+def test_the_figure_draws_the_joint_and_the_evidence(cubic_between_3_and_4, tmp_path):
+    loc = locate_joint(cubic_between_3_and_4, laws=["cubic"])
+    out = loc.plot(tmp_path / "joint.png", title="chain")
+    assert out.is_file() and out.stat().st_size > 10_000

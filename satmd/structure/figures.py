@@ -1,0 +1,68 @@
+"""The figure of a located joint: the sensors, the joint drawn between two of them, the evidence per place."""
+from __future__ import annotations
+
+import numpy as np
+
+
+def joint_figure(location, path, title: str = ""):
+    """Draw ``location`` (a `JointLocation`) into ``path``: left, the sensors in a row above the ground with the
+    joint between its two (equally supported places dashed); right, ΔBIC of every place to the best.
+
+    Parameters
+    ----------
+    location : JointLocation
+    path : the image file (its suffix sets the format)
+    title : a title above both panels
+
+    Returns
+    -------
+    Path
+    """
+    from ..plots import pyplot, save
+
+    plt = pyplot()
+    sensors = sorted({c for e in location.location for c in e["between"] if c != "ground"},
+                     key=lambda c: (len(c), c))
+    x = {c: float(i) for i, c in enumerate(sensors)}
+    fig, (ax, bx) = plt.subplots(1, 2, figsize=(11, 3.8), gridspec_kw={"width_ratios": [1.1, 1.0]})
+
+    def ends(pair):
+        a, b = pair
+        return (x[a], 1.0), ((x[a] + 0.25, 0.0) if b == "ground" else (x[b], 1.0))
+
+    ax.axhline(0.0, color="0.3", lw=2)
+    ax.fill_between([-0.6, len(sensors) - 0.4], -0.15, 0.0, color="0.85", hatch="///", lw=0)
+    for e in location.location[1:]:
+        if e["delta_bic"] <= 10.0:
+            (x0, y0), (x1, y1) = ends(e["between"])
+            ax.plot([x0, x1], [y0, y1 + (0.25 if y1 == 1.0 else 0)], "--", color="tab:orange", lw=1.5)
+    if location.detected:
+        (x0, y0), (x1, y1) = ends(location.between)
+        t = np.linspace(0, 1, 41)
+        zig = 0.06 * np.sign(np.sin(2 * np.pi * 6 * t)) * (t > 0.15) * (t < 0.85)
+        arc = 0.35 if y1 == 1.0 else 0.0
+        ax.plot(x0 + (x1 - x0) * t, y0 + (y1 - y0) * t + arc * np.sin(np.pi * t) + zig, color="tab:red", lw=2.5,
+                label=f"joint ({location.law})")
+        ax.legend(loc="lower right", fontsize=8)
+    ax.scatter([x[c] for c in sensors], [1.0] * len(sensors), s=260, color="tab:blue", zorder=3)
+    for c in sensors:
+        ax.annotate(c, (x[c], 1.0), xytext=(0, -22), textcoords="offset points", ha="center", fontsize=9)
+    ax.set_xlim(-0.6, len(sensors) - 0.4)
+    ax.set_ylim(-0.2, 1.6)
+    ax.axis("off")
+    ax.set_title("where the joint acts" if location.detected else "no joint: one linear structure explains every level")
+
+    rows = location.location[::-1]
+    labels = [" – ".join(e["between"]) for e in rows]
+    values = [max(e["delta_bic"], 0.0) + 1.0 for e in rows]
+    colors = ["tab:red" if i == len(rows) - 1 and location.detected else "0.6" for i in range(len(rows))]
+    bx.barh(labels, values, color=colors)
+    bx.set_xscale("log")
+    bx.set_xlabel("ΔBIC to the best place + 1 (lower is better)")
+    bx.axvline(11.0, color="tab:orange", ls="--", lw=1, label="equally supported (ΔBIC ≤ 10)")
+    bx.legend(fontsize=8, loc="lower right")
+    bx.tick_params(axis="y", labelsize=8)
+    if title:
+        fig.suptitle(title)
+    fig.tight_layout()
+    return save(fig, path)
