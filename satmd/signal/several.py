@@ -111,11 +111,38 @@ def common_frfs(recordings) -> list:
         return [estimate_frf(r) for r in recordings]
     bands = [excited_band(r["force"], r.fs_hz)[:2] for r in recordings]
     band = (max(b[0] for b in bands), min(b[1] for b in bands))
+    band = _within_sweeps(recordings, band)
     first = estimate_frf(recordings[0], band_hz=band)
-    width = first.estimator.get("window_hz") or first.estimator.get("settings", {}).get("window_hz")
+    width = _window_of(first)
     out = [first] + [estimate_frf(r, band_hz=band, width_hz=width) for r in recordings[1:]]  # the first: as is
     return [_with_model_error(d, r, band, width) if d.estimator.get("method") == "lpm" else d
             for d, r in zip(out, recordings)]
+
+
+def _window_of(data):
+    """The LPM window width (Hz) that gives another recording of the same length ``data``'s windows: (bins − 1)
+    times the bin width. The rounded ``window_hz`` does not: at 0.216667 Hz on a 60 s record it is 13.00002
+    bins, which the LPM rounds to 15, and the two levels then share no frequency."""
+    est = data.estimator or {}
+    bins, record_s = est.get("bins_per_window"), est.get("record_s")
+    if bins and record_s:
+        return (int(bins) - 1) / float(record_s)
+    return est.get("window_hz") or est.get("settings", {}).get("window_hz")
+
+
+def _within_sweeps(recordings, band_hz):
+    """``band_hz`` cut to the part every sweep covers (5 % inside its ends), as `estimate_frf` cuts each sweep's own:
+    every estimate then starts at the same bin and the local windows of all levels fall on one grid (a sweep's
+    detected ends move a little with level, and a window grid shifted by one bin shares no frequency)."""
+    from .excitation import excitation_of
+
+    lo, hi = band_hz
+    for r in recordings:
+        exc = excitation_of(r)
+        if exc.kind == "sweep" and exc.sweep:
+            f0, f1 = sorted((exc.sweep["f_start_hz"], exc.sweep["f_end_hz"]))
+            lo, hi = max(lo, 1.05 * f0), min(hi, 0.95 * f1)
+    return (lo, hi)
 
 
 def _with_model_error(data, recording, band_hz, width):

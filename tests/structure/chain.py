@@ -36,13 +36,23 @@ def multisine(period, fs, lo, hi, seed):
     return one / np.std(one)
 
 
+def log_sweep(fs, duration_s, f_start, f_end, taper_s=0.5):
+    """One logarithmic sine sweep from f_start to f_end Hz, unit amplitude, tapered in and out."""
+    t = np.arange(int(round(duration_s * fs))) / fs
+    rate = np.log(f_end / f_start) / duration_s
+    x = np.sin(2 * np.pi * f_start * (np.exp(rate * t) - 1) / rate)
+    return x * np.clip(np.minimum(t, duration_s - t) / taper_s, 0.0, 1.0)
+
+
 def simulate_chain(n=5, joint=(2, 3), law=lambda d, v: 3e9 * d ** 3, levels=(1.0, 3.0, 8.0), fs=256.0,
-                   period=1024, periods=5, band=(3.0, 60.0), noise=0.01, seed=0, m=1.0, k=4e4):
-    """Recordings (force, acc1..accN) of the chain at each level; ``joint`` = (i, j) masses (0-based), j None: ground."""
+                   period=1024, periods=5, band=(3.0, 60.0), noise=0.01, seed=0, m=1.0, k=4e4, force=None):
+    """Recordings (force, acc1..accN) of the chain at each level; ``joint`` = (i, j) masses (0-based), j None: ground.
+    ``force``: one record of the force shape (a sweep, ...) instead of ``periods`` of a multisine."""
     M, K, C = chain_matrices(n, m, k)
     i, j = joint
     rng = np.random.default_rng(seed)
-    u = multisine(period, fs, *band, seed=seed)
+    u = multisine(period, fs, *band, seed=seed) if force is None else np.asarray(force, float)
+    periods = periods if force is None else 1
     out = []
     for level in levels:
         f = np.tile(level * u, periods)

@@ -77,7 +77,9 @@ def discover_recordings(items, linear, rig=None, free=None, alpha: float = 1e-3,
     finding = nl.findings[0] if nl.findings else {}
     moving = finding.get("moving")
     if not nl.detected:
-        rep = linear(pooled(datas), rig=rig, free=free, alpha=alpha, **kwargs)
+        # one linear system: its FRFs pooled where they share a grid, else the lowest level's alone
+        one = pooled(datas) if grid is not None else datas[int(np.argmin(levels))] if levels else datas[0]
+        rep = linear(one, rig=rig, free=free, alpha=alpha, **kwargs)
         return replace(rep, nonlinear=nl)
     ref = datas[int(np.argmin(levels))] if levels else datas[0]
     free2 = free + ((moving,) if moving and moving not in free else ())
