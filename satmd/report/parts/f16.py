@@ -71,7 +71,8 @@ def build(ctx) -> str:
     head = " | ".join(f"{lev:.1f} N RMS: f [Hz]; ζ" for lev in levels)
     return "\n".join([
         "Four levels of the F-16 benchmark (Noël & Schoukens 2017, nonlinearbenchmark.org), read as the lab wrote "
-        f"them (`--map {CHANNELS}`): satmd detects the periodic multisine "
+        f"them (`--map {CHANNELS}`: acc1 on the wing, acc2 on the payload beside its mounting): satmd detects the "
+        "periodic multisine "
         f"({datas[0].estimator['excitation']['periods']} periods of {datas[0].estimator['excitation']['period_s']:g} s)"
         " and estimates each FRF at the excited lines. The aircraft is not a SATMD rig "
         f"(model adequate: {rep.model_adequate}); no SATMD element is named. " + said, "",
