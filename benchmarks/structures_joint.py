@@ -78,20 +78,18 @@ def one(case: int, seed: int, null: bool) -> dict:
 
 def f16() -> dict | None:
     """locate_joint on the F-16's four levels (None when ../shared is absent)."""
-    from scipy.io import loadmat
+    import warnings
 
-    from satmd.io import Recording
+    from satmd.io import load_recording
     from satmd.io.shared import real_data
 
     if real_data("f16", "F16Data_FullMSine_Level7.mat") is None:
         return None
-    recs = []
-    for level in (1, 3, 5, 7):
-        d = loadmat(real_data("f16", f"F16Data_FullMSine_Level{level}.mat"))
-        acc = d["Acceleration"]
-        recs.append(Recording(float(np.ravel(d["Fs"])[0]), {"force": d["Force"].ravel(), "acc1": acc[0],
-                                                             "acc2": acc[1], "acc3": acc[2]},
-                              meta={"source": f"F16Data_FullMSine_Level{level}.mat"}))
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")  # "ignored variable(s) Voltage"
+        recs = [load_recording(real_data("f16", f"F16Data_FullMSine_Level{level}.mat"),
+                               channel_map="force=Force,a1=Acceleration[1],a2=Acceleration[2],a3=Acceleration[3]")
+                for level in (1, 3, 5, 7)]
     t0 = time.perf_counter()
     loc = locate_joint(recs, band_hz=(2.5, 14.5))
     return {"between": list(loc.between), "truth": ["acc2", "acc3"], "location": loc.location, "law": loc.law,

@@ -14,6 +14,7 @@ import numpy as np
 from ..errors import DataError
 from ..numerics import force_level
 from ..signal.excitation import excitation_of, received
+from ..signal.periodic import periodic_spectra as signal_spectra
 
 
 @dataclass(frozen=True)
@@ -108,21 +109,16 @@ def periodic_spectra(recording) -> PeriodicSpectra:
     if exc.kind != "periodic":
         raise DataError(f"{source}: the force is {exc.kind}, not periodic; locating a joint needs a periodic force "
                         "(a multisine, as a ground vibration test uses) at every level")
-    n, steady = exc.period_samples, list(exc.steady)
+    n = exc.period_samples
     lines = np.asarray(exc.lines, int)
-
-    def spectra(name):
-        x = np.asarray(rec[name], float)[: exc.periods * n].reshape(exc.periods, n)[steady]
-        return np.fft.rfft(x, axis=1)[:, lines]
-
-    force = spectra("force").mean(axis=0)
+    force = signal_spectra(rec, exc, "force").mean(axis=0)  # (steady periods, lines) of the periodic estimator
     responses, std = {}, {}
     for name in rec.channels:
         if name == "force":
             continue
-        Y = spectra(name)
+        Y = signal_spectra(rec, exc, name)
         responses[name] = Y.mean(axis=0)
-        std[name] = np.sqrt(np.var(Y, axis=0, ddof=1) / len(steady) / 2.0)
+        std[name] = np.sqrt(np.var(Y, axis=0, ddof=1) / Y.shape[0] / 2.0)
     if not responses:
         raise DataError(f"{source}: no response channel beside the force")
     return PeriodicSpectra(source, force_level(rec["force"]), float(rec.fs_hz), int(n), lines, force, responses, std)

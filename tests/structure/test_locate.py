@@ -69,14 +69,15 @@ def test_refusals_name_what_is_wrong(cubic_between_3_and_4):
 def test_f16_joint_is_between_the_wing_and_the_payload():
     """The F-16's nonlinear interface joins the wing (acc2) and the payload (acc3) (the benchmark's own
     description): levels 1, 3, 5, 7, the lowest the linear reference."""
-    from scipy.io import loadmat
+    import warnings
 
-    recs = []
-    for level in (1, 3, 5, 7):
-        d = loadmat(real_data("f16", f"F16Data_FullMSine_Level{level}.mat"))
-        acc = d["Acceleration"]
-        recs.append(Recording(float(np.ravel(d["Fs"])[0]), {"force": d["Force"].ravel(), "acc1": acc[0], "acc2": acc[1],
-                                                             "acc3": acc[2]}, meta={"source": f"level {level}"}))
+    from satmd.io import load_recording
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")  # "ignored variable(s) Voltage"
+        recs = [load_recording(real_data("f16", f"F16Data_FullMSine_Level{level}.mat"),
+                               channel_map="force=Force,a1=Acceleration[1],a2=Acceleration[2],a3=Acceleration[3]")
+                for level in (1, 3, 5, 7)]
     loc = locate_joint(recs, band_hz=(2.5, 14.5))
     assert loc.between == ("acc2", "acc3")
     assert loc.location[1]["delta_bic"] > 1000
