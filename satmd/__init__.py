@@ -31,6 +31,7 @@ _EXPORTS = {
     **dict.fromkeys(("FitResult", "identify", "identify_many", "fit_nonlinear", "NonlinearFit"), ".identification"),
     **dict.fromkeys(("fit_modes", "follow_modes"), ".modal"),
     **dict.fromkeys(("DiscoveryReport", "discover", "discover_many"), ".discovery"),
+    **dict.fromkeys(("StructureModel", "fit_structure", "locate_joint"), ".structure"),
     **dict.fromkeys(("TuneResult", "retune", "tune"), ".tuning"),
     "tune_nonlinear": ".tuning.nonlinear",
     "InverseModel": ".inverse",  # torch is optional: it loads only when the model is used
@@ -49,6 +50,7 @@ if TYPE_CHECKING:  # what type checkers and editors see; at run time `__getattr_
                           nonlinear_element, register_nonlinear)
     from .signal import estimate_frf
     from .simulation import simulate
+    from .structure import StructureModel, fit_structure, locate_joint
     from .tuning import TuneResult, retune, tune
     from .tuning.nonlinear import tune_nonlinear
 

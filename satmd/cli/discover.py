@@ -21,6 +21,9 @@ def register(sub):
     p.add_argument("--json", action="store_true", help="print exactly the SPEC §9 JSON document")
     p.add_argument("--plot", default=None, metavar="FIG.png",
                    help="measured vs nominal vs augmented FRFs and residuals, bands shaded")
+    p.add_argument("--save-model", default=None, metavar="MODEL.json",
+                   help="recordings of a structure at several levels: write its model (linear part and joint, "
+                        "SPEC §11) for `satmd predict`")
     p.set_defaults(func=run)
 
 
@@ -29,6 +32,10 @@ def run(args):
     from ..io import is_recording
     from ._common import check_outputs, estimate_notes, load_recording_args, parse_band, plot_suffixes
 
+    from ..errors import SatmdError
+
+    if args.save_model:
+        check_outputs([("--save-model", args.save_model, (".json",))], inputs=[args.data, *args.more])
     free = parse_list(args.free) or DEFAULT_FREE
     candidates = parse_names(args.candidates, registered_names(), "--candidates") if args.candidates else None
     channels = parse_list(args.channels)
@@ -45,6 +52,11 @@ def run(args):
         estimate_notes(args, rep.estimator, rep.estimator.get("measurement", []))
     else:
         rep = discover(load_data(args), free=free, candidates=candidates, channels=channels, alpha=args.alpha)
+    if args.save_model:
+        if rep.model is None:
+            raise SatmdError("--save-model: no structure model was fitted (it needs recordings of one structure at "
+                             "two or more levels, a periodic force and two or more response channels)")
+        rep.model.save(args.save_model)
     if args.plot:
         rep.plot(args.plot)
     if args.json:

@@ -62,7 +62,7 @@ class UnexplainedFinding(EffectFinding):
 
 
 _NONLINEAR_KEYS = ("name", "between", "location", "law", "parameters", "ci95", "equivalent", "equivalent_linear",
-                   "character", "modes", "explanation", "moving", "direction")
+                   "character", "modes", "explanation", "moving", "direction", "fit")
 
 
 @dataclass(frozen=True)
@@ -81,6 +81,7 @@ class NonlinearFinding:
     modes : per resonance, how it changes with level (a structure the SATMD model cannot describe).
     between, location, law : a structure's joint (``name`` ``joint``, SPEC §11): the two sensors (or a sensor
         and ``ground``) it acts between, every place ranked by ΔBIC, and its law.
+    fit : the joint's model against the linear one, NRMSE per recording and channel (SPEC §11).
 
     Read access by the JSON keys (``finding["name"]``, ``finding.get("modes")``) is kept, as for
     `EffectFinding`; the optional fields that are None are absent there.
@@ -99,6 +100,7 @@ class NonlinearFinding:
     between: list | None = None
     location: list | None = None
     law: str | None = None
+    fit: dict | None = None
 
     def to_dict(self) -> dict:
         """The SPEC §9 entry (the optional fields when set)."""

@@ -38,6 +38,11 @@ class DiscoveryReport:
     adequacy: Adequacy | None = None  # (SPEC §9 ``model_adequate``); None: adequate (nothing spoke against it)
 
     @property
+    def model(self):
+        """A structure's `satmd.structure.StructureModel` (linear part and joint, SPEC §11), or None."""
+        return getattr(self.nonlinear, "model", None)
+
+    @property
     def effects(self) -> list:
         """The named physics (`EffectFinding`, most important first)."""
         return [j.finding for j in self.judged if j.status == "named"]

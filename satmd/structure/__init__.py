@@ -11,8 +11,14 @@ do at a level that was not tested. This package answers the first two:
 - `locate`: `locate_joint`, between which two sensors (or one sensor and the ground) a joint acts and
   which law it follows, ranked by evidence (ΔBIC) over every pair.
 
-The joint's model in time and the prediction of levels that were not measured (SPEC §11's
-`StructureModel`, `satmd predict`) will live here too (`model`); they are not built yet.
+and then models it and predicts levels that were not measured:
+
+- `linear`: `LinearStructure`, the lowest level as a stable pole-residue model of every channel
+  (`satmd.modal.rational.vector_fit`), in time;
+- `kernel`: the joint's force sample by sample (an implicit step, compiled with numba when it is there);
+- `model`: `StructureModel` (the linear part and its `Joint`), `simulate`, `predict`, JSON `save`/`load`;
+- `fit`: `fit_structure`, the model fitted on every level at once (a frequency-domain start, then output
+  error in time).
 
 How (`locate`): the nonlinear force of a joint is a feedback input to the linear structure (nonlinear
 subspace identification, FNSI: Noël & Kerschen 2013). With the structure's poles from its lowest level,
@@ -24,6 +30,10 @@ problem; the pair whose motion explains the level change best is the joint's pla
 from __future__ import annotations
 
 from .laws import LAWS, JointLaw, law
+from .fit import fit_structure
+from .linear import LinearStructure
 from .locate import JointLocation, locate_joint
+from .model import Joint, Prediction, StructureModel
 
-__all__ = ["locate_joint", "JointLocation", "JointLaw", "LAWS", "law"]
+__all__ = ["locate_joint", "JointLocation", "JointLaw", "LAWS", "law", "fit_structure", "StructureModel", "Joint",
+           "Prediction", "LinearStructure"]

@@ -66,3 +66,56 @@ def joint_figure(location, path, title: str = ""):
         fig.suptitle(title)
     fig.tight_layout()
     return save(fig, path)
+
+
+def prediction_figure(prediction, path, title: str = ""):
+    """Measured, linear and nonlinear responses of one recording (a `Prediction`): per channel, a second of the
+    time history (top) and the spectrum of the whole record (bottom, log scale: what the model puts above the
+    excited band, the harmonics, is seen there).
+
+    Parameters
+    ----------
+    prediction : Prediction (with its signals)
+    path : the image file (its suffix sets the format)
+    title : a title (default: the file and its NRMSE)
+
+    Returns
+    -------
+    Path
+    """
+    from ..plots import pyplot, save
+
+    plt = pyplot()
+    names = list(prediction.channels)
+    fig, axes = plt.subplots(2, len(names), figsize=(4.2 * len(names), 6.4), squeeze=False)
+    fs = prediction.fs_hz or 1.0
+    labels = ("measured", "linear", "with the joint")
+    styles = (dict(color="0.2", lw=1.2), dict(color="tab:blue", lw=0.9, ls="--"), dict(color="tab:red", lw=0.9))
+    for j, c in enumerate(names):
+        sig = prediction.signals[c]
+        n = sig.shape[1]
+        show = slice(max(0, n // 2 - int(fs) // 2), min(n, n // 2 + int(fs) // 2))
+        t = np.arange(n)[show] / fs
+        freq = np.fft.rfftfreq(n, 1.0 / fs)
+        for k, (label, style) in enumerate(zip(labels, styles)):
+            axes[0, j].plot(t, sig[k][show], label=label, **style)
+            axes[1, j].semilogy(freq, np.abs(np.fft.rfft(sig[k] - sig[k].mean())) / n + 1e-300, **style)
+        axes[0, j].set_title(f"{c}: NRMSE {prediction.nrmse[j]:.3f} (linear {prediction.linear_nrmse[j]:.3f})",
+                             fontsize=9)
+        axes[0, j].set_xlabel("time [s]")
+        axes[1, j].set_xlabel("frequency [Hz]")
+        axes[1, j].set_xlim(0, min(fs / 2, 4 * _band_top(sig[0], fs)))
+    axes[0, 0].set_ylabel("acceleration")
+    axes[1, 0].set_ylabel("|spectrum|")
+    axes[0, 0].legend(fontsize=8)
+    flag = " (extrapolated)" if prediction.extrapolated else ""
+    fig.suptitle(title or f"{prediction.file}: force {prediction.level:.3g} N RMS{flag}", fontsize=10)
+    fig.tight_layout()
+    return save(fig, path)
+
+
+def _band_top(x, fs) -> float:
+    """The frequency below which 99 % of a signal's power lies (to frame the spectrum with its harmonics)."""
+    p = np.abs(np.fft.rfft(x - np.mean(x))) ** 2
+    cum = np.cumsum(p) / max(p.sum(), 1e-300)
+    return float(np.fft.rfftfreq(x.size, 1.0 / fs)[min(int(np.searchsorted(cum, 0.99)), p.size - 1)]) or fs / 8

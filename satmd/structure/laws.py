@@ -3,53 +3,108 @@
 A joint's force is ``g(d, v) = Σ_j c_j t_j(d, v)`` plus a linear part (``d``, ``v``) that every law
 carries: the lowest level's FRF already holds the joint linearised there, and at a higher level its
 equivalent stiffness and damping move as well. A law is the set of terms ``t_j``; the coefficients are
-what the data fit (`satmd.structure.locate`).
+what the data fit (`satmd.structure.locate` in the frequency domain, `satmd.structure.model` in time).
+
+Every term is written once, in `term`: its value and its slopes in d and v, as NumPy arithmetic on
+scalars or arrays, so the same lines serve the regression's columns and the compiled time integrator
+(`satmd.structure.kernel`). A term's ``aux`` is its one shape constant (a clearance's gap, a friction's
+smoothing velocity), a property of the joint, the same at every level.
 """
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Callable
 
 import numpy as np
 
 from ..errors import DataError
 
+#: term name -> code of `term`
+TERM_CODES = {"d": 0, "v": 1, "d³": 2, "d|d|": 3, "contact": 4, "sign(v)": 5, "v|v|": 6, "d²": 7, "v³": 8}
+FRICTION_SMOOTHING = 0.05  # a Coulomb force smoothed over 5 % of the reference velocity's RMS
 
-def _friction(d, v, d0, v0):
-    return [np.tanh(v / (0.05 * v0))]  # a Coulomb force, smoothed over 5 % of the reference velocity's RMS
 
-
-def _clearance(d, v, d0, v0):
-    gap = d0  # contact beyond the reference level's RMS stroke: stiffer outside ±gap
-    return [np.where(np.abs(d) > gap, d - np.sign(d) * gap, 0.0)]
+def term(code, d, v, aux):
+    """(value, ∂/∂d, ∂/∂v) of term ``code`` (`TERM_CODES`) at (d, v); ``aux`` its shape constant."""
+    if code == 0:
+        return d, 1.0 + 0.0 * d, 0.0 * d
+    if code == 1:
+        return v, 0.0 * v, 1.0 + 0.0 * v
+    if code == 2:
+        return d * d * d, 3.0 * d * d, 0.0 * d
+    if code == 3:
+        return d * np.abs(d), 2.0 * np.abs(d), 0.0 * d
+    if code == 4:  # a gap of ±aux that closes: zero inside, the stroke beyond it outside
+        beyond = 1.0 * (np.abs(d) > aux)
+        return beyond * (d - np.sign(d) * aux), beyond, 0.0 * d
+    if code == 5:
+        t = np.tanh(v / aux)
+        return t, 0.0 * v, (1.0 - t * t) / aux
+    if code == 6:
+        return v * np.abs(v), 0.0 * v, 2.0 * np.abs(v)
+    if code == 7:
+        return d * d, 2.0 * d, 0.0 * d
+    return v * v * v, 0.0 * v, 3.0 * v * v
 
 
 @dataclass(frozen=True)
 class JointLaw:
-    """A joint law: ``name`` (SPEC §11), its ``terms(d, v, d0, v0) -> [array, ...]`` and their ``term_names``.
+    """A joint law: ``name`` (SPEC §11), its ``term_names`` (keys of `TERM_CODES`) and its description.
 
-    ``d0`` and ``v0`` are the RMS stroke and relative velocity at the reference (lowest) level: a law's
-    smoothing or gap is a property of the joint, the same at every level, so it is set from one level."""
+    The linear terms ``d`` and ``v`` are added to every law (`all_terms`). ``aux(name, d0, v0)`` gives each
+    term's shape constant from the reference level's RMS stroke ``d0`` and relative velocity ``v0``.
+    ``units`` names each coefficient's unit (force per term unit), for the model's parameters."""
 
     name: str
-    terms: Callable
     term_names: tuple
     description: str
 
-    def columns(self, d, v, d0: float, v0: float) -> list:
+    @property
+    def all_terms(self) -> tuple:
         """The law's terms, then the linear part every law carries (d, v)."""
-        return [np.asarray(t, float) for t in self.terms(d, v, d0, v0)] + [d, v]
+        return (*self.term_names, "d", "v")
+
+    @property
+    def codes(self) -> np.ndarray:
+        return np.array([TERM_CODES[t] for t in self.all_terms], np.int64)
+
+    @staticmethod
+    def aux(term_name: str, d0: float, v0: float) -> float:
+        """The shape constant of a term: the gap (the reference RMS stroke) or the friction's smoothing."""
+        if term_name == "contact":
+            return float(d0)
+        if term_name == "sign(v)":
+            return float(FRICTION_SMOOTHING * v0)
+        return 1.0
+
+    def auxes(self, d0: float, v0: float) -> np.ndarray:
+        return np.array([self.aux(t, d0, v0) for t in self.all_terms], float)
+
+    def columns(self, d, v, d0: float, v0: float) -> list:
+        """The law's terms at (d, v), then the linear part (d, v): one array each."""
+        d, v = np.asarray(d, float), np.asarray(v, float)
+        return [np.asarray(term(TERM_CODES[t], d, v, a)[0], float) for t, a in zip(self.all_terms, self.auxes(d0, v0))]
+
+    def force(self, coefficients, d, v, aux) -> np.ndarray:
+        """Σ c_j t_j(d, v) for coefficients and shape constants in the order of `all_terms`."""
+        d, v = np.asarray(d, float), np.asarray(v, float)
+        return sum(c * term(TERM_CODES[t], d, v, a)[0] for c, t, a in zip(coefficients, self.all_terms, aux))
+
+    def formula(self, coefficients, aux) -> str:
+        """The force written out, e.g. ``-3.1e+04·d + 2.2·v - 41·tanh(v/0.0012)``."""
+        parts = []
+        for c, t, a in zip(coefficients, self.all_terms, aux):
+            text = {"contact": f"(|d|>{a:.3g})·(d∓{a:.3g})", "sign(v)": f"tanh(v/{a:.3g})"}.get(t, t)
+            parts.append(f"{c:+.3g}·{text}")
+        return " ".join(parts).lstrip("+")
 
 
 LAWS = {law_.name: law_ for law_ in (
-    JointLaw("cubic", lambda d, v, d0, v0: [d ** 3], ("d³",), "a cubic spring k3·d³ (hardening or softening by its sign)"),
-    JointLaw("softening", lambda d, v, d0, v0: [d * np.abs(d)], ("d|d|",),
-             "a spring whose stiffness changes with the stroke, d|d| (softening when negative)"),
-    JointLaw("clearance", _clearance, ("contact",), "a gap that closes: stiffer beyond ±gap"),
-    JointLaw("friction", _friction, ("sign(v)",), "stick-slip: a Coulomb force opposing the relative velocity"),
-    JointLaw("quadratic_damping", lambda d, v, d0, v0: [v * np.abs(v)], ("v|v|",), "damping that grows with speed, v|v|"),
-    JointLaw("sparse", lambda d, v, d0, v0: [d ** 2, d ** 3, d * np.abs(d), v * np.abs(v), v ** 3, *_friction(d, v, d0, v0)],
-             ("d²", "d³", "d|d|", "v|v|", "v³", "sign(v)"),
+    JointLaw("cubic", ("d³",), "a cubic spring k3·d³ (hardening or softening by its sign)"),
+    JointLaw("softening", ("d|d|",), "a spring whose stiffness changes with the stroke, d|d| (softening when negative)"),
+    JointLaw("clearance", ("contact",), "a gap that closes: stiffer beyond ±gap"),
+    JointLaw("friction", ("sign(v)",), "stick-slip: a Coulomb force opposing the relative velocity"),
+    JointLaw("quadratic_damping", ("v|v|",), "damping that grows with speed, v|v|"),
+    JointLaw("sparse", ("d²", "d³", "d|d|", "v|v|", "v³", "sign(v)"),
              "a law found over a library of d and v terms (none of the named laws explains the data alone)"),
 )}
 

@@ -40,6 +40,7 @@ class NonlinearReport:
     experiments : what to record next to settle what is open
     levels : one level figure per recording (force RMS), in the order given
     set_aside : linear effects a one-recording fit named while distortion is present (not physics)
+    model : a structure's `satmd.structure.StructureModel` (its linear part and joint), when one was fitted
     """
 
     detected: bool
@@ -48,11 +49,12 @@ class NonlinearReport:
     experiments: list = field(default_factory=list)
     levels: list = field(default_factory=list)
     set_aside: list = field(default_factory=list)
+    model: object = field(default=None, repr=False, compare=False)
 
     def to_dict(self) -> dict:
         """The SPEC §9 ``nonlinear`` block (plus ``experiments``)."""
         keys = ("name", "between", "location", "law", "parameters", "ci95", "equivalent", "equivalent_linear", "character",
-                "modes", "explanation")
+                "modes", "fit", "explanation")
         out = {"detected": bool(self.detected), "tests": [t.to_dict() for t in self.tests],
                "findings": [{k: f[k] for k in keys if k in f} for f in self.findings],  # typed or plain dicts
                "experiments": list(self.experiments)}

@@ -174,8 +174,29 @@ def with_joint(report, recordings):
                    f"{' and '.join(loc.location[1]['between'])})" if len(loc.location) > 1 else f"a joint between {a} and {b}")
     if near:
         explanation += "; as well supported: " + "; ".join(" and ".join(e["between"]) for e in near)
+    model = _structure_model(recordings, loc)
+    fit = parameters = None
+    if model is not None and model.joint is not None:
+        fit = {k: model.fit[k] for k in ("metric", "channels", "linear", "nonlinear")}
+        parameters = model.joint.parameters()
+        worst_lin = max(max(r) for r in model.fit["linear"])
+        worst_nl = max(max(r) for r in model.fit["nonlinear"])
+        explanation += (f"; modelled ({model.joint.formula()}), simulated from each force the worst NRMSE goes "
+                        f"from {worst_lin:.2f} (linear) to {worst_nl:.2f}")
     old = report.findings[0]
-    joint = NonlinearFinding("joint", between=[a, b], location=loc.location, law=loc.law,
+    joint = NonlinearFinding("joint", between=[a, b], location=loc.location, law=loc.law, parameters=parameters or {},
                              equivalent=[{"law": e["law"], "delta_bic": e["delta_bic"]} for e in loc.equivalent_laws],
-                             modes=old.get("modes"), explanation=explanation + (f". {old.explanation}" if old.explanation else ""))
-    return replace(report, findings=[joint])
+                             modes=old.get("modes"), fit=fit,
+                             explanation=explanation + (f". {old.explanation}" if old.explanation else ""))
+    return replace(report, findings=[joint], model=model)
+
+
+def _structure_model(recordings, loc):
+    """The joint's model fitted on every level (`satmd.structure.fit_structure`), or None where it cannot be."""
+    from ...errors import DataError
+    from ...structure import fit_structure
+
+    try:
+        return fit_structure(recordings, between=loc.between, law=loc.law)
+    except DataError:
+        return None

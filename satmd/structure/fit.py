@@ -1,0 +1,290 @@
+"""`fit_structure`: a `StructureModel` from recordings of one structure at several levels (see `model`)."""
+from __future__ import annotations
+
+import numpy as np
+
+from dataclasses import replace
+
+from ..errors import DataError
+from .laws import law as law_named
+from .linear import LinearStructure, fit_linear
+from .model import Joint, StructureModel, _Drive, nrmse, warmup_of
+from .spectra import periodic_spectra
+
+ALTERNATIONS = 30  # of the frequency-domain start (κ at fixed c, c at fixed κ)
+STARTS = ("measured", "underlying")
+SHRINK = (1.0, 0.5, 0.25, 0.1, 0.03, 0.01, 0.0)  # scales of the start's joint tried until the loop is stable
+
+
+def fit_structure(recordings, between=None, law: str | None = None, channels=None, n_pairs: int | None = None,
+                  max_nfev: int = 40, files=None, driving_point: str | None = None, starts=STARTS,
+                  progress=None) -> StructureModel:
+    """The structure's linear part and its joint, fitted on every recording at once (SPEC §11).
+
+    Parameters
+    ----------
+    recordings : Recordings of one structure at two or more levels (a periodic force, the same channels)
+    between : (a, b) the joint's sensors (``b`` may be ``"ground"``); default: `locate_joint`'s best place
+    law : the law's name; default: `locate_joint`'s law
+    channels : the response channels (default every channel but the force)
+    n_pairs : pole pairs of the linear part (default: chosen on the lowest level, `fit_linear`)
+    max_nfev : evaluations of the output-error fit (each simulates every recording)
+    files : names of the recordings for the fit table (default their ``source``)
+    driving_point : the channel at the force's point (default: found, `linear.driving_point`); with one the
+        joint's coefficients are in newtons (reciprocity fixes the scale of its path), without one relative
+    starts : the linear parts the fit starts from, each fitted to the end and the best kept: ``"measured"``
+        (the lowest level's best linear approximation) and ``"underlying"`` (the structure under the joint,
+        from every level at once)
+    progress : callable(str) told of each stage (the CLI prints it on stderr)
+
+    Returns
+    -------
+    StructureModel (``joint`` None when no place explains the change between levels)
+    """
+    from .locate import locate_joint
+
+    say = progress or (lambda msg: None)
+    if len(recordings) < 2:
+        raise DataError("a structure model needs recordings at two or more levels")
+    spectra = [periodic_spectra(r) for r in recordings]
+    names = tuple(channels or spectra[0].responses)
+    for s in spectra:
+        missing = [c for c in names if c not in s.responses]
+        if missing:
+            raise DataError(f"{s.source}: no channel {', '.join(missing)} (the other levels have it)")
+    if between is None or law is None:
+        say("locating the joint among every pair of sensors ...")
+        loc = locate_joint(spectra, channels=names)
+        if not loc.detected:
+            between = law = None
+        else:
+            between, law = tuple(between or loc.between), law or loc.law
+    for c in (between or ()):
+        if c != "ground" and c not in names:
+            raise DataError(f"the joint's sensor {c!r} is not a channel ({', '.join(names)})")
+    ref = min(spectra, key=lambda s: s.level)
+    say(f"linear part from the lowest level ({ref.source}) ...")
+    linear = fit_linear(ref, names, between, n_pairs)
+    levels = (min(s.level for s in spectra), max(s.level for s in spectra))
+    files = list(files or [s.source for s in spectra])
+    if between is None:
+        model = StructureModel(linear, None, levels)
+        return _with_table(model, recordings, files)
+    between = tuple(between)
+    lw = law_named(law)
+    d0, v0 = ref.scales(*between)
+    aux = lw.auxes(d0, v0)
+    reference = linear
+    measured = [np.array([np.asarray(r[ch], float) for ch in names]) for r in recordings]
+    fitted = []
+    for start in starts:  # the lowest level as the linear part, or the structure under the joint: the better kept
+        if start == "underlying":
+            say("the structure under the joint and the joint's path, from every level at once ...")
+            linear, c, kappa = _underlying_start(reference, spectra, between, lw, d0, v0)
+        else:
+            linear, (c, kappa) = reference, _start(reference, spectra, between, lw, d0, v0)
+        model = StructureModel(linear, Joint(between, law, c, aux, kappa), levels, reference=reference,
+                               oversample=oversampling(linear, ref.fs_hz))
+        drives = [(_Drive(model, np.asarray(r["force"], float), float(r.fs_hz), warmup_of(r)), m)
+                  for r, m in zip(recordings, measured)]
+        say(f"output-error fit of the {law} joint between {between[0]} and {between[1]} on {len(recordings)} "
+            f"recordings (from the {start} linear part) ...")
+        model = _output_error(_stable(model, drives), drives, ref, max_nfev)
+        fitted.append((_cost(model, drives), len(fitted), model, drives))
+    _, _, model, drives = min(fitted)
+    model = _in_newtons(model, driving_point)
+    return _with_table(model, recordings, files, drives)
+
+
+def oversampling(linear, fs_hz: float) -> int:
+    """The joint's step: 16 or more a period of the structure's highest mode (a stick-slip or a contact moves
+    the force faster than the modes), at most 8 steps a sample."""
+    top = float(np.abs(linear.poles).max()) / (2 * np.pi) if linear.poles.size else 0.0
+    return int(np.clip(np.ceil(16 * top / fs_hz), 1, 8))
+
+
+def _cost(model, drives) -> float:
+    return float(sum(np.sum(((d.outputs(model.joint) - m) / m.std(axis=1, keepdims=True)) ** 2) / m.size
+                     for d, m in drives))
+
+
+def _underlying_start(linear, spectra, between, lw, d0, v0, extra_pairs: int = 2):
+    """(LinearStructure, c, κ): the structure under the joint and the joint, from every level at once.
+
+    Every channel's response at every level is the structure's FRF times the force plus the joint's column
+    times the spectrum of its force, ``A = H_u F + T G`` (FNSI's feedback form). At fixed law coefficients c
+    this is a two-input system whose shared poles and residues a vector fit finds (`vector_fit_inputs`); at
+    fixed H_u and T, c is linear; alternated. The poles are the structure's under the joint (not the
+    lowest level's, where the joint already damps and stiffens it). The pair's first sensor is fitted as the
+    pair's difference (see `linear.fit_linear`). κ is T's residues over H_u's, mode by mode, in least squares
+    over the channels."""
+    from ..modal.rational import vector_fit_inputs
+
+    names = linear.channels
+    ia = names.index(between[0])
+    ib = names.index(between[1]) if between[1] != "ground" else None
+    data = []
+    for s in spectra:
+        A = np.array([s.responses[c] for c in names])
+        if ib is not None:
+            A[ia] = A[ia] - A[ib]
+        G = np.array([s.at_lines(t) for t in lw.columns(*s.relative(*between), d0, v0)])
+        W = np.repeat(1.0 / np.maximum(np.abs(A).mean(axis=1, keepdims=True), 1e-300), A.shape[1], axis=1)
+        data.append((s.freq_hz, s.force, G, A, W))
+    c = np.zeros(len(lw.all_terms))
+    c[0] = 1.0
+    k = linear.poles.size + extra_pairs
+    poles = None
+    for _ in range(ALTERNATIONS // 3):
+        blocks = [(f, np.array([F, c @ G]), A, W) for f, F, G, A, W in data]
+        poles, res, feed = vector_fit_inputs(blocks, k, iterations=6 if poles is not None else 12, poles=poles)
+        T = [_model_frf(f, poles, res[:, 1], feed[:, 1]) for f, *_ in data]
+        X = np.vstack([np.column_stack([(T[m][i] * g) * W[i] for g in G])
+                       for m, (f, F, G, A, W) in enumerate(data) for i in range(len(names))])
+        y = np.concatenate([(A[i] - _model_frf(f, poles, res[i:i + 1, 0], feed[i:i + 1, 0])[0] * F) * W[i]
+                            for f, F, G, A, W in data for i in range(len(names))])
+        c_new = np.linalg.lstsq(*_real(X, y), rcond=None)[0]
+        c = c_new / (abs(c_new[0]) or 1.0)
+    blocks = [(f, np.array([F, c @ G]), A, W) for f, F, G, A, W in data]
+    poles, res, feed = vector_fit_inputs(blocks, k, iterations=6, poles=poles)
+    R, D, T = res[:, 0].copy(), feed[:, 0].copy(), res[:, 1].copy()
+    if ib is not None:  # back to the sensors' own channels
+        R[ia] += R[ib]
+        D[ia] += D[ib]
+        T[ia] += T[ib]
+    kappa = np.sum(R.conj() * T, axis=0) / np.maximum(np.sum(np.abs(R) ** 2, axis=0), 1e-300)
+    return LinearStructure(names, poles, R, D), c, kappa
+
+
+def _model_frf(f, poles, residues, feed):
+    return LinearStructure(tuple(range(len(residues))), poles, residues, np.asarray(feed, float)).frf(f)
+
+
+def _real(X, y):
+    return np.vstack([X.real, X.imag]), np.concatenate([y.real, y.imag])
+
+
+def _start(linear, spectra, between, lw, d0, v0):
+    """(c, κ): the joint's coefficients and coupling from the level changes, in the frequency domain."""
+    names = linear.channels
+    lam = linear.poles
+    blocks = []
+    for s in spectra:
+        f = s.freq_hz
+        iw = 2j * np.pi * f[:, None]
+        H = linear.frf(f)
+        G = [s.at_lines(t) for t in lw.columns(*s.relative(*between), d0, v0)]
+        for i, c in enumerate(names):
+            a = linear.residues[i][None, :] / (iw - lam[None, :])
+            b = linear.residues[i].conj()[None, :] / (iw - lam.conj()[None, :])
+            cols = np.stack([a + b, 1j * (a - b)], axis=2).reshape(f.size, -1)  # real (Re κ, Im κ) per mode
+            w = 1.0 / max(float(np.mean(np.abs(s.responses[c]))), 1e-300)
+            blocks.append((cols * w, G, (s.responses[c] - H[i] * s.force) * w))
+    y = np.concatenate([e for _, _, e in blocks])
+    y = np.concatenate([y.real, y.imag])
+    c = np.zeros(len(lw.all_terms))
+    c[0] = 1.0
+    kappa = np.zeros(2 * lam.size)
+    for _ in range(ALTERNATIONS):
+        X = np.vstack([cols * sum(cj * g for cj, g in zip(c, G))[:, None] for cols, G, _ in blocks])
+        kappa = np.linalg.lstsq(np.vstack([X.real, X.imag]), y, rcond=None)[0]
+        X = np.vstack([np.stack([(cols @ kappa) * g for g in G], axis=1) for cols, G, _ in blocks])
+        c = np.linalg.lstsq(np.vstack([X.real, X.imag]), y, rcond=None)[0]
+        scale = abs(c[0]) or 1.0  # the pair (c, κ) is known up to a scale: the law's first term is 1 in size
+        c, kappa = c / scale, kappa * scale
+    return c, kappa[0::2] + 1j * kappa[1::2]
+
+
+def _with_joint(model, c, kappa) -> StructureModel:
+
+    return replace(model, joint=replace(model.joint, coefficients=np.asarray(c, float), coupling=np.asarray(kappa)))
+
+
+def _stable(model, drives) -> StructureModel:
+    """The start scaled down (toward the linear model) until every recording's simulation stays finite."""
+    j = model.joint
+    for s in SHRINK:
+        trial = _with_joint(model, j.coefficients * s, j.coupling)
+        if all(np.all(np.isfinite(d.outputs(trial.joint))) for d, _ in drives):
+            return trial
+    return model  # pragma: no cover - the scale 0 is the linear model
+
+
+def _output_error(model, drives, ref, max_nfev) -> StructureModel:
+    """Least squares of the simulated responses on every recording: the law's coefficients (the first held:
+    it fixes the scale the path shares), its shape constants (in log: a gap, a friction's smoothing) and the
+    path κ."""
+
+    from scipy.optimize import least_squares
+
+    j = model.joint
+    n_c = j.coefficients.size
+    shaped = [i for i, t in enumerate(j.terms) if t in ("contact", "sign(v)")]
+    step = max(1, int(ref.fs_hz / (8 * ref.freq_hz[-1])))  # the responses are band-limited well below Nyquist
+    scales = [m.std(axis=1, keepdims=True) for _, m in drives]
+
+    def unpack(theta):
+        c = np.concatenate([j.coefficients[:1], theta[:n_c - 1]])
+        aux = j.aux.copy()
+        aux[shaped] = np.exp(theta[n_c - 1:n_c - 1 + len(shaped)])
+        k = theta[n_c - 1 + len(shaped):]
+        return replace(j, coefficients=c, aux=aux, coupling=k[0::2] + 1j * k[1::2])
+
+    def residual(theta):
+        trial = unpack(theta)
+        out = []
+        for (drive, measured), sd in zip(drives, scales):
+            e = (drive.outputs(trial, step) - measured[:, ::step]) / sd
+            out.append(np.nan_to_num(e, nan=1e3, posinf=1e3, neginf=-1e3).ravel() / np.sqrt(e.size))
+        return np.concatenate(out)
+
+    k0 = np.column_stack([j.coupling.real, j.coupling.imag]).ravel()
+    log_aux = np.log(j.aux[shaped])
+    theta0 = np.concatenate([j.coefficients[1:], log_aux, k0])
+    scale = np.maximum(np.abs(theta0), 1e-3 * (np.abs(theta0).max() or 1.0))
+    scale[n_c - 1:n_c - 1 + len(shaped)] = 1.0  # a log: steps of order one
+    sol = least_squares(residual, theta0, x_scale=scale, diff_step=1e-4, max_nfev=max_nfev)
+    start = residual(theta0)
+    best = sol.x if sol.cost <= 0.5 * float(start @ start) else theta0
+    return replace(model, joint=unpack(best))
+
+
+def _in_newtons(model, driving_point=None) -> StructureModel:
+    """The joint with its path scaled as reciprocity says (κ_r = −(A_ar − A_br)/A_dr for a driving point d),
+    so that its coefficients are forces; the simulation is unchanged (c s, κ / s). As it was when there is no
+    driving point or the fitted path does not follow the modes' shapes (a misfit over 30 %)."""
+
+    from .linear import driving_point as found
+
+    lin, j = model.linear, model.joint
+    d = driving_point or found(lin)
+    if d is None:
+        return model
+    if d not in lin.channels:
+        raise DataError(f"the driving point {d!r} is not a channel ({', '.join(lin.channels)})")
+    phys = -lin.coupling(*j.between, d)
+    w = np.abs(lin.residues[lin.index(d)] / lin.poles ** 2)  # each mode's weight at the driving point
+    w = np.where(w > 0.05 * w.max(), w, 0.0)  # the structure's modes, not the poles that only shape the fit
+    s = float(np.sum(w * (j.coupling * phys.conj()).real) / max(np.sum(w * np.abs(phys) ** 2), 1e-300))
+    misfit = np.sqrt(np.sum(w * np.abs(j.coupling - s * phys) ** 2) / max(np.sum(w * np.abs(j.coupling) ** 2), 1e-300))
+    if not np.isfinite(s) or s == 0 or misfit > 0.3:
+        return model
+    return replace(model, joint=replace(j, coefficients=j.coefficients * s, coupling=j.coupling / s, units="N"),
+                   driving_point=d)
+
+
+def _with_table(model, recordings, files, drives=None) -> StructureModel:
+
+    lin, nl = [], []
+    for i, r in enumerate(recordings):
+        if drives is None:
+            drive = _Drive(model, np.asarray(r["force"], float), float(r.fs_hz), warmup_of(r))
+            measured = np.array([np.asarray(r[c], float) for c in model.channels])
+        else:
+            drive, measured = drives[i]
+        a = drive.outputs(None)
+        b = drive.outputs(model.joint) if model.joint is not None else a
+        lin.append([round(nrmse(x, m), 4) for x, m in zip(a, measured)])
+        nl.append([round(nrmse(x, m), 4) for x, m in zip(b, measured)])
+    return replace(model, fit={"metric": "nrmse", "channels": list(model.channels), "files": files,
+                               "linear": lin, "nonlinear": nl})

@@ -1,0 +1,177 @@
+"""`LinearStructure`: the structure at its lowest level, poles and residues on every channel, in time.
+
+From a modal fit of the force-to-acceleration FRFs (`satmd.modal.fit_modes`, accelerance
+``H_o(ω) = Σ_r A_or/(iω − λ_r) + A_or*/(iω − λ_r*) + D_o``), each mode is a first-order complex state
+driven by the force; ``D_o`` (the real, frequency-flat residual: the mass line above the band) passes
+the force straight through. The other residual terms of the fit (the imaginary constant and the terms in
+ω² and 1/ω²) stand for modes outside the band and have no causal state: they are left out, which is
+what the lowest level's linear NRMSE then measures.
+
+A joint between sensors a and b is a pair of equal and opposite forces at a and b. Its path to every
+channel is not measured (one shaker), but on one structure the residues of a column are those of the
+force's column scaled per mode (reciprocity: ``A_o,ab = A_o c_r`` with ``c_r = (A_ar − A_br) / A_dr``
+for a driving point d). `coupling` gives ``c_r`` from a driving point; without one the model fits it.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..errors import DataError
+
+
+@dataclass(frozen=True)
+class LinearStructure:
+    """Poles and the force's residues on every channel (accelerance), with a flat feed-through.
+
+    Attributes
+    ----------
+    channels : the response channels, in order
+    poles : (n,) complex λ_r (upper half-plane)
+    residues : (C, n) complex A_or
+    feedthrough : (C,) real D_o [(m/s²)/N]
+    """
+
+    channels: tuple
+    poles: np.ndarray
+    residues: np.ndarray
+    feedthrough: np.ndarray
+
+    @classmethod
+    def from_modal(cls, modal) -> "LinearStructure":
+        """From a `satmd.modal.ModalFit` of accelerances (its modes and each channel's coefficients)."""
+        n = len(modal.modes)
+        poles = np.array([m.pole for m in modal.modes], complex)
+        res = np.array([modal.coefficients[c][0:2 * n:2] + 1j * modal.coefficients[c][1:2 * n:2]
+                        for c in modal.channels])
+        feed = np.array([float(modal.coefficients[c][2 * n]) for c in modal.channels])
+        return cls(tuple(modal.channels), poles, res, feed)
+
+    def index(self, channel: str) -> int:
+        try:
+            return self.channels.index(channel)
+        except ValueError:
+            raise DataError(f"no channel {channel!r} in the structure (channels: {', '.join(self.channels)})") from None
+
+    def frf(self, freq_hz) -> np.ndarray:
+        """(C, M) complex accelerance of the model at ``freq_hz``."""
+        iw = 2j * np.pi * np.asarray(freq_hz, float)[None, :, None]
+        lam = self.poles[None, None, :]
+        A = self.residues[:, None, :]
+        return (A / (iw - lam) + A.conj() / (iw - lam.conj())).sum(axis=2) + self.feedthrough[:, None]
+
+    def pair_residues(self, a: str, b: str) -> np.ndarray:
+        """(n,) accelerance residues of the relative motion of a to b (b may be ``"ground"``) per unit force."""
+        ra = self.residues[self.index(a)]
+        return ra - (0.0 if b == "ground" else self.residues[self.index(b)])
+
+    def coupling(self, a: str, b: str, driving_point: str) -> np.ndarray:
+        """(n,) c_r: the joint's column of residues over the force's, from the driving point (reciprocity)."""
+        return self.pair_residues(a, b) / self.residues[self.index(driving_point)]
+
+    def to_dict(self) -> dict:
+        return {"channels": list(self.channels), "poles": _pairs(self.poles),
+                "residues": [_pairs(r) for r in self.residues], "feedthrough": self.feedthrough.tolist()}
+
+    @classmethod
+    def from_dict(cls, d: dict) -> "LinearStructure":
+        return cls(tuple(d["channels"]), _complex(d["poles"]), np.array([_complex(r) for r in d["residues"]]),
+                   np.asarray(d["feedthrough"], float))
+
+
+def fit_linear(spectra, channels, between=None, n_pairs=None) -> LinearStructure:
+    """The linear part from one level's spectra (its lowest): a vector fit of every channel's FRF.
+
+    Parameters
+    ----------
+    spectra : PeriodicSpectra of the reference level
+    channels : the response channels, in order
+    between : (a, b) a joint's pair: the fit is made on the channels with ``a`` replaced by ``a − b``, so that
+        the pair's relative motion (a small difference of large signals) is as accurate as each channel
+    n_pairs : pole pairs (default: from 2 up, one more while it cuts the error by 10 %, at most 24)
+
+    Returns
+    -------
+    LinearStructure
+    """
+    from ..modal.rational import vector_fit
+
+    names = tuple(channels)
+    f = spectra.freq_hz
+    H = np.array([spectra.responses[c] / spectra.force for c in names])
+    ia = names.index(between[0]) if between else None
+    ib = names.index(between[1]) if between and between[1] != "ground" else None
+    fitted = H.copy()
+    if ib is not None:
+        fitted[ia] = H[ia] - H[ib]
+    weight = np.abs(spectra.force)[None, :] / np.abs(fitted).mean(axis=1, keepdims=True)  # the response's error
+    best, worse = None, 0
+    for k in ([n_pairs] if n_pairs else _pair_counts(f)):
+        poles, res, feed = vector_fit(f, fitted, weight, k)
+        err = float(np.sqrt(np.mean([np.sum(np.abs((LinearStructure(names, poles, res, feed).frf(f) - fitted) * w) ** 2)
+                                      / np.sum(np.abs(h * w) ** 2) for h, w in zip(fitted, weight)])))
+        if best is None or err < 0.9 * best[0]:
+            best, worse = (err, poles, res, feed), 0
+        else:
+            worse += 1
+            if worse == 2:  # two more pole pairs bought less than 10 % each: the data hold no more
+                break
+    _, poles, res, feed = best
+    if ib is not None:  # back to the sensors' own channels
+        res, feed = res.copy(), feed.copy()
+        res[ia] += res[ib]
+        feed[ia] += feed[ib]
+    return LinearStructure(names, poles, res, feed)
+
+
+def _pair_counts(freq_hz) -> list:
+    top = int(min(24, (freq_hz.size - 2) // 4))
+    return list(range(2, max(2, top) + 1))
+
+
+def driving_point(linear: LinearStructure):
+    """The channel at the force's point, found: the one whose receptance modal constants ``A_r / λ_r²`` all
+    have the driving point's sign (a positive mass-normalised ``φ_d²``, so −Re(A/λ²)·… > 0 on every mode);
+    None when no channel, or more than one, does."""
+    w = np.abs(linear.poles)
+    # receptance residue of mode r: A / λ²; its modal constant φ_d² ≈ 2 i ω_d (A/λ²) for light damping
+    const = (2j * w * linear.residues / linear.poles ** 2).real
+    weight = np.abs(linear.residues) / np.abs(linear.residues).max(axis=1, keepdims=True)
+    strong = weight > 0.05
+    found = [c for c, k, s in zip(linear.channels, const, strong) if np.all(k[s] > 0)]
+    return found[0] if len(found) == 1 else None
+
+
+def discretise(poles, fs_hz: float):
+    """(ψ, G0, G1): ``z_k = ψ z_{k-1} + G0 u_{k-1} + G1 u_k`` for ``z' = λ z + u`` with u straight between samples."""
+    h = 1.0 / fs_hz
+    lam = np.asarray(poles, complex)
+    psi = np.exp(lam * h)
+    i0 = (psi - 1.0) / lam
+    i1 = (psi - 1.0 - lam * h) / (lam ** 2 * h)
+    return psi, i0 - i1, i1
+
+
+def modal_states(u, poles, fs_hz: float) -> np.ndarray:
+    """(n, N) complex states of ``z' = λ z + u`` from rest, u straight between samples (IIR filters, no loop)."""
+    from scipy.signal import lfilter
+
+    psi, G0, G1 = discretise(poles, fs_hz)
+    u = np.asarray(u, float)
+    return np.array([lfilter([g1, g0], [1.0, -p], u.astype(complex)) for p, g0, g1 in zip(psi, G0, G1)])
+
+
+def response(states, residues) -> np.ndarray:
+    """Re Σ_r 2 R_r z_r for residues R (n,) or (C, n): (N,) or (C, N)."""
+    R = np.asarray(residues)
+    return 2.0 * (R.real @ states.real - R.imag @ states.imag)  # the real part alone: half the work
+
+
+def _pairs(z) -> list:
+    return [[float(x.real), float(x.imag)] for x in np.asarray(z, complex)]
+
+
+def _complex(pairs) -> np.ndarray:
+    a = np.asarray(pairs, float).reshape(-1, 2)
+    return a[:, 0] + 1j * a[:, 1]

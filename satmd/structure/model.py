@@ -1,0 +1,295 @@
+"""`StructureModel`: the structure's linear part plus its joint, simulated in time from a measured force.
+
+Fitted by `fit_structure` on recordings at several levels (SPEC §11):
+
+1. **Where and what** (`locate_joint`, unless given): the pair of sensors and the law.
+2. **Linear part** from the lowest level (`linear.fit_linear`): a stable pole-residue model of every
+   channel. The pair's relative motion is a small difference of two large accelerations, so the model
+   is fitted on the channels with the pair's first sensor replaced by the difference: a few per cent of
+   error on each sensor would otherwise be all of the joint's stroke.
+3. **Start** in the frequency domain, every level at once: the change ``E_o = A_o − H_o F`` is the
+   joint's force ``G = Σ c_j t_j(d, v)`` (from the measured relative motion) through the joint's column,
+   ``A_or κ_r / (iω − λ_r)`` with a coupling ``κ_r`` per mode (reciprocity: the column of a force at
+   two sensors is the force's column scaled per mode). Linear in κ at fixed c and in c at fixed κ:
+   alternated to convergence. Where this open-loop start makes the closed loop run away, the joint's
+   terms are scaled down until it does not.
+4. **Output error** in time (`scipy.optimize.least_squares`): the responses simulated from rest with
+   each measured force (`simulate`), all levels and channels at once, each channel in units of its RMS;
+   the law's coefficients and the coupling are free.
+
+A periodic force is simulated from rest over one extra period before the record (a lab's record starts
+in steady state: its first period is the structure's answer to the period before it); any other force
+from rest at the first sample. NRMSE (SPEC §11): RMS of the simulation's error over the RMS of the
+measured output, per channel.
+"""
+from __future__ import annotations
+
+import json
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..errors import DataError
+from .kernel import joint_force
+from .laws import law as law_named
+from .linear import LinearStructure, discretise, modal_states, response
+
+SCHEMA = "satmd-structure-model/1"
+PREDICTION_SCHEMA = "satmd-prediction/1"
+
+
+@dataclass(frozen=True)
+class Joint:
+    """A joint between two sensors (``b`` may be ``"ground"``): its law, coefficients and path.
+
+    Attributes
+    ----------
+    between : (a, b); the joint's stroke is ``d = x_a − x_b``
+    law : the law's name (`satmd.structure.laws.LAWS`)
+    coefficients : (J,) of the law's terms (`JointLaw.all_terms`): force in N per term unit
+    aux : (J,) each term's shape constant (a gap in m, a friction's smoothing in m/s)
+    coupling : (n,) complex κ_r: the joint's column of residues is the force's times κ
+    units : ``"N"`` when the coefficients are forces (the path scaled by reciprocity through a driving
+        point), ``"relative"`` when only their product with the path is known
+    """
+
+    between: tuple
+    law: str
+    coefficients: np.ndarray
+    aux: np.ndarray
+    coupling: np.ndarray
+    units: str = "relative"
+
+    @property
+    def terms(self) -> tuple:
+        return law_named(self.law).all_terms
+
+    def parameters(self) -> dict:
+        """{term: coefficient} and the shape constants (``gap``, ``friction_velocity``) by name."""
+        out = {t: float(c) for t, c in zip(self.terms, self.coefficients)}
+        for t, a in zip(self.terms, self.aux):
+            if t == "contact":
+                out["gap"] = float(a)
+            if t == "sign(v)":
+                out["friction_velocity"] = float(a)
+        return out
+
+    def formula(self) -> str:
+        return law_named(self.law).formula(self.coefficients, self.aux)
+
+    def to_dict(self) -> dict:
+        return {"between": list(self.between), "law": self.law, "terms": list(self.terms),
+                "coefficients": [float(c) for c in self.coefficients], "aux": [float(a) for a in self.aux],
+                "coupling": [[float(k.real), float(k.imag)] for k in self.coupling], "units": self.units,
+                "formula": self.formula()}
+
+    @classmethod
+    def from_dict(cls, d: dict) -> "Joint":
+        k = np.asarray(d["coupling"], float).reshape(-1, 2)
+        return cls(tuple(d["between"]), str(d["law"]), np.asarray(d["coefficients"], float),
+                   np.asarray(d["aux"], float), k[:, 0] + 1j * k[:, 1], str(d.get("units", "relative")))
+
+
+@dataclass(frozen=True)
+class Prediction:
+    """A model's simulation of one recording: NRMSE per channel, nonlinear and linear (SPEC §11).
+
+    ``signals`` holds the measured, linear and nonlinear responses {channel: (3, N)} for figures."""
+
+    file: str
+    level: float
+    extrapolated: bool
+    channels: tuple
+    nrmse: list
+    linear_nrmse: list
+    fs_hz: float = 0.0
+    signals: dict = field(default_factory=dict, repr=False)
+
+    def to_dict(self) -> dict:
+        return {"file": self.file, "level": round(self.level, 6), "extrapolated": self.extrapolated,
+                "channels": list(self.channels), "nrmse": [round(x, 4) for x in self.nrmse],
+                "linear_nrmse": [round(x, 4) for x in self.linear_nrmse]}
+
+    def report(self) -> str:
+        flag = " (extrapolated: outside the fitted levels)" if self.extrapolated else ""
+        rows = ", ".join(f"{c} {n:.3f} (linear {ln:.3f})" for c, n, ln in zip(self.channels, self.nrmse, self.linear_nrmse))
+        return f"{self.file}: force {self.level:.4g} N RMS{flag}; NRMSE {rows}"
+
+
+@dataclass(frozen=True)
+class StructureModel:
+    """A structure's linear part and its joint, fitted on recordings at several levels (SPEC §11).
+
+    Attributes
+    ----------
+    linear : LinearStructure: the structure under the joint (with no joint, the lowest level)
+    joint : Joint, or None (no joint: the structure is linear at every level)
+    reference : LinearStructure of the lowest level as measured (its best linear approximation): the linear
+        model the joint's model is compared with (SPEC §11 ``linear``); None: ``linear`` is that model
+    levels : (lo, hi) force RMS [N] of the recordings fitted
+    fit : {"metric": "nrmse", "channels": [...], "files": [...], "linear": [[...]], "nonlinear": [[...]]}
+    units : {"force": "N", "response": "m/s²"}
+    driving_point : the channel at the force's point, when there is one
+    oversample : the joint's force is integrated at this many times the record's rate
+    """
+
+    linear: LinearStructure
+    joint: Joint | None
+    levels: tuple
+    fit: dict = field(default_factory=dict)
+    units: dict = field(default_factory=lambda: {"force": "N", "response": "m/s²"})
+    driving_point: str | None = None
+    oversample: int = 4
+    reference: LinearStructure | None = None
+
+    @property
+    def channels(self) -> tuple:
+        return self.linear.channels
+
+    def simulate(self, force, fs_hz: float, warmup_samples: int = 0, joint: bool = True) -> np.ndarray:
+        """(C, N) accelerations simulated from rest with ``force`` (N samples) preceded by its last
+        ``warmup_samples`` (a periodic force's period); ``joint=False``: the linear part alone."""
+        force = np.asarray(force, float)
+        drive = _Drive(self, force, fs_hz, warmup_samples)
+        return drive.outputs(self.joint if joint else None)
+
+    def predict(self, recording, file: str | None = None) -> Prediction:
+        """Simulate a recording's force through the model and compare with its responses (SPEC §11)."""
+        name = file or str(recording.meta.get("source", "recording"))
+        missing = [c for c in self.channels if c not in recording.channels]
+        if missing or "force" not in recording.channels:
+            raise DataError(f"{name}: no channel {', '.join(missing or ['force'])} (the model predicts "
+                            f"{', '.join(self.channels)} from the force)")
+        force = np.asarray(recording["force"], float)
+        measured = np.array([np.asarray(recording[c], float) for c in self.channels])
+        if not (np.all(np.isfinite(force)) and np.all(np.isfinite(measured))):
+            raise DataError(f"{name}: NaN or inf in the force or a response")
+        warm = warmup_of(recording)
+        drive = _Drive(self, force, float(recording.fs_hz), warm)
+        lin = drive.outputs(None)
+        nl = drive.outputs(self.joint) if self.joint is not None else lin
+        level = float(np.sqrt(np.mean((force - force.mean()) ** 2)))
+        lo, hi = self.levels
+        return Prediction(name, level, bool(level < lo * 0.98 or level > hi * 1.02), self.channels,
+                          [nrmse(s, m) for s, m in zip(nl, measured)], [nrmse(s, m) for s, m in zip(lin, measured)],
+                          float(recording.fs_hz), {c: np.array([m, a, b]) for c, m, a, b in zip(self.channels, measured, lin, nl)})
+
+    def to_dict(self) -> dict:
+        return {"schema": SCHEMA, "channels": list(self.channels), "units": dict(self.units),
+                "levels": [float(x) for x in self.levels], "driving_point": self.driving_point,
+                "oversample": int(self.oversample),
+                "linear": self.linear.to_dict(),
+                "reference": None if self.reference is None else self.reference.to_dict(),
+                "joint": None if self.joint is None else self.joint.to_dict(), "fit": self.fit}
+
+    def save(self, path) -> None:
+        """Write the model as JSON (never pickle), atomically."""
+        from ..io.atomic import atomic_write
+
+        with atomic_write(path, "w") as fh:
+            fh.write(json.dumps(self.to_dict(), indent=1))
+
+    @classmethod
+    def from_dict(cls, d: dict) -> "StructureModel":
+        if d.get("schema") != SCHEMA:
+            raise DataError(f"not a structure model (schema {d.get('schema')!r}, expected {SCHEMA!r})")
+        return cls(LinearStructure.from_dict(d["linear"]), None if d.get("joint") is None else Joint.from_dict(d["joint"]),
+                   tuple(d["levels"]), d.get("fit", {}), d.get("units", {"force": "N", "response": "m/s²"}),
+                   d.get("driving_point"), int(d.get("oversample", 4)),
+                   None if d.get("reference") is None else LinearStructure.from_dict(d["reference"]))
+
+    @classmethod
+    def load(cls, path) -> "StructureModel":
+        """Read a model written by `save`."""
+        try:
+            with open(path, encoding="utf-8") as fh:
+                d = json.load(fh)
+        except json.JSONDecodeError as exc:
+            raise DataError(f"{path}: not JSON ({exc.msg} at line {exc.lineno})") from None
+        try:
+            return cls.from_dict(d)
+        except (KeyError, TypeError, ValueError) as exc:
+            raise DataError(f"{path}: a structure model with a missing or malformed field ({exc})") from None
+
+    def report(self) -> str:
+        lines = [f"structure model: channels {', '.join(self.channels)}, {self.linear.poles.size} poles, "
+                 f"fitted at {self.levels[0]:.4g}–{self.levels[1]:.4g} N RMS"]
+        if self.joint is None:
+            lines.append("no joint: linear at every level")
+        else:
+            a, b = self.joint.between
+            unit = " N" if self.joint.units == "N" else " (relative: no driving point fixes its scale)"
+            lines.append(f"joint between {a} and {b}: {self.joint.law}, force {self.joint.formula()}{unit}")
+        if self.fit:
+            lines.append("NRMSE (" + ", ".join(self.fit["channels"]) + "): linear → with the joint")
+            for f, lin, nl in zip(self.fit["files"], self.fit["linear"], self.fit["nonlinear"]):
+                lines.append(f"  {f}: " + ", ".join(f"{a:.3f} → {b:.3f}" for a, b in zip(lin, nl)))
+        return "\n".join(lines)
+
+
+def nrmse(simulated, measured) -> float:
+    """RMS of the simulation's error over the RMS of the measured output (about its mean)."""
+    m = np.asarray(measured, float)
+    scale = float(np.sqrt(np.mean((m - m.mean()) ** 2))) or 1.0
+    return float(np.sqrt(np.mean((np.asarray(simulated, float) - m) ** 2)) / scale)
+
+
+def warmup_of(recording) -> int:
+    """Samples of warm-up before a recording: one period of a periodic force whose record starts in steady
+    state (no start-up transient in its first period), else none (from rest, as the record did)."""
+    from ..signal.excitation import excitation_of, received
+
+    try:
+        exc = excitation_of(received(recording))
+    except DataError:
+        return 0
+    steady_start = exc.kind == "periodic" and not exc.transient_periods
+    return int(exc.period_samples) if steady_start else 0
+
+
+class _Drive:
+    """One force through the model: the linear part's response and the pair's motion, computed once.
+
+    The joint's force runs at ``oversample`` times the sample rate (the force interpolated band-limited): a
+    stick-slip or a contact makes the force change faster than the record's samples follow, and a step at
+    the record's rate would smear it. Its response is then taken back to the record's samples."""
+
+    def __init__(self, model: StructureModel, force, fs_hz: float, warmup: int):
+        from ..physics.nonlinear.integrate import band_limited, upsample
+
+        self.model, self.fs, self.skip = model, float(fs_hz), int(warmup)
+        lin = model.linear
+        u = np.concatenate([force[force.size - warmup:], force]) if warmup else force
+        ub = band_limited(u, fs_hz)
+        self.linear = response(modal_states(ub, lin.poles, fs_hz), lin.residues) + lin.feedthrough[:, None] * u
+        ref = model.reference
+        self.base = self.linear if ref is None else (response(modal_states(ub, ref.poles, fs_hz), ref.residues)
+                                                     + ref.feedthrough[:, None] * u)
+        self.pair = None
+        if model.joint is not None:
+            self.r = r = max(1, int(model.oversample))
+            fine = r * fs_hz
+            uf = band_limited(upsample(u, r), fine) if r > 1 else band_limited(u, fs_hz)
+            x = modal_states(uf, lin.poles, fine)
+            self.psi, self.G0, self.G1 = discretise(lin.poles, fine)
+            self.pair = p = lin.pair_residues(*model.joint.between)
+            self.dF, self.vF = response(x, p / lin.poles ** 2), response(x, p / lin.poles)
+
+    def outputs(self, joint: Joint | None, step: int = 1) -> np.ndarray:
+        """(C, N) responses (every ``step``-th sample) with ``joint``, or (None) the linear model of the lowest
+        level (`StructureModel.reference`)."""
+        keep = slice(self.skip, None, step)
+        if joint is None:
+            return self.base[:, keep]
+        lin = self.model.linear
+        k = joint.coupling
+        pair = self.pair * k
+        g = joint_force(self.psi, self.G0, self.G1, 2 * pair / lin.poles ** 2, 2 * pair / lin.poles, self.dF, self.vF,
+                        law_named(joint.law).codes, np.asarray(joint.coefficients, float), np.asarray(joint.aux, float))
+        if not np.all(np.isfinite(g)):
+            return np.full_like(self.linear[:, keep], np.nan)
+        z = modal_states(g, lin.poles, self.fs * self.r)[:, ::self.r][:, keep]  # at the record's samples
+        column = lin.residues * k[None, :]
+        # a force at the joint's sensors moves them at once: the column's flat part Σ 2 Re(A/λ) (receptance ~ 1/s²)
+        direct = response(1.0 / lin.poles[:, None], column)[:, 0]
+        return self.linear[:, keep] + response(z, column) + direct[:, None] * g[::self.r][keep]

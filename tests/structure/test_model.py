@@ -1,0 +1,160 @@
+"""A structure's joint modelled in time and its unseen levels predicted (issue 47, SPEC §11), on the independent
+chain of `chain.py` (Runge-Kutta from Newton's law, no satmd code)."""
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+
+from satmd.errors import DataError
+from satmd.io import Recording
+from satmd.modal.rational import vector_fit, vector_fit_inputs
+from satmd.structure import Joint, LinearStructure, StructureModel, fit_structure
+from satmd.structure.kernel import _compiled, _pass, joint_force
+from satmd.structure.laws import LAWS
+from satmd.structure.linear import discretise, driving_point, fit_linear, modal_states, response
+from satmd.structure.model import _Drive, nrmse
+from satmd.structure.spectra import periodic_spectra
+from tests.structure.chain import simulate_chain
+
+CUBIC = 3e9  # N/m³ between masses 3 and 4
+
+
+@pytest.fixture(scope="module")
+def cubic_levels():
+    """Levels 1, 3 and 8 N RMS of the chain with a cubic joint between masses 3 and 4 (1 % noise)."""
+    return simulate_chain(joint=(2, 3), law=lambda d, v: CUBIC * d ** 3, levels=(1.0, 3.0, 8.0), seed=1)
+
+
+@pytest.fixture(scope="module")
+def cubic_model(cubic_levels):
+    return fit_structure([cubic_levels[0], cubic_levels[2]])
+
+
+def _known(poles, residues, feed, freq):
+    return LinearStructure(tuple(range(len(residues))), np.asarray(poles), np.asarray(residues), np.asarray(feed)).frf(freq)
+
+
+def test_vector_fit_recovers_a_rational_model_exactly():
+    f = np.linspace(2.0, 15.0, 200)
+    poles = np.array([-0.1 + 2j * np.pi * 4, -0.2 + 2j * np.pi * 7, -0.05 + 2j * np.pi * 11])
+    res = np.array([[1 + 2j, 3 - 1j, 0.5j], [-2 + 1j, 0.3, 1 - 1j]])
+    H = _known(poles, res, [0.1, -0.2], f)
+    p, r, d = vector_fit(f, H, n_pairs=3)
+    order = np.argsort(p.imag)
+    assert np.allclose(p[order], poles, rtol=1e-8)
+    assert np.allclose(r[:, order], res, rtol=1e-7) and np.allclose(d, [0.1, -0.2], atol=1e-9)
+
+
+def test_vector_fit_of_two_inputs_separates_their_paths():
+    """Outputs of a force and a second input at several 'levels' (other input spectra): both paths found."""
+    rng = np.random.default_rng(0)
+    f = np.linspace(2.0, 15.0, 150)
+    poles = np.array([-0.2 + 2j * np.pi * 5, -0.3 + 2j * np.pi * 9])
+    R = rng.standard_normal((2, 2, 2)) + 1j * rng.standard_normal((2, 2, 2))
+    blocks = []
+    for _ in range(3):
+        U = rng.standard_normal((2, f.size)) + 1j * rng.standard_normal((2, f.size))
+        Y = np.array([sum(_known(poles, R[o, i:i + 1], [0.0], f)[0] * U[i] for i in range(2)) for o in range(2)])
+        blocks.append((f, U, Y, np.ones_like(Y.real)))
+    p, r, d = vector_fit_inputs(blocks, 2)
+    order = np.argsort(p.imag)
+    assert np.allclose(p[order], poles, rtol=1e-7) and np.allclose(r[:, :, order], R, rtol=1e-6)
+
+
+def test_the_compiled_joint_pass_is_the_numpy_pass():
+    rng = np.random.default_rng(1)
+    poles = np.array([-1.0 + 30j, -2.0 + 70j])
+    psi, G0, G1 = discretise(poles, 400.0)
+    rd, rv = 1e-3 * (rng.standard_normal(2) + 1j), 1e-2 * (rng.standard_normal(2) + 1j)
+    dF, vF = 1e-3 * rng.standard_normal(2000), 1e-2 * rng.standard_normal(2000)
+    law_ = LAWS["friction"]
+    args = (psi, G0, G1, rd, rv, dF, vF, law_.codes, np.array([0.5, 20.0, 1.0]), np.array([1e-3, 1.0, 1.0]))
+    slow = _pass(*args)
+    if _compiled() is None:
+        pytest.skip("numba is not installed")
+    assert np.allclose(joint_force(*args), slow, rtol=1e-10, atol=1e-12)
+
+
+def test_the_linear_part_in_time_has_its_frf():
+    """A sine through the discretised modes (its samples interpolated band-limited, as a measured force is), after
+    its transient, has the amplitude and phase of the FRF."""
+    from satmd.physics.nonlinear.integrate import band_limited
+
+    lin = LinearStructure(("a",), np.array([-0.5 + 2j * np.pi * 6]), np.array([[0.3 - 0.8j]]), np.array([0.05]))
+    fs, f0 = 200.0, 7.3
+    t = np.arange(int(60 * fs)) / fs
+    u = np.cos(2 * np.pi * f0 * t)
+    y = response(modal_states(band_limited(u, fs), lin.poles, fs), lin.residues)[0] + lin.feedthrough[0] * u
+    H = lin.frf([f0])[0, 0]
+    late = (t > 40) & (t < 55)  # the transient gone, the record's end (where the interpolation stops) not reached
+    assert np.allclose(y[late], (H * np.exp(2j * np.pi * f0 * t[late])).real, atol=5e-4 * abs(H))
+
+
+def test_the_model_with_the_true_structure_reproduces_the_chain():
+    """The time model (modes, the joint's path by reciprocity, its implicit step) on the chain's own linear part
+    and its true cubic law: the chain's response at the top level to the noise's size (noise-free data)."""
+    levels = simulate_chain(joint=(2, 3), law=lambda d, v: CUBIC * d ** 3, levels=(8.0,), seed=1, noise=0.0)
+    bare = simulate_chain(joint=(2, 3), law=lambda d, v: 0 * d, levels=(1.0,), seed=1, noise=0.0)[0]
+    names = tuple(f"acc{i}" for i in range(1, 6))
+    lin = fit_linear(periodic_spectra(bare), names, ("acc3", "acc4"))
+    assert driving_point(lin) in (None, "acc1")
+    kappa = -lin.coupling("acc3", "acc4", "acc1")  # a force +g on acc4, −g on acc3
+    joint = Joint(("acc3", "acc4"), "cubic", np.array([CUBIC, 0.0, 0.0]), np.ones(3), kappa, "N")
+    model = StructureModel(lin, joint, (1.0, 8.0))
+    rec = levels[0]
+    drive = _Drive(model, np.asarray(rec["force"]), rec.fs_hz, 0)
+    measured = np.array([rec[c] for c in names])
+    linear = [nrmse(a, m) for a, m in zip(drive.outputs(None), measured)]
+    with_joint = [nrmse(a, m) for a, m in zip(drive.outputs(joint), measured)]
+    assert min(linear) > 0.025 and max(with_joint) < 0.01
+
+
+def test_a_fitted_model_predicts_a_level_it_never_saw(cubic_levels, cubic_model):
+    m = cubic_model
+    assert m.joint.between == ("acc3", "acc4") and m.joint.law == "cubic"
+    top = m.fit["nonlinear"][1]
+    assert max(top) < 0.02 < min(m.fit["linear"][1])  # 1 % noise; the linear model misses by 3-5 %
+    held = m.predict(cubic_levels[1], file="level 3")
+    assert not held.extrapolated and max(held.nrmse) < 0.016
+    assert m.joint.units == "N" and m.driving_point == "acc1"
+    assert 0.7 * CUBIC < m.joint.parameters()["d³"] < 1.3 * CUBIC  # in N/m³: reciprocity fixed the scale
+
+
+def test_a_level_outside_the_fitted_range_is_flagged(cubic_levels, cubic_model):
+    quiet = Recording(cubic_levels[0].fs_hz, {c: 0.5 * np.asarray(cubic_levels[0][c]) for c in cubic_levels[0].channels},
+                      meta={"source": "half"})
+    p = cubic_model.predict(quiet)
+    assert p.extrapolated and p.to_dict()["extrapolated"] is True
+
+
+def test_a_saved_model_loads_and_predicts_the_same(cubic_levels, cubic_model, tmp_path):
+    path = tmp_path / "model.json"
+    cubic_model.save(path)
+    doc = json.loads(path.read_text())
+    assert doc["schema"] == "satmd-structure-model/1" and doc["joint"]["between"] == ["acc3", "acc4"]
+    again = StructureModel.load(path)
+    assert again.predict(cubic_levels[1]).nrmse == pytest.approx(cubic_model.predict(cubic_levels[1]).nrmse, rel=1e-9)
+
+
+def test_bad_models_and_recordings_are_refused(cubic_levels, cubic_model, tmp_path):
+    bad = tmp_path / "bad.json"
+    bad.write_text('{"schema": "satmd-report/1"}')
+    with pytest.raises(DataError, match="not a structure model"):
+        StructureModel.load(bad)
+    broken = tmp_path / "broken.json"
+    broken.write_text("{")
+    with pytest.raises(DataError, match="not JSON"):
+        StructureModel.load(broken)
+    rec = cubic_levels[1]
+    fewer = Recording(rec.fs_hz, {c: rec[c] for c in ("force", "acc1", "acc2")}, meta={"source": "three.csv"})
+    with pytest.raises(DataError, match=r"three\.csv: no channel acc3, acc4, acc5"):
+        cubic_model.predict(fewer)
+
+
+def test_a_linear_structure_gets_a_linear_model_that_predicts_every_level():
+    recs = simulate_chain(joint=(2, 3), law=lambda d, v: 0.0 * d, levels=(1.0, 4.0), seed=5)
+    m = fit_structure(recs)
+    assert m.joint is None
+    assert max(max(r) for r in m.fit["linear"]) < 0.02  # 1 % noise
