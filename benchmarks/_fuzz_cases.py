@@ -74,6 +74,57 @@ def make_base(folder):
             warm = ["--warm-start", "1"] if kind != "supervised" else []
             assert main(["inverse", "train", "--kind", kind, "--epochs", "2", *warm, "--samples-per-pair", "1",
                          "--members", members, "--quiet", "--out", f"{folder}/{name}"]) == 0
+    make_structure_base(folder)
+
+
+def make_structure_base(folder):
+    """Two levels of a 4-mass chain with a cubic joint (`tests/structure/chain.py`) and its saved model."""
+    import contextlib
+    import sys
+    from pathlib import Path
+
+    root = Path(__file__).resolve().parents[1]
+    if str(root) not in sys.path:
+        sys.path.insert(0, str(root))
+    from satmd.cli import main
+    from satmd.io import Recording, save_recording
+    from tests.structure.chain import simulate_chain
+
+    low, high = simulate_chain(n=4, joint=(1, 2), law=lambda d, v: 3e9 * d ** 3, levels=(1.0, 8.0), periods=4, seed=3)
+    save_recording(low, f"{folder}/s1.csv")
+    save_recording(high, f"{folder}/s8.csv")
+    fewer = Recording(high.fs_hz, {c: high[c] for c in ("force", "acc1", "acc2", "acc4")}, meta={})
+    save_recording(fewer, f"{folder}/s8_no_acc3.csv")
+    more = Recording(high.fs_hz, {**{c: high[c] for c in high.channels}, "acc5": high["acc4"]}, meta={})
+    save_recording(more, f"{folder}/s8_acc5.csv")
+    quiet = io.StringIO()
+    with contextlib.redirect_stdout(quiet), contextlib.redirect_stderr(quiet):
+        assert main(["discover", f"{folder}/s1.csv", f"{folder}/s8.csv", "--save-model", f"{folder}/structure.json"]) == 0
+
+
+def structure_cases(base) -> list[dict]:
+    """Issue 47: a structure's levels and its saved model, each hostile input refused naming the file and channel."""
+    cases = []
+    add = cases.append
+    add(case("structure levels", "cli", "refuse", ["s8_no_acc3.csv", "acc3"],
+             argv=["discover", "{base}/s1.csv", "{base}/s8_no_acc3.csv"]))
+    add(case("structure levels", "cli", "refuse", ["s8_acc5.csv", "acc5"],
+             argv=["discover", "{base}/s1.csv", "{base}/s8_acc5.csv"]))
+    add(case("structure levels", "cli", "refuse", ["--driving-point", "acc9"],
+             argv=["discover", "{base}/s1.csv", "{base}/s8.csv", "--save-model", "{work}/m.json",
+                   "--driving-point", "acc9"]))
+    add(case("structure levels", "cli", "refuse", ["s8_no_acc3.csv", "acc3"],
+             argv=["predict", "{base}/structure.json", "{base}/s8_no_acc3.csv"]))
+    add(case("structure levels", "cli", "answer", argv=["predict", "{base}/structure.json", "{base}/s8.csv", "--json"]))
+    model = json.loads(open(f"{base}/structure.json", encoding="utf-8").read())
+    for label, edit in (("no linear part", lambda d: d.pop("linear")), ("other schema", lambda d: d.update(schema="x")),
+                        ("poles not numbers", lambda d: d["linear"].update(poles="many")),
+                        ("a joint without a law", lambda d: d["joint"].pop("law"))):
+        bad = json.loads(json.dumps(model))
+        edit(bad)
+        add(case("structure levels", "cli", "refuse", ["bad.json"], argv=["predict", "{work}/bad.json", "{base}/s8.csv"],
+                 files={"bad.json": json.dumps(bad).encode()}, label=label))
+    return cases
 
 
 def _csv_with_comment(base_text: str, comment: str) -> bytes:
@@ -452,6 +503,7 @@ def generate(base) -> list[dict]:
         add(case("random damage", "api", "either", [name], op="load_frf" if name == "frf.csv" else "load_recording",
                  files={name: blob}, args=["{work}/" + name]))
     cases += issue38_cases(base)
+    cases += structure_cases(base)
     from _fuzz_excitation import cases as excitation_cases
 
     cases += excitation_cases(case)

@@ -85,5 +85,5 @@ __all__ = [
     "discover", "discover_many", "DiscoveryReport", "InverseModel", "tune", "TuneResult", "retune",
     "NonlinearElement", "nonlinear_element", "integrate", "register_nonlinear", "DataTypeError",
     "Recording", "load_recording", "save_recording", "estimate_frf", "fit_nonlinear", "NonlinearFit",
-    "tune_nonlinear", "fit_modes", "follow_modes",
+    "tune_nonlinear", "fit_modes", "follow_modes", "StructureModel", "fit_structure", "locate_joint",
 ]

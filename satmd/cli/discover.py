@@ -24,6 +24,9 @@ def register(sub):
     p.add_argument("--save-model", default=None, metavar="MODEL.json",
                    help="recordings of a structure at several levels: write its model (linear part and joint, "
                         "SPEC §11) for `satmd predict`")
+    p.add_argument("--driving-point", default=None, metavar="NAME",
+                   help="with --save-model: the channel at the shaker (default: found from its modal constants, or "
+                        "none); it fixes the joint's force in newtons")
     p.set_defaults(func=run)
 
 
@@ -36,11 +39,16 @@ def run(args):
 
     if args.save_model:
         check_outputs([("--save-model", args.save_model, (".json",))], inputs=[args.data, *args.more])
+    if args.driving_point and not args.save_model:
+        raise SatmdError("--driving-point applies to a structure's model: give --save-model too")
     free = parse_list(args.free) or DEFAULT_FREE
     candidates = parse_names(args.candidates, registered_names(), "--candidates") if args.candidates else None
     channels = parse_list(args.channels)
     if args.more:  # several recordings of one rig (issue 26)
         items = [_load_one(args, path) for path in (args.data, *args.more)]
+        if args.driving_point and hasattr(items[0], "fs_hz") and args.driving_point not in items[0].channels:
+            raise SatmdError(f"--driving-point {args.driving_point}: no such channel in {args.data} "
+                             f"(channels: {', '.join(c for c in items[0].channels if c != 'force')})")
         rep = discover(items, free=free, candidates=candidates, channels=channels, alpha=args.alpha)
     elif is_recording(args.data):  # the library's own path: estimate, discover, test linearity
         if args.plot:  # every output is checked before the first piece of work
@@ -56,7 +64,12 @@ def run(args):
         if rep.model is None:
             raise SatmdError("--save-model: no structure model was fitted (it needs recordings of one structure at "
                              "two or more levels, a periodic force and two or more response channels)")
-        rep.model.save(args.save_model)
+        model = rep.model
+        if args.driving_point:
+            from ..structure.fit import in_newtons
+
+            model = in_newtons(model, args.driving_point)
+        model.save(args.save_model)
     if args.plot:
         rep.plot(args.plot)
     if args.json:

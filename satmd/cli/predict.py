@@ -39,9 +39,7 @@ def run(args):
         except SatmdError as err:
             raise SatmdError(str(err) if str(path) in str(err) else f"{path}: {err}") from None
     if args.plot:
-        from ..structure.figures import prediction_figure
-
-        prediction_figure(out[0], args.plot)
+        out[0].plot(args.plot)
     if args.json:
         print(dumps_json({"schema": PREDICTION_SCHEMA, "recordings": [p.to_dict() for p in out]}, "predict", indent=2))
     else:

@@ -14,6 +14,8 @@ import numpy as np
 
 from ..errors import DataError
 
+MIN_ZETA = 1e-3  # the least damping ratio of a fitted pole
+
 
 def _columns(s, poles) -> np.ndarray:
     """(M, 2K) complex columns whose real coefficients (p, q) give (p + iq)/(s − λ) + (p − iq)/(s − λ*)."""
@@ -22,9 +24,9 @@ def _columns(s, poles) -> np.ndarray:
     return np.stack([a + b, 1j * (a - b)], axis=2).reshape(s.size, -1)
 
 
-def _stack(X, y=None):
-    X = np.vstack([X.real, X.imag])
-    return X if y is None else (X, np.concatenate([y.real, y.imag]))
+def _stack(X, y):
+    """(rows, right-hand side) of a complex least-squares problem as a real one."""
+    return np.vstack([X.real, X.imag]), np.concatenate([y.real, y.imag])
 
 
 def _relocate(poles, sigma) -> np.ndarray:
@@ -42,7 +44,9 @@ def _relocate(poles, sigma) -> np.ndarray:
     for r1, r2 in zip(reals[0::2], reals[1::2]):  # two real zeros become one lightly separated pair
         upper.append(0.5 * (r1 + r2) + 0.5j * max(abs(r2 - r1), tol))
     z = np.array(upper, complex)
-    z = -np.maximum(np.abs(z.real), 1e-5 * np.abs(z)) + 1j * z.imag  # reflected into the stable half-plane
+    # reflected into the stable half-plane, and damped at least MIN_ZETA: a pole that sharp fits noise, and in a
+    # simulation with a joint it stores whatever the joint gives it
+    z = -np.maximum(np.abs(z.real), MIN_ZETA * np.abs(z)) + 1j * z.imag
     return np.sort_complex(z)
 
 
@@ -76,7 +80,7 @@ def vector_fit(freq_hz, frf, weight=None, n_pairs: int = 10, iterations: int = 1
         rows, rhs = [], []
         for h, w in zip(H, W):  # each channel's own residues projected out: R of [M, y] holds what σ sees
             M, y = _stack(np.hstack([P, np.ones((s.size, 1)), -h[:, None] * P]) * w[:, None], h * w)
-            R = np.linalg.qr(np.column_stack([M, y]), mode="r")
+            R = np.asarray(np.linalg.qr(np.column_stack([M, y]), mode="r"))
             rows.append(R[n_own:-1, n_own:-1])
             rhs.append(R[n_own:-1, -1])
         sigma = np.linalg.lstsq(np.vstack(rows), np.concatenate(rhs), rcond=None)[0]
@@ -84,7 +88,8 @@ def vector_fit(freq_hz, frf, weight=None, n_pairs: int = 10, iterations: int = 1
     P = np.hstack([_columns(s, poles), np.ones((s.size, 1))])
     residues, feed = [], []
     for h, w in zip(H, W):
-        c = np.linalg.lstsq(*_stack(P * w[:, None], h * w), rcond=None)[0]
+        A, b = _stack(P * w[:, None], h * w)
+        c = np.linalg.lstsq(A, b, rcond=None)[0]
         residues.append(c[0:-1:2] + 1j * c[1:-1:2])
         feed.append(float(c[-1]))
     return poles, np.array(residues), np.array(feed)
@@ -130,7 +135,7 @@ def vector_fit_inputs(blocks, n_pairs: int, iterations: int = 12, poles=None):
                 P = _columns(2j * np.pi * f, poles)
                 parts.append(np.column_stack([np.hstack([X, -Y[o][:, None] * P]) * W[o][:, None], Y[o] * W[o]]))
             M = np.vstack(parts)
-            R = np.linalg.qr(np.vstack([M.real, M.imag]), mode="r")
+            R = np.asarray(np.linalg.qr(np.vstack([M.real, M.imag]), mode="r"))
             n_own = own[0].shape[1]
             rows.append(R[n_own:-1, n_own:-1])
             rhs.append(R[n_own:-1, -1])
@@ -143,7 +148,8 @@ def vector_fit_inputs(blocks, n_pairs: int, iterations: int = 12, poles=None):
     for o in range(n_out):
         X = np.vstack([x * W[o][:, None] for x, (_, _, _, W) in zip(own, blocks)])
         y = np.concatenate([Y[o] * W[o] for _, _, Y, W in blocks])
-        c = np.linalg.lstsq(*_stack(X, y), rcond=None)[0].reshape(n_in, 2 * k + 1)
+        A, b = _stack(X, y)
+        c = np.linalg.lstsq(A, b, rcond=None)[0].reshape(n_in, 2 * k + 1)
         residues[o] = c[:, 0:2 * k:2] + 1j * c[:, 1:2 * k:2]
         feed[o] = c[:, -1]
     return poles, residues, feed

@@ -12,6 +12,7 @@ from .model import Joint, StructureModel, _Drive, nrmse, warmup_of
 from .spectra import periodic_spectra
 
 ALTERNATIONS = 30  # of the frequency-domain start (κ at fixed c, c at fixed κ)
+FIT_PERIODS = 3  # steady periods of a periodic test in the output-error fit
 STARTS = ("measured", "underlying")
 SHRINK = (1.0, 0.5, 0.25, 0.1, 0.03, 0.01, 0.0)  # scales of the start's joint tried until the loop is stable
 
@@ -71,11 +72,13 @@ def fit_structure(recordings, between=None, law: str | None = None, channels=Non
         model = StructureModel(linear, None, levels)
         return _with_table(model, recordings, files)
     between = tuple(between)
+    assert law is not None  # set with the place
     lw = law_named(law)
     d0, v0 = ref.scales(*between)
     aux = lw.auxes(d0, v0)
     reference = linear
-    measured = [np.array([np.asarray(r[ch], float) for ch in names]) for r in recordings]
+    span = [_fit_span(r) for r in recordings]
+    measured = [np.array([np.asarray(r[ch], float)[:n] for ch in names]) for r, n in zip(recordings, span)]
     fitted = []
     for start in starts:  # the lowest level as the linear part, or the structure under the joint: the better kept
         if start == "underlying":
@@ -85,15 +88,33 @@ def fit_structure(recordings, between=None, law: str | None = None, channels=Non
             linear, (c, kappa) = reference, _start(reference, spectra, between, lw, d0, v0)
         model = StructureModel(linear, Joint(between, law, c, aux, kappa), levels, reference=reference,
                                oversample=oversampling(linear, ref.fs_hz))
-        drives = [(_Drive(model, np.asarray(r["force"], float), float(r.fs_hz), warmup_of(r)), m)
-                  for r, m in zip(recordings, measured)]
+        drives = [(_Drive(model, np.asarray(r["force"], float)[:n], float(r.fs_hz), warmup_of(r)), m)
+                  for r, m, n in zip(recordings, measured, span)]
         say(f"output-error fit of the {law} joint between {between[0]} and {between[1]} on {len(recordings)} "
             f"recordings (from the {start} linear part) ...")
         model = _output_error(_stable(model, drives), drives, ref, max_nfev)
-        fitted.append((_cost(model, drives), len(fitted), model, drives))
-    _, _, model, drives = min(fitted)
-    model = _in_newtons(model, driving_point)
-    return _with_table(model, recordings, files, drives)
+        fitted.append(model)
+    # judged on the whole records: a model that slowly gathers energy shows it only over many periods
+    whole = [(_Drive(fitted[0], np.asarray(r["force"], float), float(r.fs_hz), warmup_of(r)),
+              np.array([np.asarray(r[ch], float) for ch in names])) for r in recordings]
+    model = min(fitted, key=lambda m: _cost(m, [(_redrive(d, m), y) for d, y in whole]))
+    model = in_newtons(model, driving_point)
+    return _with_table(model, recordings, files)
+
+
+def _fit_span(recording) -> int:
+    """Samples of a recording the output-error fit uses: a periodic force's first steady periods (the next ones
+    repeat them, to the noise), with the leading transient, else the whole record."""
+    from ..signal.excitation import excitation_of, received
+
+    n = len(recording["force"])
+    try:
+        exc = excitation_of(received(recording))
+    except DataError:
+        return n
+    if exc.kind != "periodic":
+        return n
+    return min(n, exc.period_samples * (FIT_PERIODS + int(exc.transient_periods or 0)))
 
 
 def oversampling(linear, fs_hz: float) -> int:
@@ -103,9 +124,15 @@ def oversampling(linear, fs_hz: float) -> int:
     return int(np.clip(np.ceil(16 * top / fs_hz), 1, 8))
 
 
+def _redrive(drive, model):
+    """``drive`` for another model (its own linear part), the same force."""
+    return drive if drive.model.linear is model.linear else _Drive(model, drive.force, drive.fs, drive.skip)
+
+
 def _cost(model, drives) -> float:
-    return float(sum(np.sum(((d.outputs(model.joint) - m) / m.std(axis=1, keepdims=True)) ** 2) / m.size
-                     for d, m in drives))
+    total = float(sum(np.sum(((d.outputs(model.joint) - m) / m.std(axis=1, keepdims=True)) ** 2) / m.size
+                      for d, m in drives))
+    return total if np.isfinite(total) else np.inf
 
 
 def _underlying_start(linear, spectra, between, lw, d0, v0, extra_pairs: int = 2):
@@ -143,7 +170,8 @@ def _underlying_start(linear, spectra, between, lw, d0, v0, extra_pairs: int = 2
                        for m, (f, F, G, A, W) in enumerate(data) for i in range(len(names))])
         y = np.concatenate([(A[i] - _model_frf(f, poles, res[i:i + 1, 0], feed[i:i + 1, 0])[0] * F) * W[i]
                             for f, F, G, A, W in data for i in range(len(names))])
-        c_new = np.linalg.lstsq(*_real(X, y), rcond=None)[0]
+        Xr, yr = _real(X, y)
+        c_new = np.linalg.lstsq(Xr, yr, rcond=None)[0]
         c = c_new / (abs(c_new[0]) or 1.0)
     blocks = [(f, np.array([F, c @ G]), A, W) for f, F, G, A, W in data]
     poles, res, feed = vector_fit_inputs(blocks, k, iterations=6, poles=poles)
@@ -249,7 +277,7 @@ def _output_error(model, drives, ref, max_nfev) -> StructureModel:
     return replace(model, joint=unpack(best))
 
 
-def _in_newtons(model, driving_point=None) -> StructureModel:
+def in_newtons(model, driving_point=None) -> StructureModel:
     """The joint with its path scaled as reciprocity says (κ_r = −(A_ar − A_br)/A_dr for a driving point d),
     so that its coefficients are forces; the simulation is unchanged (c s, κ / s). As it was when there is no
     driving point or the fitted path does not follow the modes' shapes (a misfit over 30 %)."""
@@ -257,11 +285,11 @@ def _in_newtons(model, driving_point=None) -> StructureModel:
     from .linear import driving_point as found
 
     lin, j = model.linear, model.joint
+    if driving_point is not None and driving_point not in lin.channels:
+        raise DataError(f"driving point {driving_point}: no such channel (channels: {', '.join(lin.channels)})")
     d = driving_point or found(lin)
-    if d is None:
-        return model
-    if d not in lin.channels:
-        raise DataError(f"the driving point {d!r} is not a channel ({', '.join(lin.channels)})")
+    if d is None or j is None:
+        return model if d is None else replace(model, driving_point=d)
     phys = -lin.coupling(*j.between, d)
     w = np.abs(lin.residues[lin.index(d)] / lin.poles ** 2)  # each mode's weight at the driving point
     w = np.where(w > 0.05 * w.max(), w, 0.0)  # the structure's modes, not the poles that only shape the fit

@@ -20,6 +20,11 @@ from ..errors import DataError
 
 #: term name -> code of `term`
 TERM_CODES = {"d": 0, "v": 1, "d³": 2, "d|d|": 3, "contact": 4, "sign(v)": 5, "v|v|": 6, "d²": 7, "v³": 8}
+#: term name -> the name of its coefficient in a model's parameters (force per term unit)
+TERM_PARAMETERS = {"d": "k", "v": "c", "d³": "k3", "d|d|": "k_soft", "contact": "k_contact", "sign(v)": "f_slip",
+                   "v|v|": "c2", "d²": "k2", "v³": "c3"}
+#: term name -> the name of its shape constant
+SHAPE_PARAMETERS = {"contact": "gap", "sign(v)": "v_slip"}
 FRICTION_SMOOTHING = 0.05  # a Coulomb force smoothed over 5 % of the reference velocity's RMS
 
 

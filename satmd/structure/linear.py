@@ -89,7 +89,7 @@ def fit_linear(spectra, channels, between=None, n_pairs=None) -> LinearStructure
     channels : the response channels, in order
     between : (a, b) a joint's pair: the fit is made on the channels with ``a`` replaced by ``a − b``, so that
         the pair's relative motion (a small difference of large signals) is as accurate as each channel
-    n_pairs : pole pairs (default: from 2 up, one more while it cuts the error by 10 %, at most 24)
+    n_pairs : pole pairs (default: the fewest, from 2 to 24, whose error is within 1.5 times the best)
 
     Returns
     -------
@@ -106,17 +106,16 @@ def fit_linear(spectra, channels, between=None, n_pairs=None) -> LinearStructure
     if ib is not None:
         fitted[ia] = H[ia] - H[ib]
     weight = np.abs(spectra.force)[None, :] / np.abs(fitted).mean(axis=1, keepdims=True)  # the response's error
-    best, worse = None, 0
+    fits = []
     for k in ([n_pairs] if n_pairs else _pair_counts(f)):
         poles, res, feed = vector_fit(f, fitted, weight, k)
         err = float(np.sqrt(np.mean([np.sum(np.abs((LinearStructure(names, poles, res, feed).frf(f) - fitted) * w) ** 2)
                                       / np.sum(np.abs(h * w) ** 2) for h, w in zip(fitted, weight)])))
-        if best is None or err < 0.9 * best[0]:
-            best, worse = (err, poles, res, feed), 0
-        else:
-            worse += 1
-            if worse == 2:  # two more pole pairs bought less than 10 % each: the data hold no more
-                break
+        fits.append((err, poles, res, feed))
+    least = min(e for e, *_ in fits)
+    # the fewest poles within half again of the best fit: more fit noise and distortion, and every pole is a
+    # path the joint's fit has to find
+    best = next(x for x in fits if x[0] <= 1.5 * least)
     _, poles, res, feed = best
     if ib is not None:  # back to the sensors' own channels
         res, feed = res.copy(), feed.copy()

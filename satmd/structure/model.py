@@ -65,13 +65,12 @@ class Joint:
         return law_named(self.law).all_terms
 
     def parameters(self) -> dict:
-        """{term: coefficient} and the shape constants (``gap``, ``friction_velocity``) by name."""
-        out = {t: float(c) for t, c in zip(self.terms, self.coefficients)}
-        for t, a in zip(self.terms, self.aux):
-            if t == "contact":
-                out["gap"] = float(a)
-            if t == "sign(v)":
-                out["friction_velocity"] = float(a)
+        """Each term's coefficient by its name (``k3`` of d³, ``k_contact``, ``f_slip`` ...; ``k`` and ``c`` the
+        change of the joint's linear stiffness and damping) and the shape constants (``gap``, ``v_slip``)."""
+        from .laws import SHAPE_PARAMETERS, TERM_PARAMETERS
+
+        out = {TERM_PARAMETERS[t]: float(c) for t, c in zip(self.terms, self.coefficients)}
+        out |= {SHAPE_PARAMETERS[t]: float(a) for t, a in zip(self.terms, self.aux) if t in SHAPE_PARAMETERS}
         return out
 
     def formula(self) -> str:
@@ -109,6 +108,12 @@ class Prediction:
         return {"file": self.file, "level": round(self.level, 6), "extrapolated": self.extrapolated,
                 "channels": list(self.channels), "nrmse": [round(x, 4) for x in self.nrmse],
                 "linear_nrmse": [round(x, 4) for x in self.linear_nrmse]}
+
+    def plot(self, path, title: str = ""):
+        """Measured, linear and nonlinear responses, time and spectrum (`figures.prediction_figure`)."""
+        from .figures import prediction_figure
+
+        return prediction_figure(self, path, title)
 
     def report(self) -> str:
         flag = " (extrapolated: outside the fitted levels)" if self.extrapolated else ""
@@ -257,7 +262,7 @@ class _Drive:
     def __init__(self, model: StructureModel, force, fs_hz: float, warmup: int):
         from ..physics.nonlinear.integrate import band_limited, upsample
 
-        self.model, self.fs, self.skip = model, float(fs_hz), int(warmup)
+        self.model, self.fs, self.skip, self.force = model, float(fs_hz), int(warmup), force
         lin = model.linear
         u = np.concatenate([force[force.size - warmup:], force]) if warmup else force
         ub = band_limited(u, fs_hz)

@@ -181,7 +181,8 @@ def with_joint(report, recordings):
         parameters = model.joint.parameters()
         worst_lin = max(max(r) for r in model.fit["linear"])
         worst_nl = max(max(r) for r in model.fit["nonlinear"])
-        explanation += (f"; modelled ({model.joint.formula()}), simulated from each force the worst NRMSE goes "
+        unit = " N" if model.joint.units == "N" else ", relative units: no driving point fixes the scale"
+        explanation += (f"; modelled ({model.joint.formula()}{unit}), simulated from each force the worst NRMSE goes "
                         f"from {worst_lin:.2f} (linear) to {worst_nl:.2f}")
     old = report.findings[0]
     joint = NonlinearFinding("joint", between=[a, b], location=loc.location, law=loc.law, parameters=parameters or {},

@@ -1,0 +1,56 @@
+"""`satmd discover ... --save-model` and `satmd predict` (issue 47, SPEC §11) on the independent chain."""
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+
+from satmd.io import save_recording
+from tests.structure.chain import simulate_chain
+
+from ._cli import refused, run
+
+
+@pytest.fixture(scope="module")
+def levels(tmp_path_factory):
+    d = tmp_path_factory.mktemp("structure")
+    recs = simulate_chain(joint=(2, 3), law=lambda dd, v: 3e9 * dd ** 3, levels=(1.0, 3.0, 8.0), seed=1)
+    for r, name in zip(recs, ("L1", "L3", "L8")):
+        save_recording(r, d / f"{name}.csv")
+    return d
+
+
+def test_discover_saves_the_model_and_predict_judges_a_level_it_never_saw(capsys, levels, tmp_path):
+    model = tmp_path / "structure.json"
+    rc, out, err = run(capsys, "discover", levels / "L1.csv", levels / "L8.csv", "--save-model", model, "--json")
+    assert rc == 0, err
+    joint = json.loads(out)["nonlinear"]["findings"][0]
+    assert joint["name"] == "joint" and joint["between"] == ["acc3", "acc4"]
+    assert joint["fit"]["metric"] == "nrmse" and len(joint["fit"]["nonlinear"]) == 2
+    assert max(joint["fit"]["nonlinear"][1]) < max(joint["fit"]["linear"][1])
+    assert "k3" in joint["parameters"]
+    rc, out, err = run(capsys, "predict", model, levels / "L3.csv", "--json", "--plot", tmp_path / "L3.png")
+    assert rc == 0, err
+    doc = json.loads(out)
+    assert doc["schema"] == "satmd-prediction/1"
+    (p,) = doc["recordings"]
+    assert p["channels"] == [f"acc{i}" for i in range(1, 6)] and p["extrapolated"] is False
+    assert max(p["nrmse"]) < 0.016 and np.isfinite(p["linear_nrmse"]).all()
+    assert (tmp_path / "L3.png").stat().st_size > 0
+    rc, out, err = run(capsys, "predict", model, levels / "L3.csv")
+    assert rc == 0 and "NRMSE acc1" in out
+
+
+def test_predict_refuses_what_it_cannot_use(capsys, levels, tmp_path):
+    not_model = tmp_path / "not_model.json"
+    not_model.write_text('{"schema": "satmd-report/1"}')
+    refused(capsys, "predict", not_model, levels / "L3.csv", says=("not a structure model",))
+    refused(capsys, "predict", levels / "missing.json", levels / "L3.csv", says=("missing.json",))
+
+
+def test_save_model_needs_a_structure(capsys, levels, tmp_path):
+    """One recording of one level: no structure model to save; said in one line, nothing written."""
+    out = tmp_path / "m.json"
+    refused(capsys, "discover", levels / "L1.csv", "--save-model", out, says=("--save-model",), alone=False)
+    assert not out.exists()
