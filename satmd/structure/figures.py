@@ -1,24 +1,33 @@
-"""The figure of a located joint: the sensors, the joint drawn between two of them, the evidence per place."""
+"""Figures of a structure: where its joint acts (the sensors, the joint between two, the evidence per place), and a
+prediction (measured, linear and nonlinear responses in time and spectrum)."""
 from __future__ import annotations
 
 import numpy as np
 
+from ..conventions import TINY
+
 
 def joint_figure(location, path, title: str = ""):
-    """Draw ``location`` (a `JointLocation`) into ``path``: left, the sensors in a row above the ground with the
+    """`draw_joint` saved into ``path`` (its suffix sets the format); returns the Path."""
+    from ..plots import save
+
+    return save(draw_joint(location, title), path)
+
+
+def draw_joint(location, title: str = ""):
+    """The figure of ``location`` (a `JointLocation`): left, the sensors in a row above the ground with the
     joint between its two (equally supported places dashed); right, ΔBIC of every place to the best.
 
     Parameters
     ----------
     location : JointLocation
-    path : the image file (its suffix sets the format)
     title : a title above both panels
 
     Returns
     -------
-    Path
+    matplotlib Figure
     """
-    from ..plots import pyplot, save
+    from ..plots import pyplot
 
     plt = pyplot()
     sensors = sorted({c for e in location.location for c in e["between"] if c != "ground"},
@@ -65,10 +74,17 @@ def joint_figure(location, path, title: str = ""):
     if title:
         fig.suptitle(title)
     fig.tight_layout()
-    return save(fig, path)
+    return fig
 
 
 def prediction_figure(prediction, path, title: str = ""):
+    """`draw_prediction` saved into ``path`` (its suffix sets the format); returns the Path."""
+    from ..plots import save
+
+    return save(draw_prediction(prediction, title), path)
+
+
+def draw_prediction(prediction, title: str = ""):
     """Measured, linear and nonlinear responses of one recording (a `Prediction`): per channel, a second of the
     time history (top) and the spectrum of the whole record (bottom, log scale: what the model puts above the
     excited band, the harmonics, is seen there).
@@ -76,14 +92,13 @@ def prediction_figure(prediction, path, title: str = ""):
     Parameters
     ----------
     prediction : Prediction (with its signals)
-    path : the image file (its suffix sets the format)
     title : a title (default: the file and its NRMSE)
 
     Returns
     -------
-    Path
+    matplotlib Figure
     """
-    from ..plots import pyplot, save
+    from ..plots import pyplot
 
     plt = pyplot()
     names = list(prediction.channels)
@@ -99,7 +114,7 @@ def prediction_figure(prediction, path, title: str = ""):
         freq = np.fft.rfftfreq(n, 1.0 / fs)
         for k, (label, style) in enumerate(zip(labels, styles)):
             axes[0, j].plot(t, sig[k][show], label=label, **style)
-            axes[1, j].semilogy(freq, np.abs(np.fft.rfft(sig[k] - sig[k].mean())) / n + 1e-300, **style)
+            axes[1, j].semilogy(freq, np.abs(np.fft.rfft(sig[k] - sig[k].mean())) / n + TINY, **style)
         axes[0, j].set_title(f"{c}: NRMSE {prediction.nrmse[j]:.3f} (linear {prediction.linear_nrmse[j]:.3f})",
                              fontsize=9)
         axes[0, j].set_xlabel("time [s]")
@@ -111,11 +126,11 @@ def prediction_figure(prediction, path, title: str = ""):
     flag = " (extrapolated)" if prediction.extrapolated else ""
     fig.suptitle(title or f"{prediction.file}: force {prediction.level:.3g} N RMS{flag}", fontsize=10)
     fig.tight_layout()
-    return save(fig, path)
+    return fig
 
 
 def _band_top(x, fs) -> float:
     """The frequency below which 99 % of a signal's power lies (to frame the spectrum with its harmonics)."""
     p = np.abs(np.fft.rfft(x - np.mean(x))) ** 2
-    cum = np.cumsum(p) / max(p.sum(), 1e-300)
+    cum = np.cumsum(p) / max(p.sum(), TINY)
     return float(np.fft.rfftfreq(x.size, 1.0 / fs)[min(int(np.searchsorted(cum, 0.99)), p.size - 1)]) or fs / 8

@@ -1,14 +1,17 @@
 """`fit_structure`: a `StructureModel` from recordings of one structure at several levels (see `model`)."""
 from __future__ import annotations
 
-import numpy as np
-
 from dataclasses import replace
 
+import numpy as np
+
+from ..conventions import TINY
 from ..errors import DataError
+from ..validation import NAMES, Interval, Options, Whole, validate_params
+from .laws import LAWS
 from .laws import law as law_named
 from .linear import LinearStructure, fit_linear
-from .model import Joint, StructureModel, _Drive, nrmse, warmup_of
+from .model import Drive, Joint, StructureModel, nrmse, warmup_of
 from .spectra import periodic_spectra
 
 ALTERNATIONS = 30  # of the frequency-domain start (κ at fixed c, c at fixed κ)
@@ -17,6 +20,9 @@ STARTS = ("measured", "underlying")
 SHRINK = (1.0, 0.5, 0.25, 0.1, 0.03, 0.01, 0.0)  # scales of the start's joint tried until the loop is stable
 
 
+@validate_params({"between": [None, NAMES], "law": [None, Options(tuple(LAWS))], "channels": [None, NAMES],
+                  "n_pairs": [None, Interval(Whole, 1, 24)], "max_nfev": [Interval(Whole, 1)],
+                  "driving_point": [None, str], "starts": [NAMES]})
 def fit_structure(recordings, between=None, law: str | None = None, channels=None, n_pairs: int | None = None,
                   max_nfev: int = 40, files=None, driving_point: str | None = None, starts=STARTS,
                   progress=None) -> StructureModel:
@@ -88,14 +94,14 @@ def fit_structure(recordings, between=None, law: str | None = None, channels=Non
             linear, (c, kappa) = reference, _start(reference, spectra, between, lw, d0, v0)
         model = StructureModel(linear, Joint(between, law, c, aux, kappa), levels, reference=reference,
                                oversample=oversampling(linear, ref.fs_hz))
-        drives = [(_Drive(model, np.asarray(r["force"], float)[:n], float(r.fs_hz), warmup_of(r)), m)
+        drives = [(Drive(model, np.asarray(r["force"], float)[:n], float(r.fs_hz), warmup_of(r)), m)
                   for r, m, n in zip(recordings, measured, span)]
         say(f"output-error fit of the {law} joint between {between[0]} and {between[1]} on {len(recordings)} "
             f"recordings (from the {start} linear part) ...")
         model = _output_error(_stable(model, drives), drives, ref, max_nfev)
         fitted.append(model)
     # judged on the whole records: a model that slowly gathers energy shows it only over many periods
-    whole = [(_Drive(fitted[0], np.asarray(r["force"], float), float(r.fs_hz), warmup_of(r)),
+    whole = [(Drive(fitted[0], np.asarray(r["force"], float), float(r.fs_hz), warmup_of(r)),
               np.array([np.asarray(r[ch], float) for ch in names])) for r in recordings]
     model = min(fitted, key=lambda m: _cost(m, [(_redrive(d, m), y) for d, y in whole]))
     model = in_newtons(model, driving_point)
@@ -126,7 +132,7 @@ def oversampling(linear, fs_hz: float) -> int:
 
 def _redrive(drive, model):
     """``drive`` for another model (its own linear part), the same force."""
-    return drive if drive.model.linear is model.linear else _Drive(model, drive.force, drive.fs, drive.skip)
+    return drive if drive.model.linear is model.linear else Drive(model, drive.force, drive.fs, drive.skip)
 
 
 def _cost(model, drives) -> float:
@@ -156,7 +162,7 @@ def _underlying_start(linear, spectra, between, lw, d0, v0, extra_pairs: int = 2
         if ib is not None:
             A[ia] = A[ia] - A[ib]
         G = np.array([s.at_lines(t) for t in lw.columns(*s.relative(*between), d0, v0)])
-        W = np.repeat(1.0 / np.maximum(np.abs(A).mean(axis=1, keepdims=True), 1e-300), A.shape[1], axis=1)
+        W = np.repeat(1.0 / np.maximum(np.abs(A).mean(axis=1, keepdims=True), TINY), A.shape[1], axis=1)
         data.append((s.freq_hz, s.force, G, A, W))
     c = np.zeros(len(lw.all_terms))
     c[0] = 1.0
@@ -180,7 +186,7 @@ def _underlying_start(linear, spectra, between, lw, d0, v0, extra_pairs: int = 2
         R[ia] += R[ib]
         D[ia] += D[ib]
         T[ia] += T[ib]
-    kappa = np.sum(R.conj() * T, axis=0) / np.maximum(np.sum(np.abs(R) ** 2, axis=0), 1e-300)
+    kappa = np.sum(R.conj() * T, axis=0) / np.maximum(np.sum(np.abs(R) ** 2, axis=0), TINY)
     return LinearStructure(names, poles, R, D), c, kappa
 
 
@@ -206,7 +212,7 @@ def _start(linear, spectra, between, lw, d0, v0):
             a = linear.residues[i][None, :] / (iw - lam[None, :])
             b = linear.residues[i].conj()[None, :] / (iw - lam.conj()[None, :])
             cols = np.stack([a + b, 1j * (a - b)], axis=2).reshape(f.size, -1)  # real (Re κ, Im κ) per mode
-            w = 1.0 / max(float(np.mean(np.abs(s.responses[c]))), 1e-300)
+            w = 1.0 / max(float(np.mean(np.abs(s.responses[c]))), TINY)
             blocks.append((cols * w, G, (s.responses[c] - H[i] * s.force) * w))
     y = np.concatenate([e for _, _, e in blocks])
     y = np.concatenate([y.real, y.imag])
@@ -293,8 +299,8 @@ def in_newtons(model, driving_point=None) -> StructureModel:
     phys = -lin.coupling(*j.between, d)
     w = np.abs(lin.residues[lin.index(d)] / lin.poles ** 2)  # each mode's weight at the driving point
     w = np.where(w > 0.05 * w.max(), w, 0.0)  # the structure's modes, not the poles that only shape the fit
-    s = float(np.sum(w * (j.coupling * phys.conj()).real) / max(np.sum(w * np.abs(phys) ** 2), 1e-300))
-    misfit = np.sqrt(np.sum(w * np.abs(j.coupling - s * phys) ** 2) / max(np.sum(w * np.abs(j.coupling) ** 2), 1e-300))
+    s = float(np.sum(w * (j.coupling * phys.conj()).real) / max(np.sum(w * np.abs(phys) ** 2), TINY))
+    misfit = np.sqrt(np.sum(w * np.abs(j.coupling - s * phys) ** 2) / max(np.sum(w * np.abs(j.coupling) ** 2), TINY))
     if not np.isfinite(s) or s == 0 or misfit > 0.3:
         return model
     return replace(model, joint=replace(j, coefficients=j.coefficients * s, coupling=j.coupling / s, units="N"),
@@ -306,7 +312,7 @@ def _with_table(model, recordings, files, drives=None) -> StructureModel:
     lin, nl = [], []
     for i, r in enumerate(recordings):
         if drives is None:
-            drive = _Drive(model, np.asarray(r["force"], float), float(r.fs_hz), warmup_of(r))
+            drive = Drive(model, np.asarray(r["force"], float), float(r.fs_hz), warmup_of(r))
             measured = np.array([np.asarray(r[c], float) for c in model.channels])
         else:
             drive, measured = drives[i]

@@ -30,6 +30,7 @@ import numpy as np
 
 from ..conventions import TINY
 from ..errors import DataError
+from ..validation import NAMES, Band, validate_params
 from .laws import LAWS
 from .spectra import PeriodicSpectra, periodic_spectra
 
@@ -101,6 +102,7 @@ class JointLocation:
         return "\n".join(lines)
 
 
+@validate_params({"laws": [None, NAMES], "band_hz": [None, Band()], "channels": [None, NAMES]})
 def locate_joint(recordings, laws=None, band_hz=None, channels=None) -> JointLocation:
     """Between which two sensors a joint acts and which law it follows, from recordings at several levels.
 

@@ -93,7 +93,8 @@ class Joint:
 class Prediction:
     """A model's simulation of one recording: NRMSE per channel, nonlinear and linear (SPEC §11).
 
-    ``signals`` holds the measured, linear and nonlinear responses {channel: (3, N)} for figures."""
+    ``signals`` holds the measured, linear and nonlinear responses {channel: (3, N)} for figures. ``diverged``:
+    the simulation with the joint ran away (the model is not stable at this level); its NRMSE is then inf."""
 
     file: str
     level: float
@@ -155,7 +156,7 @@ class StructureModel:
         """(C, N) accelerations simulated from rest with ``force`` (N samples) preceded by its last
         ``warmup_samples`` (a periodic force's period); ``joint=False``: the linear part alone."""
         force = np.asarray(force, float)
-        drive = _Drive(self, force, fs_hz, warmup_samples)
+        drive = Drive(self, force, fs_hz, warmup_samples)
         return drive.outputs(self.joint if joint else None)
 
     def predict(self, recording, file: str | None = None) -> Prediction:
@@ -170,13 +171,14 @@ class StructureModel:
         if not (np.all(np.isfinite(force)) and np.all(np.isfinite(measured))):
             raise DataError(f"{name}: NaN or inf in the force or a response")
         warm = warmup_of(recording)
-        drive = _Drive(self, force, float(recording.fs_hz), warm)
+        drive = Drive(self, force, float(recording.fs_hz), warm)
         lin = drive.outputs(None)
         nl = drive.outputs(self.joint) if self.joint is not None else lin
         level = float(np.sqrt(np.mean((force - force.mean()) ** 2)))
         lo, hi = self.levels
         return Prediction(name, level, bool(level < lo * 0.98 or level > hi * 1.02), self.channels,
-                          [nrmse(s, m) for s, m in zip(nl, measured)], [nrmse(s, m) for s, m in zip(lin, measured)],
+                          [_finite_nrmse(s, m) for s, m in zip(nl, measured)],
+                          [nrmse(s, m) for s, m in zip(lin, measured)],
                           float(recording.fs_hz), {c: np.array([m, a, b]) for c, m, a, b in zip(self.channels, measured, lin, nl)})
 
     def to_dict(self) -> dict:
@@ -239,6 +241,11 @@ def nrmse(simulated, measured) -> float:
     return float(np.sqrt(np.mean((np.asarray(simulated, float) - m) ** 2)) / scale)
 
 
+def _finite_nrmse(simulated, measured) -> float:
+    value = nrmse(simulated, measured)
+    return value if np.isfinite(value) else float("inf")
+
+
 def warmup_of(recording) -> int:
     """Samples of warm-up before a recording: one period of a periodic force whose record starts in steady
     state (no start-up transient in its first period), else none (from rest, as the record did)."""
@@ -252,7 +259,7 @@ def warmup_of(recording) -> int:
     return int(exc.period_samples) if steady_start else 0
 
 
-class _Drive:
+class Drive:
     """One force through the model: the linear part's response and the pair's motion, computed once.
 
     The joint's force runs at ``oversample`` times the sample rate (the force interpolated band-limited): a

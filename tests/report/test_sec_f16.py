@@ -14,3 +14,15 @@ def test_f16_section_reads_the_levels_and_names_no_element(tmp_path):
     row = next(line for line in text.splitlines() if line.startswith("| 7.32 Hz"))
     assert row.rstrip().endswith("| softening | rising |")
     assert (tmp_path / "r" / "figures" / "f16_levels.png").is_file()
+
+
+@needs_real("f16", "F16Data_FullMSine_Level5.mat")
+def test_structure_section_places_models_and_predicts_the_f16(tmp_path):
+    """Quick: the joint located, a short fit on levels 1, 3, 7, level 5 predicted better than the linear model."""
+    index = reproduce(tmp_path / "r", only=["structure"], quick=True, log=lambda *_: None)
+    text = index.read_text()
+    assert "between acc2 and acc3" in text
+    row = next(line for line in text.splitlines() if line.startswith("| **level 5 (never seen)**"))
+    pairs = [cell.strip("* ").split(" → ") for cell in row.split("|")[2:-1]]
+    assert len(pairs) == 3 and all(float(b) < float(a) for a, b in pairs)  # better than linear on every channel
+    assert (tmp_path / "r" / "figures" / "structure_level5.png").is_file()

@@ -14,7 +14,7 @@ from satmd.structure import Joint, LinearStructure, StructureModel, fit_structur
 from satmd.structure.kernel import _compiled, _pass, joint_force
 from satmd.structure.laws import LAWS
 from satmd.structure.linear import discretise, driving_point, fit_linear, modal_states, response
-from satmd.structure.model import _Drive, nrmse
+from satmd.structure.model import Drive, nrmse
 from satmd.structure.spectra import periodic_spectra
 from tests.structure.chain import simulate_chain
 
@@ -104,7 +104,7 @@ def test_the_model_with_the_true_structure_reproduces_the_chain():
     joint = Joint(("acc3", "acc4"), "cubic", np.array([CUBIC, 0.0, 0.0]), np.ones(3), kappa, "N")
     model = StructureModel(lin, joint, (1.0, 8.0))
     rec = levels[0]
-    drive = _Drive(model, np.asarray(rec["force"]), rec.fs_hz, 0)
+    drive = Drive(model, np.asarray(rec["force"]), rec.fs_hz, 0)
     measured = np.array([rec[c] for c in names])
     linear = [nrmse(a, m) for a, m in zip(drive.outputs(None), measured)]
     with_joint = [nrmse(a, m) for a, m in zip(drive.outputs(joint), measured)]

@@ -182,8 +182,13 @@ def with_joint(report, recordings):
         worst_lin = max(max(r) for r in model.fit["linear"])
         worst_nl = max(max(r) for r in model.fit["nonlinear"])
         unit = " N" if model.joint.units == "N" else ", relative units: no driving point fixes the scale"
-        explanation += (f"; modelled ({model.joint.formula()}{unit}), simulated from each force the worst NRMSE goes "
-                        f"from {worst_lin:.2f} (linear) to {worst_nl:.2f}")
+        if worst_nl < worst_lin:
+            explanation += (f"; modelled ({model.joint.formula()}{unit}), simulated from each force the worst NRMSE "
+                            f"goes from {worst_lin:.2f} (linear) to {worst_nl:.2f}")
+        else:  # said, not hidden: the place or the law the levels point to does not make a better simulation
+            explanation += (f"; its model ({model.joint.formula()}{unit}) does not simulate the recordings better than "
+                            f"the linear one (worst NRMSE {worst_lin:.2f} linear, {worst_nl:.2f} with the joint): the "
+                            "place or the law may be wrong")
     old = report.findings[0]
     joint = NonlinearFinding("joint", between=[a, b], location=loc.location, law=loc.law, parameters=parameters or {},
                              equivalent=[{"law": e["law"], "delta_bic": e["delta_bic"]} for e in loc.equivalent_laws],
