@@ -521,6 +521,67 @@ def _from_benchmark(name: str):
     return None if fn is None else (lambda: fn(load(name)))
 
 
+#: benchmark (its results JSON) -> the code its figures measure: a figure is stale when any of it changed after the
+#: commit the JSON was measured at (`outdated`). The physics underlies nearly everything; it is named where a figure
+#: is of the physics itself.
+MEASURES = {
+    "demo": ["satmd"],
+    "discover_intervals": ["satmd/discovery", "satmd/identification", "satmd/physics"],
+    "discovery": ["satmd/discovery", "satmd/identification", "satmd/physics"],
+    "distill": ["satmd/explain"],
+    "excitations": ["satmd/signal", "satmd/simulation"],
+    "f16_levels": ["satmd/modal", "satmd/signal", "satmd/discovery/nonlinear"],
+    "fleet": ["satmd/_fleet.py", "satmd/identification"],
+    "forward": ["satmd/physics"],
+    "fuzz": ["satmd/cli", "satmd/io", "benchmarks/_fuzz_cases.py", "benchmarks/_fuzz_excitation.py"],
+    "identification": ["satmd/identification", "satmd/physics"],
+    "inverse": ["satmd/inverse"],
+    "inverse_once": ["satmd/inverse"],
+    "inverse_training": ["satmd/inverse"],
+    "memory": ["satmd/physics", "satmd/identification"],
+    "nonlinear": ["satmd/discovery/nonlinear", "satmd/identification/nonlinear", "satmd/signal",
+                  "satmd/physics/nonlinear"],
+    "nonlinear_model": ["satmd/identification/nonlinear", "satmd/physics/nonlinear"],
+    "out_of_model": ["satmd/discovery", "satmd/tuning"],
+    "recordings": ["satmd/signal", "satmd/simulation"],
+    "silverbox": ["satmd/discovery/nonlinear", "satmd/identification/nonlinear", "satmd/signal"],
+    "startup": ["satmd/__init__.py", "satmd/cli"],
+    "structures_joint": ["satmd/structure/locate.py", "satmd/structure/laws.py", "satmd/structure/spectra.py"],
+    "structures_levels": ["satmd/modal", "satmd/discovery/nonlinear", "satmd/signal"],
+    "structures_predict": ["satmd/structure", "satmd/modal/rational.py"],
+    "tuning": ["satmd/tuning"],
+}
+
+
+def outdated() -> list[str]:
+    """'NAME: measured at C (date), and PATHS changed since (latest: C2)' for every results file older than the code
+    its figures measure (`MEASURES`); the results measured with uncommitted changes are named too."""
+    import subprocess
+
+    out = []
+    for name, paths in MEASURES.items():
+        path = ROOT / "benchmarks" / "results" / f"{name}.json"
+        if not path.exists():
+            continue
+        doc = json.loads(path.read_text())
+        mach = doc.get("machine", {}) if isinstance(doc, dict) else {}
+        mach = mach if isinstance(mach, dict) else {}  # an old result's machine was one line of text
+        commit = mach.get("commit")
+        if not commit:
+            out.append(f"{name}: no commit recorded (measured before figures carried one)")
+            continue
+        log = subprocess.run(["git", "log", "-1", "--format=%h %cs", f"{commit}..HEAD", "--", *paths], cwd=ROOT,
+                             capture_output=True, text=True)
+        if log.returncode != 0:
+            out.append(f"{name}: commit {commit} is not in this history")
+        elif log.stdout.strip():
+            out.append(f"{name}: measured at {commit} ({str(mach.get('date', ''))[:10]}); {', '.join(paths)} changed "
+                       f"since (latest {log.stdout.strip()})")
+        elif mach.get("tree_changed"):
+            out.append(f"{name}: measured at {commit} with uncommitted changes")
+    return out
+
+
 REGIONS = {
     "table2": table2,
     "ablation-run": ablation_run,
@@ -569,9 +630,15 @@ def render(text: str) -> tuple[str, list[str]]:
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--check", action="store_true", help="exit 1 if a file differs from the results")
+    ap.add_argument("--stale", action="store_true",
+                    help="list the results older than the code they measure (exit 1 if any): `make bench` reruns them")
     ap.add_argument("--readme", type=Path, default=None,
                     help="only this file (default: README.md and every docs page with a region)")
     args = ap.parse_args(argv)
+    if args.stale:
+        old = outdated()
+        print("\n".join(old) if old else "every result is as new as the code it measures")
+        return 1 if old else 0
     files = [args.readme] if args.readme else targets()
     texts = {path: path.read_text(encoding="utf-8") for path in files}
     missing = [n for n in REGIONS if not any(f"<!-- results:{n} -->" in t for t in texts.values())]
