@@ -11,6 +11,7 @@ from ..validation import NAMES, Interval, Options, Whole, validate_params
 from .laws import LAWS
 from .laws import law as law_named
 from .linear import LinearStructure, fit_linear
+from .locate import shape_of
 from .model import Drive, Joint, StructureModel, nrmse, warmup_of
 from .spectra import periodic_spectra
 
@@ -59,12 +60,15 @@ def fit_structure(recordings, between=None, law: str | None = None, channels=Non
         missing = [c for c in names if c not in s.responses]
         if missing:
             raise DataError(f"{s.source}: no channel {', '.join(missing)} (the other levels have it)")
+    shape = None
     if between is None or law is None:
         say("locating the joint among every pair of sensors ...")
         loc = locate_joint(spectra, channels=names)
         if not loc.detected:
             between = law = None
         else:
+            if between is None or tuple(between) == loc.between:
+                shape = loc.shape if law is None or law == loc.law else None
             between, law = tuple(between or loc.between), law or loc.law
     for c in (between or ()):
         if c != "ground" and c not in names:
@@ -81,7 +85,7 @@ def fit_structure(recordings, between=None, law: str | None = None, channels=Non
     assert law is not None  # set with the place
     lw = law_named(law)
     d0, v0 = ref.scales(*between)
-    aux = lw.auxes(d0, v0)
+    aux = shape if shape is not None else shape_of(spectra, between, law, names)
     reference = linear
     span = [_fit_span(r) for r in recordings]
     measured = [np.array([np.asarray(r[ch], float)[:n] for ch in names]) for r, n in zip(recordings, span)]
@@ -89,9 +93,9 @@ def fit_structure(recordings, between=None, law: str | None = None, channels=Non
     for start in starts:  # the lowest level as the linear part, or the structure under the joint: the better kept
         if start == "underlying":
             say("the structure under the joint and the joint's path, from every level at once ...")
-            linear, c, kappa = _underlying_start(reference, spectra, between, lw, d0, v0)
+            linear, c, kappa = _underlying_start(reference, spectra, between, lw, d0, v0, aux)
         else:
-            linear, (c, kappa) = reference, _start(reference, spectra, between, lw, d0, v0)
+            linear, (c, kappa) = reference, _start(reference, spectra, between, lw, d0, v0, aux)
         model = StructureModel(linear, Joint(between, law, c, aux, kappa), levels, reference=reference,
                                oversample=oversampling(linear, ref.fs_hz))
         drives = [(Drive(model, np.asarray(r["force"], float)[:n], float(r.fs_hz), warmup_of(r)), m)
@@ -141,7 +145,7 @@ def _cost(model, drives) -> float:
     return total if np.isfinite(total) else np.inf
 
 
-def _underlying_start(linear, spectra, between, lw, d0, v0, extra_pairs: int = 2):
+def _underlying_start(linear, spectra, between, lw, d0, v0, aux, extra_pairs: int = 2):
     """(LinearStructure, c, κ): the structure under the joint and the joint, from every level at once.
 
     Every channel's response at every level is the structure's FRF times the force plus the joint's column
@@ -161,7 +165,7 @@ def _underlying_start(linear, spectra, between, lw, d0, v0, extra_pairs: int = 2
         A = np.array([s.responses[c] for c in names])
         if ib is not None:
             A[ia] = A[ia] - A[ib]
-        G = np.array([s.at_lines(t) for t in lw.columns(*s.relative(*between), d0, v0)])
+        G = np.array([s.at_lines(t) for t in lw.columns(*s.relative(*between), d0, v0, aux)])
         W = np.repeat(1.0 / np.maximum(np.abs(A).mean(axis=1, keepdims=True), TINY), A.shape[1], axis=1)
         data.append((s.freq_hz, s.force, G, A, W))
     c = np.zeros(len(lw.all_terms))
@@ -198,7 +202,7 @@ def _real(X, y):
     return np.vstack([X.real, X.imag]), np.concatenate([y.real, y.imag])
 
 
-def _start(linear, spectra, between, lw, d0, v0):
+def _start(linear, spectra, between, lw, d0, v0, aux):
     """(c, κ): the joint's coefficients and coupling from the level changes, in the frequency domain."""
     names = linear.channels
     lam = linear.poles
@@ -207,7 +211,7 @@ def _start(linear, spectra, between, lw, d0, v0):
         f = s.freq_hz
         iw = 2j * np.pi * f[:, None]
         H = linear.frf(f)
-        G = [s.at_lines(t) for t in lw.columns(*s.relative(*between), d0, v0)]
+        G = [s.at_lines(t) for t in lw.columns(*s.relative(*between), d0, v0, aux)]
         for i, c in enumerate(names):
             a = linear.residues[i][None, :] / (iw - lam[None, :])
             b = linear.residues[i].conj()[None, :] / (iw - lam.conj()[None, :])

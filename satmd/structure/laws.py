@@ -26,6 +26,9 @@ TERM_PARAMETERS = {"d": "k", "v": "c", "d³": "k3", "d|d|": "k_soft", "contact":
 #: term name -> the name of its shape constant
 SHAPE_PARAMETERS = {"contact": "gap", "sign(v)": "v_slip"}
 FRICTION_SMOOTHING = 0.05  # a Coulomb force smoothed over 5 % of the reference velocity's RMS
+#: the shape constants tried for a shaped term, in units of the reference level's RMS stroke (a gap) or relative
+#: velocity (a friction's smoothing): the law's evidence is its best over them (`JointLaw.shapes`)
+SHAPE_GRID = {"contact": (0.5, 1.0, 2.0, 3.0), "sign(v)": (FRICTION_SMOOTHING, 0.2, 0.5, 1.0)}
 
 
 def term(code, d, v, aux):
@@ -84,10 +87,26 @@ class JointLaw:
     def auxes(self, d0: float, v0: float) -> np.ndarray:
         return np.array([self.aux(t, d0, v0) for t in self.all_terms], float)
 
-    def columns(self, d, v, d0: float, v0: float) -> list:
-        """The law's terms at (d, v), then the linear part (d, v): one array each."""
+    def shapes(self, d0: float, v0: float) -> list:
+        """Every set of shape constants to try (`SHAPE_GRID`; one set for a law without a shaped term)."""
+        shaped = [i for i, t in enumerate(self.all_terms) if t in SHAPE_GRID]
+        if not shaped:
+            return [self.auxes(d0, v0)]
+        out = []
+        for k in range(len(SHAPE_GRID[self.all_terms[shaped[0]]])):  # every shaped term at its k-th multiple
+            aux = self.auxes(d0, v0)
+            for i in shaped:
+                t = self.all_terms[i]
+                aux[i] = SHAPE_GRID[t][k] * (d0 if t == "contact" else v0)
+            out.append(aux)
+        return out
+
+    def columns(self, d, v, d0: float, v0: float, aux=None) -> list:
+        """The law's terms at (d, v), then the linear part (d, v): one array each (``aux``: the shape constants,
+        default `auxes`)."""
         d, v = np.asarray(d, float), np.asarray(v, float)
-        return [np.asarray(term(TERM_CODES[t], d, v, a)[0], float) for t, a in zip(self.all_terms, self.auxes(d0, v0))]
+        aux = self.auxes(d0, v0) if aux is None else aux
+        return [np.asarray(term(TERM_CODES[t], d, v, a)[0], float) for t, a in zip(self.all_terms, aux)]
 
     def force(self, coefficients, d, v, aux) -> np.ndarray:
         """Σ c_j t_j(d, v) for coefficients and shape constants in the order of `all_terms`."""

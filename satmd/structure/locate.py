@@ -53,6 +53,7 @@ class JointLocation:
         ``detected`` when it is above `EQUIVALENT`
     reference : the source of the level taken as linear; levels: force RMS of every recording
     poles_hz : the structure's modes used (f in Hz, ζ)
+    shape : the chosen law's shape constants at the best place (`JointLaw.all_terms` order: a gap, a smoothing)
     """
 
     between: tuple
@@ -65,6 +66,7 @@ class JointLocation:
     levels: list
     poles_hz: list = field(default_factory=list)
     evidence: float = 0.0
+    shape: np.ndarray | None = field(default=None, repr=False)
 
     @property
     def detected(self) -> bool:
@@ -128,9 +130,30 @@ def locate_joint(recordings, laws=None, band_hz=None, channels=None) -> JointLoc
     items = [ref, *others]
     places = [(a, b) for a, b in itertools.combinations(names, 2)] + [(a, "ground") for a in names]
     chosen = [LAWS[n] for n in (laws or LAWS)]
-    bic: dict = {(p, law_.name): _evidence(p, law_, others, ref, H, names, rows, basis) for p in places for law_ in chosen}
+    bic: dict = {}
+    shapes: dict = {}
+    for p in places:
+        for law_ in chosen:
+            bic[(p, law_.name)], shapes[(p, law_.name)] = best_shape(p, law_, others, ref, H, names, rows, basis)
     bic[None] = _evidence(None, None, others, ref, H, names, rows, basis)
-    return _verdict(bic, places, chosen, ref, items, modal)
+    return _verdict(bic, places, chosen, ref, items, modal, shapes)
+
+
+def shape_of(recordings, between, law_name: str, channels=None) -> np.ndarray:
+    """The shape constants of ``law_name`` at ``between`` that explain the level changes best (`best_shape`)."""
+    ref, others, names, rows, H, basis, _ = prepare(recordings, None, channels)
+    return best_shape(tuple(between), LAWS[law_name], others, ref, H, names, rows, basis)[1]
+
+
+def best_shape(place, law_, others, ref, H, names, rows, basis):
+    """(BIC, shape constants) of a law at a place at its best shape (a gap, a friction's smoothing) of
+    `JointLaw.shapes`; one more parameter counted when there was a choice."""
+    d0, v0 = ref.scales(*place)
+    tried = law_.shapes(d0, v0)
+    found = [(_evidence(place, law_, others, ref, H, names, rows, basis, aux), i) for i, aux in enumerate(tried)]
+    value, i = min(found)
+    n = sum(2 * k.size for k in rows.values() if k is not rows[id(ref)]) * len(names)
+    return value + (np.log(n) if len(tried) > 1 else 0.0), tried[i]
 
 
 def prepare(recordings, band_hz=None, channels=None):
@@ -169,14 +192,14 @@ def prepare(recordings, band_hz=None, channels=None):
     return ref, others, names, rows, H, basis, modal
 
 
-def _evidence(place, law_, others, ref, H, names, rows, basis) -> float:
+def _evidence(place, law_, others, ref, H, names, rows, basis, aux=None) -> float:
     """BIC of one place and law: every channel, every higher level, one weighted linear least-squares fit each
     (``place`` None: no joint, the levels one linear structure)."""
     G: dict = {id(s): [] for s in others}
     if place is not None:
         d0, v0 = ref.scales(*place)
         for s in others:
-            G[id(s)] = [s.at_lines(t)[rows[id(s)]] for t in law_.columns(*s.relative(*place), d0, v0)]
+            G[id(s)] = [s.at_lines(t)[rows[id(s)]] for t in law_.columns(*s.relative(*place), d0, v0, aux)]
     rss, n_rows, n_par = 0.0, 0, 0
     for c in names:
         X_parts, y_parts = [], []
@@ -195,7 +218,7 @@ def _evidence(place, law_, others, ref, H, names, rows, basis) -> float:
     return n_rows * np.log(max(rss, TINY) / n_rows) + n_par * np.log(n_rows)
 
 
-def _verdict(bic, places, laws, ref, items, modal) -> JointLocation:
+def _verdict(bic, places, laws, ref, items, modal, shapes) -> JointLocation:
     per_place = {p: min(((bic[(p, law_.name)], law_.name) for law_ in laws)) for p in places}
     ranked = sorted(places, key=lambda p: (per_place[p][0], p))
     best_bic = per_place[ranked[0]][0]
@@ -214,6 +237,6 @@ def _verdict(bic, places, laws, ref, items, modal) -> JointLocation:
         between=tuple(at), location=location, law=chosen, laws=laws_out,
         equivalent_places=[e for e in location[1:] if e["delta_bic"] <= EQUIVALENT],
         equivalent_laws=[e for e in laws_out if e["law"] != chosen and e["delta_bic"] <= EQUIVALENT],
-        reference=ref.source, levels=[round(float(s.level), 6) for s in items],
+        reference=ref.source, levels=[round(float(s.level), 6) for s in items], shape=shapes[(tuple(at), chosen)],
         poles_hz=[(round(float(m.f_hz), 4), round(float(m.zeta), 5)) for m in modal.modes],
         evidence=float(bic[None] - best_bic))
