@@ -16,7 +16,8 @@ Evidence: BIC = N ln(RSS/N) + p ln N per pair and law. Rows are weighted by each
 at that level, not by each line's noise: between levels far above the noise the misfit is the model's
 (the poles of one level, the joint's terms from the in-band motion), which scales with the response, and
 weighting by the noise let the quietest lines decide (on the F-16 it put the joint between acc2 and the
-ground). A pair's
+ground). A law with a shape constant (a clearance's gap, a friction's smoothing) is tried at each of
+`laws.SHAPE_GRID`'s values and keeps its best, counted as one parameter more. A pair's
 evidence is its best law's; pairs are ranked by ΔBIC to the best, and those within `EQUIVALENT` are
 listed as equivalent places, never dropped. At the best pair the laws are ranked the same way; the
 ``sparse`` library is named only when it beats every named law by more than `EQUIVALENT`.
