@@ -27,9 +27,8 @@ def build(ctx) -> str:
                 for i in (*FITTED, HELD)}
     fitted = [recs[i] for i in FITTED]
     loc = locate_joint(fitted)
-    starts, nfev = (("measured",), 6) if ctx.quick else (("measured", "underlying"), 40)
     model = fit_structure(fitted, between=loc.between, law=loc.law, files=[f"level {i}" for i in FITTED],
-                          starts=starts, max_nfev=nfev)
+                          max_nfev=10 if ctx.quick else 40)
     held = model.predict(recs[HELD], file=f"level {HELD}")
     ctx.results["structure"] = {"between": list(loc.between), "law": loc.law, "fit": model.fit,
                                 "held_out": held.to_dict(), "formula": model.joint.formula() if model.joint else None}
