@@ -17,6 +17,7 @@ from .spectra import periodic_spectra
 
 ALTERNATIONS = 30  # of the frequency-domain start (κ at fixed c, c at fixed κ)
 FIT_PERIODS = 3  # steady periods of a periodic test in the output-error fit
+CROSS_VALIDATED = 3  # named laws (the best by the levels' spectra) weighed against the sparse library
 STARTS = ("measured", "underlying")
 SHRINK = (1.0, 0.5, 0.25, 0.1, 0.03, 0.01, 0.0)  # scales of the start's joint tried until the loop is stable
 
@@ -26,7 +27,7 @@ SHRINK = (1.0, 0.5, 0.25, 0.1, 0.03, 0.01, 0.0)  # scales of the start's joint t
                   "driving_point": [None, str], "starts": [NAMES], "free_path": [bool]})
 def fit_structure(recordings, between=None, law: str | None = None, channels=None, n_pairs: int | None = None,
                   max_nfev: int = 40, files=None, driving_point: str | None = None, starts=STARTS,
-                  free_path: bool = False, progress=None) -> StructureModel:
+                  free_path: bool = False, location=None, progress=None) -> StructureModel:
     """The structure's linear part and its joint, fitted on every recording at once (SPEC §11).
 
     Parameters
@@ -46,6 +47,11 @@ def fit_structure(recordings, between=None, law: str | None = None, channels=Non
     free_path : the output-error fit moves the joint's path κ too (default: the law's coefficients and shape
         constants alone, the path as the frequency-domain start found it: on the F-16, freeing its 16-20 numbers
         fitted the fitted levels closer and predicted the level left out worse, 0.32-0.47 against 0.28-0.40)
+    location : a `JointLocation` of these recordings already made (default: `locate_joint` runs when the place
+        or the law is not given). When it names the ``sparse`` law and three or more levels are given, the
+        best three named laws are fitted too, each on every level but a middle one, and the law that predicts
+        that level best is kept (`cross_validated`): a law of many terms can fit the levels it sees and miss the
+        others
     progress : callable(str) told of each stage (the CLI prints it on stderr)
 
     Returns
@@ -65,14 +71,22 @@ def fit_structure(recordings, between=None, law: str | None = None, channels=Non
             raise DataError(f"{s.source}: no channel {', '.join(missing)} (the other levels have it)")
     shape = None
     if between is None or law is None:
-        say("locating the joint among every pair of sensors ...")
-        loc = locate_joint(spectra, channels=names)
+        if location is None:
+            say("locating the joint among every pair of sensors ...")
+        loc = location or locate_joint(spectra, channels=names)
         if not loc.detected:
             between = law = None
         else:
             if between is None or tuple(between) == loc.between:
                 shape = loc.shape if law is None or law == loc.law else None
             between, law = tuple(between or loc.between), law or loc.law
+            if law == "sparse" and len(recordings) >= 3 and tuple(between) == loc.between:
+                named = [e["law"] for e in loc.laws if e["law"] != "sparse"][:CROSS_VALIDATED]
+                if named:
+                    say(f"sparse, {', '.join(named)}: each fitted without a middle level and judged on it ...")
+                    law = cross_validated(recordings, between, ["sparse", *named], channels=names, n_pairs=n_pairs,
+                                          max_nfev=max_nfev, starts=starts, free_path=free_path)
+                    shape = loc.shape if law == "sparse" else None
     for c in (between or ()):
         if c != "ground" and c not in names:
             raise DataError(f"the joint's sensor {c!r} is not a channel ({', '.join(names)})")
@@ -99,6 +113,9 @@ def fit_structure(recordings, between=None, law: str | None = None, channels=Non
             linear, c, kappa = _underlying_start(reference, spectra, between, lw, d0, v0, aux)
         else:
             linear, (c, kappa) = reference, _start(reference, spectra, between, lw, d0, v0, aux)
+        if not (np.all(np.isfinite(c)) and np.all(np.isfinite(kappa)) and np.all(np.isfinite(linear.residues))):
+            say(f"the {start} start has no finite joint: left out")
+            continue
         model = StructureModel(linear, Joint(between, law, c, aux, kappa), levels, reference=reference,
                                oversample=oversampling(linear, ref.fs_hz))
         drives = [(Drive(model, np.asarray(r["force"], float)[:n], float(r.fs_hz), warmup_of(r)), m)
@@ -107,12 +124,28 @@ def fit_structure(recordings, between=None, law: str | None = None, channels=Non
             f"recordings (from the {start} linear part) ...")
         model = _output_error(_stable(model, drives), drives, ref, max_nfev, fixed_path=not free_path)
         fitted.append(model)
+    if not fitted:  # no start gave a joint to fit: the linear model of the lowest level, said by its table
+        return _with_table(StructureModel(reference, None, levels), recordings, files)
     # judged on the whole records: a model that slowly gathers energy shows it only over many periods
     whole = [(Drive(fitted[0], np.asarray(r["force"], float), float(r.fs_hz), warmup_of(r)),
               np.array([np.asarray(r[ch], float) for ch in names])) for r in recordings]
     model = min(fitted, key=lambda m: _cost(m, [(_redrive(d, m), y) for d, y in whole]))
     model = in_newtons(model, driving_point)
     return _with_table(model, recordings, files)
+
+
+def cross_validated(recordings, between, laws, **fit) -> str:
+    """The law (of ``laws``) whose model, fitted on every recording but a middle level, predicts that level best
+    (mean NRMSE over its channels)."""
+    levels = [float(np.sqrt(np.mean(np.square(np.asarray(r["force"], float))))) for r in recordings]
+    order = np.argsort(levels)
+    held = int(order[len(order) // 2])  # a middle level: neither the linear reference nor the top
+    rest = [r for i, r in enumerate(recordings) if i != held]
+    scores = []
+    for law in laws:
+        model = fit_structure(rest, between=between, law=law, **fit)
+        scores.append((float(np.mean(model.predict(recordings[held]).nrmse)), law))
+    return min(scores)[1]
 
 
 def _fit_span(recording) -> int:
@@ -280,13 +313,15 @@ def _output_error(model, drives, ref, max_nfev, fixed_path=False) -> StructureMo
         out = []
         for (drive, measured), sd in zip(drives, scales):
             e = (drive.outputs(trial, step) - measured[:, ::step]) / sd
-            out.append(np.nan_to_num(e, nan=1e3, posinf=1e3, neginf=-1e3).ravel() / np.sqrt(e.size))
+            e = np.clip(np.nan_to_num(e, nan=1e3), -1e3, 1e3)  # a run-away: large, finite, smooth enough to step
+            out.append(e.ravel() / np.sqrt(e.size))
         return np.concatenate(out)
 
-    k0 = [] if fixed_path else np.column_stack([j.coupling.real, j.coupling.imag]).ravel()
+    k0 = np.zeros(0) if fixed_path else np.column_stack([j.coupling.real, j.coupling.imag]).ravel()
     log_aux = np.log(j.aux[shaped])
     theta0 = np.concatenate([j.coefficients if fixed_path else j.coefficients[1:], log_aux, k0])
     scale = np.maximum(np.abs(theta0), 1e-3 * (np.abs(theta0).max() or 1.0))
+    scale[scale == 0] = 1.0
     scale[n_free:n_free + len(shaped)] = 1.0  # a log: steps of order one
     sol = least_squares(residual, theta0, x_scale=scale, diff_step=1e-4, max_nfev=max_nfev)
     start = residual(theta0)

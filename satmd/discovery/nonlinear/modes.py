@@ -190,8 +190,14 @@ def with_joint(report, recordings):
                             f"the linear one (worst NRMSE {worst_lin:.2f} linear, {worst_nl:.2f} with the joint): the "
                             "place or the law may be wrong")
     old = report.findings[0]
-    joint = NonlinearFinding("joint", between=[a, b], location=loc.location, law=loc.law, parameters=parameters or {},
-                             equivalent=[{"law": e["law"], "delta_bic": e["delta_bic"]} for e in loc.equivalent_laws],
+    law = model.joint.law if model is not None and model.joint is not None else loc.law
+    equivalent = [{"law": e["law"], "delta_bic": e["delta_bic"]} for e in loc.equivalent_laws if e["law"] != law]
+    if law != loc.law:  # the sparse library fitted the levels best, the named law predicted a level left out better
+        equivalent.insert(0, {"law": loc.law, "delta_bic": 0.0})
+        explanation += (f"; {law}, not the {loc.law} library the levels' spectra preferred: fitted without a middle "
+                        f"level, it predicted that level better")
+    joint = NonlinearFinding("joint", between=[a, b], location=loc.location, law=law, parameters=parameters or {},
+                             equivalent=equivalent,
                              modes=old.get("modes"), fit=fit,
                              explanation=explanation + (f". {old.explanation}" if old.explanation else ""))
     return replace(report, findings=[joint], model=model)
@@ -203,6 +209,6 @@ def _structure_model(recordings, loc):
     from ...structure import fit_structure
 
     try:
-        return fit_structure(recordings, between=loc.between, law=loc.law)
+        return fit_structure(recordings, location=loc)
     except DataError:
         return None
