@@ -137,7 +137,9 @@ def fit_structure(recordings, between=None, law: str | None = None, channels=Non
 def cross_validated(recordings, between, laws, **fit) -> str:
     """The law (of ``laws``) whose model, fitted on every recording but a middle level, predicts that level best
     (mean NRMSE over its channels)."""
-    levels = [float(np.sqrt(np.mean(np.square(np.asarray(r["force"], float))))) for r in recordings]
+    from ..numerics import force_level
+
+    levels = [force_level(r["force"]) for r in recordings]
     order = np.argsort(levels)
     held = int(order[len(order) // 2])  # a middle level: neither the linear reference nor the top
     rest = [r for i, r in enumerate(recordings) if i != held]

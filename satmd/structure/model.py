@@ -30,6 +30,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..errors import DataError
+from ..numerics import force_level
 from .kernel import joint_force
 from .laws import law as law_named
 from .linear import LinearStructure, discretise, modal_states, response
@@ -174,7 +175,7 @@ class StructureModel:
         drive = Drive(self, force, float(recording.fs_hz), warm)
         lin = drive.outputs(None)
         nl = drive.outputs(self.joint) if self.joint is not None else lin
-        level = float(np.sqrt(np.mean((force - force.mean()) ** 2)))
+        level = force_level(force)
         lo, hi = self.levels
         return Prediction(name, level, bool(level < lo * 0.98 or level > hi * 1.02), self.channels,
                           [_finite_nrmse(s, m) for s, m in zip(nl, measured)],
