@@ -36,7 +36,7 @@ from tests.structure.chain import simulate_chain  # noqa: E402
 LEVELS = (1.0, 2.8, 8.0)
 
 
-def _law(kind, rng):
+def law_of(kind, rng):
     """(force law g(d, v), its SPEC §11 name); strengths set so the top level changes the response by 5-30 %."""
     if kind == "hardening":
         return (lambda d, v, a=rng.uniform(1e9, 6e9): a * d ** 3), "cubic"
@@ -59,7 +59,7 @@ def one(case: int, seed: int, null: bool) -> dict:
     i = int(rng.integers(0, n))
     joint = (i, None) if rng.random() < 0.25 or i == n - 1 else (i, i + 1)
     kind = str(rng.choice(["hardening", "softening", "friction", "quadratic_damping", "clearance"]))
-    law, name = _law(kind, rng)
+    law, name = law_of(kind, rng)
     if null:
         law, name = (lambda d, v: 0.0 * d), None
     t0 = time.perf_counter()

@@ -31,26 +31,13 @@ sys.path.insert(0, str(ROOT))
 sys.path.insert(0, str(ROOT / "benchmarks"))
 from _machine import describe, load_after, machine  # noqa: E402
 from satmd.structure import fit_structure  # noqa: E402
+from structures_joint import law_of as _law  # noqa: E402  (the same laws, drawn the same way)
 from tests.structure.chain import simulate_chain  # noqa: E402
 
 FIT_LEVELS, HELD, BEYOND = (1.0, 8.0), 3.0, 12.0
 KINDS = ("hardening", "softening", "friction", "quadratic_damping", "clearance")
 F16_MAP = "force=Force,a1=Acceleration[1],a2=Acceleration[2],a3=Acceleration[3]"
 PUBLISHED_L6 = {"nrmse": [0.134, 0.099, 0.237], "model": "deep state-space network (nonlinearbenchmark.org results)"}
-
-
-def _law(kind, rng):
-    """(force law g(d, v), its SPEC §11 name), as benchmarks/structures_joint.py draws them."""
-    if kind == "hardening":
-        return (lambda d, v, a=rng.uniform(1e9, 6e9): a * d ** 3), "cubic"
-    if kind == "softening":
-        return (lambda d, v, ks=rng.uniform(1e4, 3e4), g0=rng.uniform(1e-4, 3e-4): ks * g0 * np.tanh(d / g0)), "softening"
-    if kind == "friction":
-        return (lambda d, v, f=rng.uniform(0.2, 0.6): f * np.tanh(v / 1e-3)), "friction"
-    if kind == "quadratic_damping":
-        return (lambda d, v, c=rng.uniform(200.0, 800.0): c * v * np.abs(v)), "quadratic_damping"
-    return (lambda d, v, g=rng.uniform(1e-4, 3e-4), kc=rng.uniform(2e4, 5e4):
-            kc * np.where(np.abs(d) > g, d - np.sign(d) * g, 0.0)), "clearance"
 
 
 def chain(case: int, seed: int) -> dict:

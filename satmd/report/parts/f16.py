@@ -17,6 +17,23 @@ def data_dir() -> Path | None:
     return real_data("f16") if real_data("f16", "F16Data_FullMSine_Level1.mat") else None
 
 
+SKIPPED = "Skipped: the F-16 files (`shared/data/real/f16/`, nonlinearbenchmark.org) are not beside this checkout."
+
+
+def recordings(levels, channel_map) -> dict | None:
+    """{level: Recording} of the F-16's multisine levels read with ``channel_map``; None when the files are absent."""
+    import warnings
+
+    from ...io import load_recording
+
+    folder = data_dir()
+    if folder is None:
+        return None
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")  # the files' Voltage variable is not used
+        return {i: load_recording(folder / f"F16Data_FullMSine_Level{i}.mat", channel_map=channel_map) for i in levels}
+
+
 def _figure(levels, recordings, datas):
     import numpy as np
 
@@ -39,19 +56,13 @@ def _figure(levels, recordings, datas):
 
 
 def build(ctx) -> str:
-    import warnings
-
     from ...discovery import discover
-    from ...io import load_recording
     from ...signal import estimate_frf
 
-    folder = data_dir()
-    if folder is None:
-        return ("Skipped: the F-16 files (`shared/data/real/f16/`, nonlinearbenchmark.org) are not beside this "
-                "checkout.")
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")  # the files' Voltage variable is not used
-        recs = [load_recording(folder / f"F16Data_FullMSine_Level{i}.mat", channel_map=CHANNELS) for i in LEVELS]
+    read = recordings(LEVELS, CHANNELS)
+    if read is None:
+        return SKIPPED
+    recs = list(read.values())
     rep = discover(recs)
     datas = [estimate_frf(r) for r in recs]
     levels = list(rep.nonlinear.levels) if rep.nonlinear is not None else [0.0] * len(recs)

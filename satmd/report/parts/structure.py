@@ -10,21 +10,13 @@ FITTED, HELD = (1, 3, 7), 5
 
 
 def build(ctx) -> str:
-    import warnings
-
-    from ...io import load_recording
     from ...structure import fit_structure, locate_joint
     from ...structure.figures import draw_joint, draw_prediction
-    from .f16 import data_dir
+    from .f16 import SKIPPED, recordings
 
-    folder = data_dir()
-    if folder is None:
-        return ("Skipped: the F-16 files (`shared/data/real/f16/`, nonlinearbenchmark.org) are not beside this "
-                "checkout.")
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")  # the files' Voltage variable is not used
-        recs = {i: load_recording(folder / f"F16Data_FullMSine_Level{i}.mat", channel_map=CHANNELS)
-                for i in (*FITTED, HELD)}
+    recs = recordings((*FITTED, HELD), CHANNELS)
+    if recs is None:
+        return SKIPPED
     fitted = [recs[i] for i in FITTED]
     loc = locate_joint(fitted)
     model = fit_structure(fitted, location=loc, files=[f"level {i}" for i in FITTED], max_nfev=10 if ctx.quick else 40)
