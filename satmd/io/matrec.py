@@ -1,7 +1,8 @@
 """Time recordings in .mat / .npz files as labs write them: their own names, matrices of signals, any rate variable.
 
 Signals are the variables ``force``, ``acc1``, ``acc2``, ``acc3``, ... (any
-case), or as a channel map says
+case; beside a force, one matrix called ``Acceleration``, ``acc``, ... is read a row an accelerometer), or as
+a channel map says
 (``"force=Force,a1=Acceleration[1],a2=Acceleration[2],a3=Acceleration[3]"``: a
 variable, or one row of a matrix of signals, counted from 1; the long axis of a
 matrix is time; any number of accelerometers ``a<N>``). The sample rate is
@@ -21,6 +22,8 @@ from .recdata import accelerometers, is_role, ordered, role_of
 RECORDING_NAMES = ("force", "acc1", "acc2")  # the rig's; any acc<N> variable is read too (`recdata.is_role`)
 FS_NAMES = ("fs_hz", "fs", "sample_rate", "samplerate", "sampling_rate", "sampling_frequency", "srate", "sr")
 TIME_NAMES = ("time_s", "time", "t")
+ACCELERATION_PREFIX = "acc"  # a matrix called Acceleration, Accel, acc, ...: one accelerometer a row
+MAX_MATRIX_ROWS = 64  # more rows than a test has accelerometers: not a matrix of signals
 
 
 def _lookup(variables, name):
@@ -114,11 +117,27 @@ def _parse_variable_map(path, spec) -> dict:
     return out
 
 
+def _response_matrix(path, v):
+    """(name, {acc1: row 1, acc2: row 2, ...}) from the one matrix of accelerations a lab's file holds beside its
+    force (``Acceleration`` 3×N: rows 1, 2, 3 as acc1, acc2, acc3, the long axis being time); None when there is
+    not exactly one."""
+    found = [k for k, a in v.items() if k.lower().startswith(ACCELERATION_PREFIX) and np.asarray(a).ndim == 2
+             and min(np.asarray(a).shape) > 1 and np.asarray(a).dtype.kind in "biuf"]
+    if len(found) != 1:
+        return None
+    a = np.asarray(v[found[0]])
+    rows = a if a.shape[1] >= a.shape[0] else a.T  # signals along the long axis
+    if rows.shape[0] > MAX_MATRIX_ROWS:
+        return None
+    return found[0], {f"acc{i + 1}": vector_variable(path, f"{found[0]}[{i + 1}]", r) for i, r in enumerate(rows)}
+
+
 def read_recording_variables(path, channel_map=None, fs_hz=None):
     """(fs_hz, {name: series}) from a .mat / .npz recording.
 
     Signals are the variables ``force``, ``acc1``, ``acc2``, ``acc3``, ... (any
-    case), or as ``channel_map`` says (``"force=Force,a1=Acceleration[2],a3=Acceleration[1]"``:
+    case; beside a force, one matrix called ``Acceleration``, ``acc``, ... is read a row an accelerometer,
+    ``acc1`` from row 1), or as ``channel_map`` says (``"force=Force,a1=Acceleration[2],a3=Acceleration[1]"``:
     a variable, or one row of a matrix of signals, counted from 1; any ``a<N>``).
     The sample rate is ``fs_hz``, or a variable (`FS_NAMES`, any case), or a time vector.
     """
@@ -140,6 +159,12 @@ def read_recording_variables(path, channel_map=None, fs_hz=None):
                 used.add(key)
         matrices = [f"{k} {np.asarray(a).shape}" for k, a in v.items()
                     if np.asarray(a).ndim == 2 and min(np.asarray(a).shape) > 1]
+        if "force" in signals and not accelerometers(signals):
+            rows = _response_matrix(path, v)
+            if rows is not None:
+                key, responses = rows
+                signals.update(responses)
+                used.add(key)
         if not signals or (matrices and not accelerometers(signals)):
             hint = (f"; it holds {', '.join(matrices)}: say which signal is which, e.g. "
                     f"a channel map force=Force,a1=Acceleration[2],a2=Acceleration[3] (rows from 1)" if matrices else "")

@@ -108,3 +108,17 @@ def test_a_resonance_that_moves_is_read_at_the_detections_level_when_it_is_the_o
     assert not alone.detected and alone.findings[0]["modes"] == []
     confirmed = unexplained_by_modes(report(1e-5), [base, moved], "N RMS")
     assert confirmed.detected and [m["trend"] for m in confirmed.findings[0]["modes"]] == ["hardening"]
+
+
+def test_a_joint_with_equally_good_laws_is_told_in_text():
+    """The structure's joint lists the laws the levels cannot tell apart by name and ΔBIC (the F-16's report
+    crashed on them once: they are records, not names)."""
+    from satmd.discovery.findings import NonlinearFinding
+    from satmd.discovery.nonlinear import NonlinearReport
+
+    joint = NonlinearFinding("joint", between=["acc2", "acc3"], law="friction", explanation="a joint",
+                             equivalent=[{"law": "sparse", "delta_bic": 0.0}, {"law": "clearance", "delta_bic": 3.5}])
+    text = NonlinearReport(True, [], [joint]).report()
+    assert "equally good: sparse (ΔBIC 0.0), clearance (ΔBIC 3.5)" in text
+    named = NonlinearFinding("softening", explanation="x", equivalent=["cubic"])
+    assert "equally good: cubic" in NonlinearReport(True, [], [named]).report()

@@ -124,6 +124,19 @@ def test_acceleration_matrix_mapped_row_by_row(tmp_path, suffix):
     with pytest.warns(DataWarning, match=r"ignored variable\(s\) Force"):
         swapped = load_recording(p, channel_map="a3=Acceleration[1],a1=Acceleration[3]")
     np.testing.assert_array_equal(swapped["acc3"], chans["r1"])
+    unmapped = load_recording(p)  # a force and one matrix of accelerations: read as the lab wrote them
+    assert list(unmapped.channels) == ["force", "acc1", "acc2", "acc3"]
+    for k in (1, 2, 3):
+        np.testing.assert_array_equal(unmapped[f"acc{k}"], chans[f"r{k}"])
+
+
+def test_two_acceleration_matrices_are_asked_about(tmp_path):
+    chans = _signals(["force", "r1", "r2", "r3"])
+    p = tmp_path / "two.npz"
+    np.savez(p, Force=chans["force"], AccWing=np.vstack([chans["r1"], chans["r2"]]),
+             AccPayload=np.vstack([chans["r2"], chans["r3"]]), Fs=np.float64(FS))
+    with pytest.raises(FormatError, match=r"say which signal is which"):
+        load_recording(p)
 
 
 @pytest.mark.parametrize("suffix", [".npz", ".mat"])

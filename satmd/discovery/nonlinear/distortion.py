@@ -72,7 +72,8 @@ class NonlinearReport:
         for f in self.findings:
             lines.append(f"  - {f['name']}: {f['explanation']}")
             if f.get("equivalent"):
-                lines.append(f"     equally good: {', '.join(f['equivalent'])} (the levels cannot tell them apart)")
+                named = [e if isinstance(e, str) else f"{e['law']} (ΔBIC {e['delta_bic']:.1f})" for e in f["equivalent"]]
+                lines.append(f"     equally good: {', '.join(named)} (the levels cannot tell them apart)")
         if self.set_aside:
             lines.append("    linear effects a fit would name are set aside while distortion is present: "
                          + ", ".join(self.set_aside))
