@@ -13,8 +13,8 @@ steady periods,
   `satmd.discovery.nonlinear.periodic`).
 
 With M random-phase realisations of P periods each (`multisine_bla`; Pintelon & Schoukens ch. 3-4),
-per realisation the mean over periods is the FRF ``G_r(k)`` and the spread over periods its noise
-variance (noise is not periodic; the distortion is); the best linear approximation (BLA) is the mean
+per realisation the FRF ``G_r(k)`` is the same ratio of means (`ratio_of_means`, one estimator for every
+periodic test) and the spread over periods its noise variance (noise is not periodic; the distortion is); the best linear approximation (BLA) is the mean
 over realisations, and the spread of ``G_r`` over realisations holds noise *and* the stochastic
 nonlinear distortion, so ``var_nl = var_total − var_noise`` (M ≥ 2, P ≥ 2). `multisine_frf` gives a
 multisine recording's BLA as FRFData; `multisine_arrays` its (M, P, N) periods.
@@ -63,18 +63,10 @@ def periodic_frf(recording, excitation, responses, band_hz=None):
                         f"periodic force excites ({f[0]:.4g}–{f[-1]:.4g} Hz)")
     U = periodic_spectra(recording, excitation, "force")[:, keep]
     P = U.shape[0]
-    Um = U.mean(axis=0)
-    dU = U - Um
-    var_u = np.sum(np.abs(dU) ** 2, axis=0) / (P - 1) / P
     frf, std, coh = {}, {}, {}
     for r in responses:
         Y = periodic_spectra(recording, excitation, r)[:, keep]
-        Ym = Y.mean(axis=0)
-        dY = Y - Ym
-        var_y = np.sum(np.abs(dY) ** 2, axis=0) / (P - 1) / P
-        cov = np.sum(dY * np.conj(dU), axis=0) / (P - 1) / P
-        G = Ym / Um
-        var = (var_y + np.abs(G) ** 2 * var_u - 2.0 * np.real(np.conj(G) * cov)) / np.abs(Um) ** 2
+        G, var = ratio_of_means(U, Y)
         ch = RECORDING_CHANNELS[r]
         frf[ch] = G
         std[ch] = np.sqrt(np.maximum(var, 0.0) / 2.0)
@@ -82,6 +74,36 @@ def periodic_frf(recording, excitation, responses, band_hz=None):
                           / np.maximum(np.sum(np.abs(U) ** 2, axis=0) * np.sum(np.abs(Y) ** 2, axis=0), TINY),
                           0.0, 1.0)
     return f[keep], frf, std, coh, 2.0 * (P - 1)
+
+
+def ratio_of_means(U, Y):
+    """(G, var): the FRF of one realisation of a periodic test, the mean output spectrum over its periods
+    divided by the mean force spectrum, and G's variance from the periods' scatter (noise on both channels,
+    correlated or not; first order).
+
+    The estimator of every periodic test here (`periodic_frf`, and each realisation of `multisine_bla`):
+    averaging the spectra before dividing keeps the force's noise out of the denominator, where a mean of
+    per-period ratios is biased by it (Pintelon & Schoukens, *System Identification*, 2nd ed., §2.5).
+
+    Parameters
+    ----------
+    U, Y : (P, L) force and response spectra over P periods at L lines
+
+    Returns
+    -------
+    tuple of (L,) complex G and (L,) real variance of G (NaN with one period)
+    """
+    P = U.shape[0]
+    Um, Ym = U.mean(axis=0), Y.mean(axis=0)
+    G = Ym / Um
+    if P < 2:
+        return G, np.full(G.shape, np.nan)
+    dU, dY = U - Um, Y - Ym
+    var_u = np.sum(np.abs(dU) ** 2, axis=0) / (P - 1) / P
+    var_y = np.sum(np.abs(dY) ** 2, axis=0) / (P - 1) / P
+    cov = np.sum(dY * np.conj(dU), axis=0) / (P - 1) / P
+    var = (var_y + np.abs(G) ** 2 * var_u - 2.0 * np.real(np.conj(G) * cov)) / np.abs(Um) ** 2
+    return G, var
 
 
 def excitation_findings(excitation) -> list[MeasurementFinding]:
@@ -106,7 +128,7 @@ def excitation_findings(excitation) -> list[MeasurementFinding]:
     return out
 
 
-__all__ = ["excitation_findings", "periodic_frf", "periodic_spectra"]
+__all__ = ["excitation_findings", "periodic_frf", "periodic_spectra", "ratio_of_means"]
 
 
 # --- several realisations: the best linear approximation (moved from discovery, issue 48) ----------------
@@ -153,9 +175,9 @@ def multisine_bla(u, y, lines, fs_hz: float) -> dict:
     lines = np.asarray(lines, int)
     U = np.fft.rfft(u, axis=2)[..., lines]
     Y = np.fft.rfft(y, axis=2)[..., lines]
-    G = Y / U  # (M, P, L)
-    Gr = G.mean(axis=1)
-    var_noise_r = G.var(axis=1, ddof=1) / P if P > 1 else np.full(Gr.shape, np.nan)
+    per = [ratio_of_means(U[m], Y[m]) for m in range(M)]  # each realisation as one periodic test
+    Gr = np.array([g for g, _ in per])
+    var_noise_r = np.array([v for _, v in per])
     bla = Gr.mean(axis=0)
     var_noise = np.nanmean(var_noise_r, axis=0) / M
     var_total = Gr.var(axis=0, ddof=1) / M if M > 1 else np.full(bla.shape, np.nan)
