@@ -341,7 +341,9 @@ def in_newtons(model, driving_point=None) -> StructureModel:
     lin, j = model.linear, model.joint
     if driving_point is not None and driving_point not in lin.channels:
         raise DataError(f"driving point {driving_point}: no such channel (channels: {', '.join(lin.channels)})")
-    d = driving_point or found(lin)
+    # found on the lowest level's model first: the structure under the joint has more poles than modes, whose
+    # fitted constants can take any sign (on the F-16 it named the payload, the lowest level the shaker's point)
+    d = driving_point or (found(model.reference) if model.reference is not None else None) or found(lin)
     if d is None or j is None:
         return model if d is None else replace(model, driving_point=d)
     phys = -lin.coupling(*j.between, d)
