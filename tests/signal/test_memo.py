@@ -93,3 +93,22 @@ def test_bands_that_differ_in_the_last_digit_are_two_questions(monkeypatch):
     assert calls["lpm"] == 2
     lpm(rec, band_hz=[30.0, 150.0])  # the same band, as floats in a list: the same question
     assert calls["lpm"] == 2
+
+
+def count_detections(monkeypatch) -> list:
+    """Every call of `detect_excitation` (the force read for its kind and layout), recorded."""
+    from satmd.signal import excitation as excitation_module
+
+    calls: list = []
+    detect = excitation_module.detect_excitation
+    monkeypatch.setattr(excitation_module, "detect_excitation", lambda *a, **k: calls.append(1) or detect(*a, **k))
+    return calls
+
+
+def test_discover_reads_each_force_once_at_the_door(monkeypatch):
+    """A recording's walk through `discover` goes down the floors once: its excitation is read when it comes in
+    (`signal.excitation.received`) and every later stage (estimators, the distortion test, the level ladder)
+    reads what it carries."""
+    calls = count_detections(monkeypatch)
+    satmd.discover([_recording(4), _recording(5)])
+    assert len(calls) == 2

@@ -83,12 +83,16 @@ def test_f16_joint_is_between_the_wing_and_the_payload():
     assert loc.location[1]["delta_bic"] > 1000
 
 
-def test_discover_says_where_the_joint_acts(cubic_between_3_and_4):
+def test_discover_says_where_the_joint_acts(cubic_between_3_and_4, monkeypatch):
     """`discover` on the levels of a structure with five accelerometers: the SATMD model is not adequate, the
-    change with level is told per resonance and placed between the two sensors the joint joins (SPEC §11)."""
+    change with level is told per resonance and placed between the two sensors the joint joins (SPEC §11).
+    Each level's force is read once, at the door, however many stages (locate, fit, simulate) follow."""
     from satmd import discover
+    from tests.signal.test_memo import count_detections
 
+    calls = count_detections(monkeypatch)
     rep = discover(cubic_between_3_and_4)
+    assert len(calls) == len(cubic_between_3_and_4)
     d = rep.to_dict()["nonlinear"]
     assert d["detected"] and [f["name"] for f in d["findings"]] == ["joint"]
     joint = d["findings"][0]
