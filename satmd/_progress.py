@@ -7,6 +7,8 @@ from __future__ import annotations
 
 import sys
 import time
+from contextlib import contextmanager
+from contextvars import ContextVar
 
 
 class LineProgress:
@@ -45,3 +47,25 @@ def progress(total: int, desc: str, unit: str = "it", enabled: bool = True):
         else:
             return tqdm(total=total, desc=desc, unit=unit, leave=False)
     return LineProgress(total, desc, unit)
+
+
+# --- stages of long work, told to whoever listens (the CLI prints them on stderr) ----------------------
+_SINK: ContextVar = ContextVar("satmd_stage_sink", default=None)
+
+
+@contextmanager
+def stages(sink):
+    """Within the block, `stage` tells ``sink`` (callable(str)) what long work is doing; nothing otherwise, so a
+    library call stays silent unless its caller asked (``satmd discover`` on a structure's levels does)."""
+    token = _SINK.set(sink)
+    try:
+        yield
+    finally:
+        _SINK.reset(token)
+
+
+def stage(text: str) -> None:
+    """Tell the listener of `stages`, if any, what is being done now."""
+    sink = _SINK.get()
+    if sink is not None:
+        sink(text)

@@ -33,7 +33,8 @@ def register(sub):
 def run(args):
     from ..discovery import discover
     from ..io import is_recording
-    from ._common import check_outputs, estimate_notes, load_recording_args, parse_band, plot_suffixes
+    from .._progress import stages
+    from ._common import Progress, check_outputs, estimate_notes, load_recording_args, parse_band, plot_suffixes
 
     from ..errors import SatmdError
 
@@ -44,12 +45,14 @@ def run(args):
     free = parse_list(args.free) or DEFAULT_FREE
     candidates = parse_names(args.candidates, registered_names(), "--candidates") if args.candidates else None
     channels = parse_list(args.channels)
+    told = Progress("discover")
     if args.more:  # several recordings of one rig (issue 26)
         items = [_load_one(args, path) for path in (args.data, *args.more)]
         if args.driving_point and hasattr(items[0], "fs_hz") and args.driving_point not in items[0].channels:
             raise SatmdError(f"--driving-point {args.driving_point}: no such channel in {args.data} "
                              f"(channels: {', '.join(c for c in items[0].channels if c != 'force')})")
-        rep = discover(items, free=free, candidates=candidates, channels=channels, alpha=args.alpha)
+        with stages(lambda text: told.step(text, force=True)):  # a structure's model takes minutes: say what runs
+            rep = discover(items, free=free, candidates=candidates, channels=channels, alpha=args.alpha)
     elif is_recording(args.data):  # the library's own path: estimate, discover, test linearity
         if args.plot:  # every output is checked before the first piece of work
             check_outputs([("--plot", args.plot, plot_suffixes())], inputs=[args.data])

@@ -60,7 +60,9 @@ def fit_structure(recordings, between=None, law: str | None = None, channels=Non
     """
     from .locate import locate_joint
 
-    say = progress or (lambda msg: None)
+    from .._progress import stage
+
+    say = progress or stage  # the caller's, else whoever listens (`satmd discover` prints the stages)
     if len(recordings) < 2:
         raise DataError("a structure model needs recordings at two or more levels")
     spectra = [periodic_spectra(r) for r in recordings]
@@ -143,8 +145,11 @@ def cross_validated(recordings, between, laws, **fit) -> str:
     order = np.argsort(levels)
     held = int(order[len(order) // 2])  # a middle level: neither the linear reference nor the top
     rest = [r for i, r in enumerate(recordings) if i != held]
+    from .._progress import stage
+
     scores = []
     for law in laws:
+        stage(f"cross-validation: the {law} joint fitted without the level of {levels[held]:.3g} RMS force ...")
         model = fit_structure(rest, between=between, law=law, **fit)
         scores.append((float(np.mean(model.predict(recordings[held]).nrmse)), law))
     return min(scores)[1]

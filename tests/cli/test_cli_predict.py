@@ -25,6 +25,7 @@ def test_discover_saves_the_model_and_predict_judges_a_level_it_never_saw(capsys
     model = tmp_path / "structure.json"
     rc, out, err = run(capsys, "discover", levels / "L1.csv", levels / "L8.csv", "--save-model", model, "--json")
     assert rc == 0, err
+    assert "locating the joint" in err and "output-error fit of the" in err  # minutes of work, told stage by stage
     joint = json.loads(out)["nonlinear"]["findings"][0]
     assert joint["name"] == "joint" and joint["between"] == ["acc3", "acc4"]
     assert joint["fit"]["metric"] == "nrmse" and len(joint["fit"]["nonlinear"]) == 2

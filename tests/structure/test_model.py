@@ -158,3 +158,18 @@ def test_a_linear_structure_gets_a_linear_model_that_predicts_every_level():
     m = fit_structure(recs)
     assert m.joint is None
     assert max(max(r) for r in m.fit["linear"]) < 0.02  # 1 % noise
+
+
+def test_the_stages_of_a_fit_are_told_to_a_listener_only():
+    """Long work is silent as a library call; within `stages` (as `satmd discover` runs it) each stage is told
+    to the listener, and an inner block can mute it."""
+    from satmd._progress import stage, stages
+
+    told: list = []
+    stage("nobody listens")  # no listener: nothing happens
+    with stages(told.append):
+        stage("one")
+        with stages(None):
+            stage("muted")
+        stage("two")
+    assert told == ["one", "two"]

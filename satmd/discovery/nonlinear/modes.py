@@ -161,6 +161,9 @@ def with_joint(report, recordings):
     responses = [c for c in recordings[0].channels if c != "force"] if recordings else []
     if len(recordings) < 2 or len(responses) < 2 or not report.findings:
         return report
+    from ..._progress import stage
+
+    stage(f"locating the joint among every pair of {len(responses)} sensors and the ground ...")
     try:
         loc = locate_joint(recordings)
     except DataError:  # not periodic tests, or too few shared lines: the account per resonance stands
