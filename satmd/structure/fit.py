@@ -8,7 +8,7 @@ import numpy as np
 from ..conventions import TINY
 from ..errors import DataError
 from ..validation import NAMES, Interval, Options, Whole, validate_params
-from .laws import LAWS
+from .laws import LAWS, SHAPE_PARAMETERS
 from .laws import law as law_named
 from .linear import LinearStructure, fit_linear
 from .locate import shape_of
@@ -332,8 +332,40 @@ def _output_error(model, drives, ref, max_nfev, fixed_path=False) -> StructureMo
     scale[n_free:n_free + len(shaped)] = 1.0  # a log: steps of order one
     sol = least_squares(residual, theta0, x_scale=scale, diff_step=1e-4, max_nfev=max_nfev)
     start = residual(theta0)
-    best = sol.x if sol.cost <= 0.5 * float(start @ start) else theta0
-    return replace(model, joint=unpack(best))
+    if sol.cost > 0.5 * float(start @ start):  # never worse than where it started
+        return replace(model, joint=unpack(theta0))
+    joint = unpack(sol.x)
+    half = _half_widths(sol.jac, sol.fun, [len(np.ravel(m[:, ::step])) for _, m in drives])
+    if half is None:
+        return replace(model, joint=joint)
+    names = list(joint.parameters())
+    ci = {}
+    for i, t in enumerate(j.terms):  # the coefficients (with the path free, the first is held: no interval)
+        if fixed_path or i > 0:
+            ci[names[i]] = float(half[i if fixed_path else i - 1])
+    for k, i in enumerate(shaped):  # a shape constant was fitted in log: its half-width by the delta method
+        ci[names[n_c + k]] = float(joint.aux[i] * half[n_free + k])
+    return replace(model, joint=replace(joint, ci95=ci))
+
+
+def _half_widths(jac, residuals, sizes):
+    """95 % half-widths of the fitted parameters: (JᵀJ)⁻¹ scaled by the residuals' variance, inflated by
+    (1 + ρ)/(1 − ρ) for their lag-one correlation ρ in time (a simulation's misfit is smooth, not white: without it
+    the intervals would count every sample as news). None when JᵀJ is singular."""
+    jac = np.asarray(jac, float)
+    n, p = jac.shape
+    if n <= p:
+        return None
+    edges = np.cumsum([0, *sizes])
+    pairs = [(residuals[a:b - 1], residuals[a + 1:b]) for a, b in zip(edges[:-1], edges[1:]) if b - a > 2]
+    rho = float(sum(x @ y for x, y in pairs) / max(sum(x @ x for x, _ in pairs), TINY)) if pairs else 0.0
+    rho = min(max(rho, 0.0), 0.999)
+    try:
+        cov = np.linalg.inv(jac.T @ jac) * float(residuals @ residuals) / (n - p) * (1 + rho) / (1 - rho)
+    except np.linalg.LinAlgError:
+        return None
+    var = np.diag(cov)
+    return np.where(var >= 0, 1.96 * np.sqrt(np.abs(var)), np.nan)
 
 
 def in_newtons(model, driving_point=None) -> StructureModel:
@@ -358,8 +390,16 @@ def in_newtons(model, driving_point=None) -> StructureModel:
     misfit = np.sqrt(np.sum(w * np.abs(j.coupling - s * phys) ** 2) / max(np.sum(w * np.abs(j.coupling) ** 2), TINY))
     if not np.isfinite(s) or s == 0 or misfit > 0.3:
         return model
-    return replace(model, joint=replace(j, coefficients=j.coefficients * s, coupling=j.coupling / s, units="N"),
-                   driving_point=d)
+    # a force coefficient scales by s, whose relative standard error is the path's misfit to the modes' shapes
+    # over the modes that set it (a weighted mean's): its interval holds both, in quadrature; a gap or a slip
+    # velocity keeps its unit and its interval
+    shapes = set(SHAPE_PARAMETERS.values())
+    values = j.parameters()
+    rel = misfit / np.sqrt(max(np.count_nonzero(w), 1))
+    ci = {n: (hw if n in shapes else abs(s) * float(np.hypot(hw, 1.96 * rel * abs(values[n]))))
+          for n, hw in j.ci95.items()}
+    return replace(model, joint=replace(j, coefficients=j.coefficients * s, coupling=j.coupling / s, units="N",
+                                        ci95=ci), driving_point=d)
 
 
 def _with_table(model, recordings, files, drives=None) -> StructureModel:

@@ -119,7 +119,11 @@ def test_a_fitted_model_predicts_a_level_it_never_saw(cubic_levels, cubic_model)
     held = m.predict(cubic_levels[1], file="level 3")
     assert not held.extrapolated and max(held.nrmse) < 0.016
     assert m.joint.units == "N" and m.driving_point == "acc1"
-    assert 0.7 * CUBIC < m.joint.parameters()["k3"] < 1.3 * CUBIC  # in N/m³: reciprocity fixed the scale
+    k3, half = m.joint.parameters()["k3"], m.joint.ci95["k3"]
+    assert 0.7 * CUBIC < k3 < 1.3 * CUBIC  # in N/m³: reciprocity fixed the scale
+    # the interval holds the scale's error (the path against the modes' shapes), not the noise alone: it covers
+    # the truth and still says something
+    assert abs(k3 - CUBIC) < half < 0.5 * k3 and set(m.joint.ci95) == {"k3", "k", "c"}
 
 
 def test_a_level_outside_the_fitted_range_is_flagged(cubic_levels, cubic_model):
@@ -135,6 +139,7 @@ def test_a_saved_model_loads_and_predicts_the_same(cubic_levels, cubic_model, tm
     doc = json.loads(path.read_text())
     assert doc["schema"] == "satmd-structure-model/1" and doc["joint"]["between"] == ["acc3", "acc4"]
     again = StructureModel.load(path)
+    assert again.joint.ci95 == cubic_model.joint.ci95
     assert again.predict(cubic_levels[1]).nrmse == pytest.approx(cubic_model.predict(cubic_levels[1]).nrmse, rel=1e-9)
 
 

@@ -186,8 +186,10 @@ def with_joint(report, recordings):
         worst_nl = max(max(r) for r in model.fit["nonlinear"])
         unit = " N" if model.joint.units == "N" else ", relative units: no driving point fixes the scale"
         if worst_nl < worst_lin:
-            explanation += (f"; modelled ({model.joint.formula()}{unit}), simulated from each force the worst NRMSE "
-                            f"goes from {worst_lin:.2f} (linear) to {worst_nl:.2f}")
+            bounds = ", ".join(f"{n} {parameters[n]:.3g} ± {w:.2g}" for n, w in model.joint.ci95.items())
+            explanation += (f"; modelled ({model.joint.formula()}{unit}{'; 95 %: ' + bounds if bounds else ''}), "
+                            f"simulated from each force the worst NRMSE goes from {worst_lin:.2f} (linear) to "
+                            f"{worst_nl:.2f}")
         else:  # said, not hidden: the place or the law the levels point to does not make a better simulation
             explanation += (f"; its model ({model.joint.formula()}{unit}) does not simulate the recordings better than "
                             f"the linear one (worst NRMSE {worst_lin:.2f} linear, {worst_nl:.2f} with the joint): the "
@@ -199,8 +201,9 @@ def with_joint(report, recordings):
         equivalent.insert(0, {"law": loc.law, "delta_bic": 0.0})
         explanation += (f"; {law}, not the {loc.law} library the levels' spectra preferred: fitted without a middle "
                         f"level, it predicted that level better")
+    ci95 = dict(model.joint.ci95) if model is not None and model.joint is not None else {}
     joint = NonlinearFinding("joint", between=[a, b], location=loc.location, law=law, parameters=parameters or {},
-                             equivalent=equivalent,
+                             ci95=ci95, equivalent=equivalent,
                              modes=old.get("modes"), fit=fit,
                              explanation=explanation + (f". {old.explanation}" if old.explanation else ""))
     return replace(report, findings=[joint], model=model)
