@@ -395,7 +395,7 @@ def in_newtons(model, driving_point=None) -> StructureModel:
     # velocity keeps its unit and its interval
     shapes = set(SHAPE_PARAMETERS.values())
     values = j.parameters()
-    rel = misfit / np.sqrt(max(np.count_nonzero(w), 1))
+    rel = float(misfit) / np.sqrt(float(max(int(np.count_nonzero(w)), 1)))
     ci = {n: (hw if n in shapes else abs(s) * float(np.hypot(hw, 1.96 * rel * abs(values[n]))))
           for n, hw in j.ci95.items()}
     return replace(model, joint=replace(j, coefficients=j.coefficients * s, coupling=j.coupling / s, units="N",
