@@ -179,8 +179,13 @@ class DiscoveryReport:
         return self.report()
 
     def figure(self):
-        """Measured vs nominal vs augmented FRFs and standardised residuals, bands shaded."""
+        """Measured vs nominal vs augmented FRFs and standardised residuals, bands shaded; for a structure whose
+        joint was located (SPEC §11), the sensors with the joint, the evidence per place and the model's fit."""
         from ..plots import fit_figure
+
+        joint = self._joint_finding()
+        if joint is not None:
+            return self._structure_figure(joint)
 
         data = self.nominal_fit.data
         curves = [("nominal model", self.nominal_fit.prediction().channels, {"color": "tab:orange", "lw": 1.0})]
@@ -200,6 +205,22 @@ class DiscoveryReport:
         title = ("discovery: " + (", ".join(self.effect_names) if self.effects else "no missing physics")
                  + f"  (χ²_red {self.fit_before['chi2_reduced']:.3g} → {self.fit_after['chi2_reduced']:.3g})")
         return fit_figure(data, curves, resid, bands=self.mismatch_bands_hz, title=title)
+
+    def _joint_finding(self):
+        """The ``joint`` finding of the nonlinear block (a structure's joint located among its sensors), or None."""
+        found = [f for f in getattr(self.nonlinear, "findings", []) or [] if f.get("name") == "joint"]
+        return found[0] if found and found[0].get("location") else None
+
+    def _structure_figure(self, joint):
+        from types import SimpleNamespace
+
+        from ..structure.figures import draw_structure_discovery
+
+        where = SimpleNamespace(location=joint["location"], between=tuple(joint["between"]), law=joint["law"],
+                                detected=True)
+        a, b = joint["between"]
+        return draw_structure_discovery(where, self.model, title=f"discovery: a joint between {a} and {b} "
+                                                                  f"({joint['law']}); not a SATMD rig")
 
     def plot(self, path):
         from ..plots import save

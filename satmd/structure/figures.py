@@ -30,10 +30,50 @@ def draw_joint(location, title: str = ""):
     from ..plots import pyplot
 
     plt = pyplot()
+    fig, (ax, bx) = plt.subplots(1, 2, figsize=(11, 3.8), gridspec_kw={"width_ratios": [1.1, 1.0]})
+    _draw_sensors(ax, location)
+    _draw_evidence(bx, location)
+    if title:
+        fig.suptitle(title)
+    fig.tight_layout()
+    return fig
+
+
+def draw_structure_discovery(location, model, title: str = ""):
+    """What `discover` found on a structure's levels: where the joint acts (`draw_joint`'s two panels) and,
+    with a fitted model, each recording's worst-channel NRMSE, linear against the joint's model (its ``fit``).
+
+    Parameters
+    ----------
+    location : JointLocation, or the joint finding read as one (``between``, ``law``, ``location``, ``detected``)
+    model : StructureModel or None
+    title : a title above the panels
+
+    Returns
+    -------
+    matplotlib Figure
+    """
+    from ..plots import pyplot
+
+    plt = pyplot()
+    fitted = model is not None and model.joint is not None and bool(model.fit)
+    fig, axes = plt.subplots(1, 3 if fitted else 2, figsize=(15.5 if fitted else 11, 3.8),
+                             gridspec_kw={"width_ratios": [1.1, 1.0, 1.0] if fitted else [1.1, 1.0]})
+    _draw_sensors(axes[0], location)
+    _draw_evidence(axes[1], location)
+    if fitted:
+        _draw_fit_table(axes[2], model.fit)
+    if title:
+        fig.suptitle(title)
+    fig.tight_layout()
+    return fig
+
+
+def _draw_sensors(ax, location):
+    """The sensors in a row above the ground, the joint between its two, equally supported places dashed."""
     sensors = sorted({c for e in location.location for c in e["between"] if c != "ground"},
                      key=lambda c: (len(c), c))
     x = {c: float(i) for i, c in enumerate(sensors)}
-    fig, (ax, bx) = plt.subplots(1, 2, figsize=(11, 3.8), gridspec_kw={"width_ratios": [1.1, 1.0]})
 
     def ends(pair):
         a, b = pair
@@ -61,6 +101,9 @@ def draw_joint(location, title: str = ""):
     ax.axis("off")
     ax.set_title("where the joint acts" if location.detected else "no joint: one linear structure explains every level")
 
+
+def _draw_evidence(bx, location):
+    """ΔBIC of every place to the best, the best in red."""
     rows = location.location[::-1]
     labels = [" – ".join(e["between"]) for e in rows]
     values = [max(e["delta_bic"], 0.0) + 1.0 for e in rows]
@@ -71,10 +114,24 @@ def draw_joint(location, title: str = ""):
     bx.axvline(11.0, color="tab:orange", ls="--", lw=1, label="equally supported (ΔBIC ≤ 10)")
     bx.legend(fontsize=8, loc="lower right")
     bx.tick_params(axis="y", labelsize=8)
-    if title:
-        fig.suptitle(title)
-    fig.tight_layout()
-    return fig
+
+
+def _draw_fit_table(cx, fit):
+    """Each recording's worst-channel NRMSE, simulated from its force: the lowest level's linear model against the
+    model with the joint."""
+    from pathlib import Path
+
+    files = [Path(str(f)).stem for f in fit["files"]]
+    lin = [max(r) for r in fit["linear"]]
+    nl = [max(r) for r in fit["nonlinear"]]
+    at = np.arange(len(files))
+    cx.bar(at - 0.2, lin, 0.4, color="tab:blue", label="linear (lowest level)")
+    cx.bar(at + 0.2, nl, 0.4, color="tab:red", label="with the joint")
+    cx.set_yscale("log")
+    cx.set_xticks(at, files, rotation=20, ha="right", fontsize=7)
+    cx.set_ylabel("worst-channel NRMSE")
+    cx.set_title("simulated from each recording's force", fontsize=10)
+    cx.legend(fontsize=8)
 
 
 def prediction_figure(prediction, path, title: str = ""):

@@ -99,6 +99,8 @@ def test_discover_says_where_the_joint_acts(cubic_between_3_and_4, monkeypatch):
     assert joint["between"] == ["acc3", "acc4"] and joint["law"] == "cubic"
     assert joint["location"][0]["between"] == ["acc3", "acc4"] and "modes" in joint
     assert "joint between acc3 and acc4" in rep.report()
+    fig = rep.figure()  # the structure's figure, not the SATMD rig's FRF panels
+    assert len(fig.axes) == 3 and "a joint between acc3 and acc4 (cubic)" in fig.texts[0].get_text()
 
 
 def test_discover_refuses_a_sensor_missing_at_one_level(cubic_between_3_and_4):
