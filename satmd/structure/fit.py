@@ -340,11 +340,13 @@ def _output_error(model, drives, ref, max_nfev, fixed_path=False) -> StructureMo
         return replace(model, joint=joint)
     names = list(joint.parameters())
     ci = {}
-    for i, t in enumerate(j.terms):  # the coefficients (with the path free, the first is held: no interval)
+    for i, c in enumerate(joint.coefficients):  # (with the path free, the first is held: no interval)
         if fixed_path or i > 0:
-            ci[names[i]] = float(half[i if fixed_path else i - 1])
-    for k, i in enumerate(shaped):  # a shape constant was fitted in log: its half-width by the delta method
-        ci[names[n_c + k]] = float(joint.aux[i] * half[n_free + k])
+            h = float(half[i if fixed_path else i - 1])
+            ci[names[i]] = [float(c) - h, float(c) + h]
+    for k, i in enumerate(shaped):  # a shape constant was fitted in log: its interval is a factor either side
+        h = float(half[n_free + k])
+        ci[names[n_c + k]] = [float(joint.aux[i] * np.exp(-h)), float(joint.aux[i] * np.exp(h))]
     return replace(model, joint=replace(joint, ci95=ci))
 
 
@@ -396,8 +398,13 @@ def in_newtons(model, driving_point=None) -> StructureModel:
     shapes = set(SHAPE_PARAMETERS.values())
     values = j.parameters()
     rel = float(misfit) / np.sqrt(float(max(int(np.count_nonzero(w)), 1)))
-    ci = {n: (hw if n in shapes else abs(s) * float(np.hypot(hw, 1.96 * rel * abs(values[n]))))
-          for n, hw in j.ci95.items()}
+    ci = {}
+    for n, (lo, hi) in j.ci95.items():
+        if n in shapes:
+            ci[n] = [lo, hi]
+            continue
+        h = abs(s) * float(np.hypot(0.5 * (hi - lo), 1.96 * rel * abs(values[n])))
+        ci[n] = [values[n] * s - h, values[n] * s + h]
     return replace(model, joint=replace(j, coefficients=j.coefficients * s, coupling=j.coupling / s, units="N",
                                         ci95=ci), driving_point=d)
 

@@ -52,9 +52,9 @@ class Joint:
     coupling : (n,) complex κ_r: the joint's column of residues is the force's times κ
     units : ``"N"`` when the coefficients are forces (the path scaled by reciprocity through a driving
         point), ``"relative"`` when only their product with the path is known
-    ci95 : 95 % half-width of each fitted parameter, by the names of `parameters` (from the output-error fit's
-        Jacobian, its residuals' correlation in time counted; given the linear part and the path); empty when
-        not estimated
+    ci95 : 95 % interval [lo, hi] of each fitted parameter, by the names of `parameters` (from the output-error
+        fit's Jacobian, its residuals' correlation in time counted; in newtons the scale's error from the path's
+        misfit to the modes' shapes too); empty when not estimated
     """
 
     between: tuple
@@ -85,14 +85,14 @@ class Joint:
         return {"between": list(self.between), "law": self.law, "terms": list(self.terms),
                 "coefficients": [float(c) for c in self.coefficients], "aux": [float(a) for a in self.aux],
                 "coupling": [[float(k.real), float(k.imag)] for k in self.coupling], "units": self.units,
-                "formula": self.formula(), "ci95": {k: float(v) for k, v in self.ci95.items()}}
+                "formula": self.formula(), "ci95": {k: [float(x) for x in v] for k, v in self.ci95.items()}}
 
     @classmethod
     def from_dict(cls, d: dict) -> "Joint":
         k = np.asarray(d["coupling"], float).reshape(-1, 2)
         return cls(tuple(d["between"]), str(d["law"]), np.asarray(d["coefficients"], float),
                    np.asarray(d["aux"], float), k[:, 0] + 1j * k[:, 1], str(d.get("units", "relative")),
-                   {str(n): float(v) for n, v in (d.get("ci95") or {}).items()})
+                   {str(n): [float(x) for x in v] for n, v in (d.get("ci95") or {}).items()})
 
 
 @dataclass(frozen=True)

@@ -186,7 +186,7 @@ def with_joint(report, recordings):
         worst_nl = max(max(r) for r in model.fit["nonlinear"])
         unit = " N" if model.joint.units == "N" else ", relative units: no driving point fixes the scale"
         if worst_nl < worst_lin:
-            bounds = ", ".join(f"{n} {parameters[n]:.3g} ± {w:.2g}" for n, w in model.joint.ci95.items())
+            bounds = ", ".join(f"{n} {parameters[n]:.3g} [{lo:.3g}, {hi:.3g}]" for n, (lo, hi) in model.joint.ci95.items())
             explanation += (f"; modelled ({model.joint.formula()}{unit}{'; 95 %: ' + bounds if bounds else ''}), "
                             f"simulated from each force the worst NRMSE goes from {worst_lin:.2f} (linear) to "
                             f"{worst_nl:.2f}")
