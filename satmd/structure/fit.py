@@ -415,8 +415,8 @@ def in_newtons(model, driving_point=None) -> StructureModel:
     w = np.where(w > 0.05 * w.max(), w, 0.0)  # the structure's modes, not the poles that only shape the fit
     s = float(np.sum(w * (j.coupling * phys.conj()).real) / max(np.sum(w * np.abs(phys) ** 2), TINY))
     misfit = np.sqrt(np.sum(w * np.abs(j.coupling - s * phys) ** 2) / max(np.sum(w * np.abs(j.coupling) ** 2), TINY))
-    if not np.isfinite(s) or s == 0 or misfit > 0.3:
-        return model
+    if not np.isfinite(s) or s == 0 or misfit > 0.3:  # the point is known, the scale is not: said so
+        return replace(model, driving_point=d)
     # a force coefficient scales by s, whose relative standard error is the path's misfit to the modes' shapes
     # over the modes that set it (a weighted mean's): its interval holds both, in quadrature; a gap or a slip
     # velocity keeps its unit and its interval

@@ -95,9 +95,18 @@ def fit_linear(spectra, channels, between=None, n_pairs=None) -> LinearStructure
     -------
     LinearStructure
     """
-    from ..modal.rational import vector_fit
+    from ..signal.memo import fingerprint
 
     names = tuple(channels)
+    # asked again for every law the cross-validation weighs (each a few seconds on the F-16): answered once
+    key = fingerprint(spectra.freq_hz, spectra.force, *[spectra.responses[c] for c in names],
+                      settings=(names, tuple(between) if between else None, n_pairs))
+    return _FITTED.answer(key, lambda: _fit_linear(spectra, names, between, n_pairs))
+
+
+def _fit_linear(spectra, names, between, n_pairs) -> LinearStructure:
+    from ..modal.rational import vector_fit
+
     f = spectra.freq_hz
     H = np.array([spectra.responses[c] / spectra.force for c in names])
     ia = names.index(between[0]) if between else None
@@ -122,6 +131,15 @@ def fit_linear(spectra, channels, between=None, n_pairs=None) -> LinearStructure
         res[ia] += res[ib]
         feed[ia] += feed[ib]
     return LinearStructure(names, poles, res, feed)
+
+
+def _memo():
+    from ..signal.memo import ContentMemo
+
+    return ContentMemo(size=8)
+
+
+_FITTED = _memo()
 
 
 def _pair_counts(freq_hz) -> list:

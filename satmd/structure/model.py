@@ -231,7 +231,10 @@ class StructureModel:
             lines.append("no joint: linear at every level")
         else:
             a, b = self.joint.between
-            unit = " N" if self.joint.units == "N" else " (relative: no driving point fixes its scale)"
+            unit = (" N" if self.joint.units == "N" else
+                    f" (relative: its path departs from the modes' shapes at the driving point {self.driving_point}, "
+                    "so reciprocity does not fix its scale)" if self.driving_point else
+                    " (relative: no driving point fixes its scale)")
             lines.append(f"joint between {a} and {b}: {self.joint.law}, force {self.joint.formula()}{unit}")
         if self.fit:
             lines.append("NRMSE (" + ", ".join(self.fit["channels"]) + "): linear → with the joint")

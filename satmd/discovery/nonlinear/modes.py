@@ -172,19 +172,23 @@ def with_joint(report, recordings):
         return report
     a, b = loc.between
     near = [e for e in loc.location[1:] if e["delta_bic"] <= 10.0]
-    explanation = (f"a joint between {a} and {b} ({loc.law}): its relative motion explains the change between "
+    model = _structure_model(recordings, loc)
+    named = model.joint.law if model is not None and model.joint is not None else loc.law
+    explanation = (f"a joint between {a} and {b} ({named}): its relative motion explains the change between "
                    f"the levels (ΔBIC {loc.location[1]['delta_bic']:.0f} to the next place, "
                    f"{' and '.join(loc.location[1]['between'])})" if len(loc.location) > 1 else f"a joint between {a} and {b}")
     if near:
         explanation += "; as well supported: " + "; ".join(" and ".join(e["between"]) for e in near)
-    model = _structure_model(recordings, loc)
     fit = parameters = None
     if model is not None and model.joint is not None:
         fit = {k: model.fit[k] for k in ("metric", "channels", "linear", "nonlinear")}
         parameters = model.joint.parameters()
         worst_lin = max(max(r) for r in model.fit["linear"])
         worst_nl = max(max(r) for r in model.fit["nonlinear"])
-        unit = " N" if model.joint.units == "N" else ", relative units: no driving point fixes the scale"
+        unit = (" N" if model.joint.units == "N" else
+                f", relative units: the fitted path departs from the modes' shapes at the driving point "
+                f"{model.driving_point} by over 30 %, so reciprocity does not fix its scale" if model.driving_point else
+                ", relative units: no driving point fixes the scale")
         if worst_nl < worst_lin:
             bounds = ", ".join(f"{n} {parameters[n]:.3g} [{lo:.3g}, {hi:.3g}]" for n, (lo, hi) in model.joint.ci95.items())
             explanation += (f"; modelled ({model.joint.formula()}{unit}{'; 95 %: ' + bounds if bounds else ''}), "
