@@ -219,3 +219,22 @@ def test_the_joint_pass_is_the_ode_of_the_same_model(law, coefficients, aux):
     exact = force_law(joint.coefficients, drive.dF + (rd @ z).real, drive.vF + (rv @ z).real, joint.aux)
     assert np.std(exact) > 0.05 * np.max(np.abs(exact)) > 0  # the joint works: its law's kink is crossed
     assert nrmse(g, exact) < 0.01, nrmse(g, exact)
+
+
+def test_the_linear_part_is_fitted_once_per_level_and_pair(cubic_levels, monkeypatch):
+    """The cross-validation fits a model per law, each from the same lowest level: its linear part is one
+    vector fit, asked for again (a copy each time, so an edit never reaches the next caller)."""
+    from satmd.structure import linear as linear_module
+
+    calls: list = []
+    fit = linear_module._fit_linear
+    monkeypatch.setattr(linear_module, "_fit_linear", lambda *a: calls.append(1) or fit(*a))
+    linear_module._FITTED.clear()
+    s = periodic_spectra(cubic_levels[0])
+    names = tuple(f"acc{i}" for i in range(1, 6))
+    first = fit_linear(s, names, ("acc3", "acc4"))
+    first.residues[:] = 0.0
+    again = fit_linear(s, names, ("acc3", "acc4"))
+    assert len(calls) == 1 and np.all(np.abs(again.residues) > 0)
+    fit_linear(s, names, ("acc2", "acc3"))  # another pair: another fit
+    assert len(calls) == 2
