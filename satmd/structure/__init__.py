@@ -17,8 +17,10 @@ and then models it and predicts levels that were not measured:
   (`satmd.modal.rational.vector_fit`), in time;
 - `kernel`: the joint's force sample by sample (an implicit step, compiled with numba when it is there);
 - `model`: `StructureModel` (the linear part and its `Joint`), `simulate`, `predict`, JSON `save`/`load`;
-- `fit`: `fit_structure`, the model fitted on every level at once (a frequency-domain start, then output
-  error in time).
+- `starts`: where the fit starts, the joint's law and path from the levels' spectra (the lowest level as the
+  structure, or the structure under the joint from every level at once);
+- `fit`: `fit_structure`, the model fitted on every level at once (from those starts, output error in time,
+  the parameters' intervals, the scale in newtons by reciprocity).
 
 How (`locate`): the nonlinear force of a joint is a feedback input to the linear structure (nonlinear
 subspace identification, FNSI: Noël & Kerschen 2013). With the structure's poles from its lowest level,

@@ -7,15 +7,16 @@ import numpy as np
 
 from ..conventions import TINY
 from ..errors import DataError
+from ..numerics import jacobian_covariance
 from ..validation import NAMES, Interval, Options, Whole, validate_params
 from .laws import LAWS, SHAPE_GRID, SHAPE_PARAMETERS
 from .laws import law as law_named
-from .linear import LinearStructure, fit_linear
+from .linear import fit_linear
 from .locate import shape_of
 from .model import Drive, Joint, StructureModel, nrmse, warmup_of
 from .spectra import periodic_spectra
+from .starts import measured_start, underlying_start
 
-ALTERNATIONS = 30  # of the frequency-domain start (κ at fixed c, c at fixed κ)
 FIT_PERIODS = 3  # steady periods of a periodic test in the output-error fit
 CROSS_VALIDATED = 3  # named laws (the best by the levels' spectra) weighed against the sparse library
 STARTS = ("measured", "underlying")
@@ -113,9 +114,9 @@ def fit_structure(recordings, between=None, law: str | None = None, channels=Non
     for start in starts:  # the lowest level as the linear part, or the structure under the joint: the better kept
         if start == "underlying":
             say("the structure under the joint and the joint's path, from every level at once ...")
-            linear, c, kappa = _underlying_start(reference, spectra, between, lw, d0, v0, aux)
+            linear, c, kappa = underlying_start(reference, spectra, between, lw, d0, v0, aux)
         else:
-            linear, (c, kappa) = reference, _start(reference, spectra, between, lw, d0, v0, aux)
+            linear, (c, kappa) = reference, measured_start(reference, spectra, between, lw, d0, v0, aux)
         if not (np.all(np.isfinite(c)) and np.all(np.isfinite(kappa)) and np.all(np.isfinite(linear.residues))):
             say(f"the {start} start has no finite joint: left out")
             continue
@@ -148,7 +149,7 @@ def _simulated_shape(linear, spectra, between, lw, d0, v0, aux, recordings, meas
         return aux
     best, best_cost = aux, np.inf
     for a in tried:
-        c, kappa = _start(linear, spectra, between, lw, d0, v0, a)
+        c, kappa = measured_start(linear, spectra, between, lw, d0, v0, a)
         if not (np.all(np.isfinite(c)) and np.all(np.isfinite(kappa))):
             continue
         model = StructureModel(linear, Joint(between, lw.name, c, a, kappa), levels, reference=linear,
@@ -211,94 +212,6 @@ def _cost(model, drives) -> float:
     total = float(sum(np.sum(((d.outputs(model.joint) - m) / m.std(axis=1, keepdims=True)) ** 2) / m.size
                       for d, m in drives))
     return total if np.isfinite(total) else np.inf
-
-
-def _underlying_start(linear, spectra, between, lw, d0, v0, aux, extra_pairs: int = 2):
-    """(LinearStructure, c, κ): the structure under the joint and the joint, from every level at once.
-
-    Every channel's response at every level is the structure's FRF times the force plus the joint's column
-    times the spectrum of its force, ``A = H_u F + T G`` (FNSI's feedback form). At fixed law coefficients c
-    this is a two-input system whose shared poles and residues a vector fit finds (`vector_fit_inputs`); at
-    fixed H_u and T, c is linear; alternated. The poles are the structure's under the joint (not the
-    lowest level's, where the joint already damps and stiffens it). The pair's first sensor is fitted as the
-    pair's difference (see `linear.fit_linear`). κ is T's residues over H_u's, mode by mode, in least squares
-    over the channels."""
-    from ..modal.rational import vector_fit_inputs
-
-    names = linear.channels
-    ia = names.index(between[0])
-    ib = names.index(between[1]) if between[1] != "ground" else None
-    data = []
-    for s in spectra:
-        A = np.array([s.responses[c] for c in names])
-        if ib is not None:
-            A[ia] = A[ia] - A[ib]
-        G = np.array([s.at_lines(t) for t in lw.columns(*s.relative(*between), d0, v0, aux)])
-        W = np.repeat(1.0 / np.maximum(np.abs(A).mean(axis=1, keepdims=True), TINY), A.shape[1], axis=1)
-        data.append((s.freq_hz, s.force, G, A, W))
-    c = np.zeros(len(lw.all_terms))
-    c[0] = 1.0
-    k = linear.poles.size + extra_pairs
-    poles = None
-    for _ in range(ALTERNATIONS // 3):
-        blocks = [(f, np.array([F, c @ G]), A, W) for f, F, G, A, W in data]
-        poles, res, feed = vector_fit_inputs(blocks, k, iterations=6 if poles is not None else 12, poles=poles)
-        T = [_model_frf(f, poles, res[:, 1], feed[:, 1]) for f, *_ in data]
-        X = np.vstack([np.column_stack([(T[m][i] * g) * W[i] for g in G])
-                       for m, (f, F, G, A, W) in enumerate(data) for i in range(len(names))])
-        y = np.concatenate([(A[i] - _model_frf(f, poles, res[i:i + 1, 0], feed[i:i + 1, 0])[0] * F) * W[i]
-                            for f, F, G, A, W in data for i in range(len(names))])
-        Xr, yr = _real(X, y)
-        c_new = np.linalg.lstsq(Xr, yr, rcond=None)[0]
-        c = c_new / (abs(c_new[0]) or 1.0)
-    blocks = [(f, np.array([F, c @ G]), A, W) for f, F, G, A, W in data]
-    poles, res, feed = vector_fit_inputs(blocks, k, iterations=6, poles=poles)
-    R, D, T = res[:, 0].copy(), feed[:, 0].copy(), res[:, 1].copy()
-    if ib is not None:  # back to the sensors' own channels
-        R[ia] += R[ib]
-        D[ia] += D[ib]
-        T[ia] += T[ib]
-    kappa = np.sum(R.conj() * T, axis=0) / np.maximum(np.sum(np.abs(R) ** 2, axis=0), TINY)
-    return LinearStructure(names, poles, R, D), c, kappa
-
-
-def _model_frf(f, poles, residues, feed):
-    return LinearStructure(tuple(range(len(residues))), poles, residues, np.asarray(feed, float)).frf(f)
-
-
-def _real(X, y):
-    return np.vstack([X.real, X.imag]), np.concatenate([y.real, y.imag])
-
-
-def _start(linear, spectra, between, lw, d0, v0, aux):
-    """(c, κ): the joint's coefficients and coupling from the level changes, in the frequency domain."""
-    names = linear.channels
-    lam = linear.poles
-    blocks = []
-    for s in spectra:
-        f = s.freq_hz
-        iw = 2j * np.pi * f[:, None]
-        H = linear.frf(f)
-        G = [s.at_lines(t) for t in lw.columns(*s.relative(*between), d0, v0, aux)]
-        for i, c in enumerate(names):
-            a = linear.residues[i][None, :] / (iw - lam[None, :])
-            b = linear.residues[i].conj()[None, :] / (iw - lam.conj()[None, :])
-            cols = np.stack([a + b, 1j * (a - b)], axis=2).reshape(f.size, -1)  # real (Re κ, Im κ) per mode
-            w = 1.0 / max(float(np.mean(np.abs(s.responses[c]))), TINY)
-            blocks.append((cols * w, G, (s.responses[c] - H[i] * s.force) * w))
-    y = np.concatenate([e for _, _, e in blocks])
-    y = np.concatenate([y.real, y.imag])
-    c = np.zeros(len(lw.all_terms))
-    c[0] = 1.0
-    kappa = np.zeros(2 * lam.size)
-    for _ in range(ALTERNATIONS):
-        X = np.vstack([cols * sum(cj * g for cj, g in zip(c, G))[:, None] for cols, G, _ in blocks])
-        kappa = np.linalg.lstsq(np.vstack([X.real, X.imag]), y, rcond=None)[0]
-        X = np.vstack([np.stack([(cols @ kappa) * g for g in G], axis=1) for cols, G, _ in blocks])
-        c = np.linalg.lstsq(np.vstack([X.real, X.imag]), y, rcond=None)[0]
-        scale = abs(c[0]) or 1.0  # the pair (c, κ) is known up to a scale: the law's first term is 1 in size
-        c, kappa = c / scale, kappa * scale
-    return c, kappa[0::2] + 1j * kappa[1::2]
 
 
 def _with_joint(model, c, kappa) -> StructureModel:
@@ -378,7 +291,7 @@ def _output_error(model, drives, ref, max_nfev, fixed_path=False) -> StructureMo
 def _half_widths(jac, residuals, sizes):
     """95 % half-widths of the fitted parameters: (JᵀJ)⁻¹ scaled by the residuals' variance, inflated by
     (1 + ρ)/(1 − ρ) for their lag-one correlation ρ in time (a simulation's misfit is smooth, not white: without it
-    the intervals would count every sample as news). None when JᵀJ is singular."""
+    the intervals would count every sample as news). None when JᵀJ is singular (`numerics.jacobian_covariance`)."""
     jac = np.asarray(jac, float)
     n, p = jac.shape
     if n <= p:
@@ -387,11 +300,10 @@ def _half_widths(jac, residuals, sizes):
     pairs = [(residuals[a:b - 1], residuals[a + 1:b]) for a, b in zip(edges[:-1], edges[1:]) if b - a > 2]
     rho = float(sum(x @ y for x, y in pairs) / max(sum(x @ x for x, _ in pairs), TINY)) if pairs else 0.0
     rho = min(max(rho, 0.0), 0.999)
-    try:
-        cov = np.linalg.inv(jac.T @ jac) * float(residuals @ residuals) / (n - p) * (1 + rho) / (1 - rho)
-    except np.linalg.LinAlgError:
-        return None
+    cov = jacobian_covariance(jac, float(residuals @ residuals) / (n - p) * (1 + rho) / (1 - rho))
     var = np.diag(cov)
+    if not np.all(np.isfinite(var)):
+        return None
     return np.where(var >= 0, 1.96 * np.sqrt(np.abs(var)), np.nan)
 
 
