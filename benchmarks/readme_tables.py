@@ -313,7 +313,9 @@ def measured() -> str:
         + " | `benchmarks/forward.py` |",
         f"| fleet: {fl['n_frf']} FRFs through `identify_many`, 2 worker processes against 1 (same run) | "
         f"process pool {fl['speedup_2_over_1_workers']['process_pool']:.2f}×, Dask LocalCluster "
-        f"{fl['speedup_2_over_1_workers']['dask_local']:.2f}×; results bit for bit identical: "
+        + (f"{fl['speedup_2_over_1_workers']['dask_local']:.2f}×" if "dask_local" in fl["speedup_2_over_1_workers"]
+           else "not measured (dask's `distributed` not installed)")
+        + "; results bit for bit identical: "
         f"{'yes' if fl['all_runs_identical'] else 'NO'} ({fl['machine']['cpu_count']}-core CPU at load average "
         f"{fl['machine']['load_average_1_5_15_before'][0]:.1f}) | `benchmarks/fleet.py` |",
         f"| discovery, shared acceptance files (`satmd discover --json`, shared scorer) | "
