@@ -34,7 +34,7 @@ def _load():
     return [round(x, 2) for x in os.getloadavg()] if hasattr(os, "getloadavg") else None
 
 
-def _commit() -> dict:
+def provenance() -> dict:
     """The commit the figures were measured at (and whether the tree had changes), and when."""
     import subprocess
     import time
@@ -71,7 +71,7 @@ def machine(device: str = "cpu", threads: int | None = None) -> dict:
         "load_average_1_5_15_before": _load(),
         "note": ("a load average above cpu_count means other processes shared the cores; "
                  "ratios are measured in the same run, interleaved"),
-        **_commit(),
+        **provenance(),
     }
     if importlib.util.find_spec("torch") is not None:
         import torch

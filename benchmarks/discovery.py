@@ -37,6 +37,9 @@ import time
 from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
 
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from _machine import provenance  # noqa: E402
+
 import numpy as np
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -126,7 +129,8 @@ def main():
     result = json.loads(out.read_text()) if parts != {"acceptance", "null", "single", "two"} and \
         out.is_file() else {}
     result.pop("out_of_model", None)  # now benchmarks/out_of_model.py (results/out_of_model.json)
-    result.update({"benchmark": "discovery", "machine": {"cpus": os.cpu_count(), "python": platform.python_version()}})
+    result.update({"benchmark": "discovery", "machine": {**provenance(), "cpus": os.cpu_count(),
+                                                          "python": platform.python_version()}})
     if "acceptance" in parts:
         result["acceptance"] = acceptance()
     with ProcessPoolExecutor(args.workers) as pool:

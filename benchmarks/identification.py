@@ -28,6 +28,9 @@ import sys
 import time
 from pathlib import Path
 
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from _machine import provenance  # noqa: E402
+
 import numpy as np
 
 from satmd import PAPER_GRID_HZ, Rig, simulate
@@ -223,7 +226,7 @@ def main(argv=None):
         "global": c,
         "targets": {"speedup_min": 1000, "speedup_met": bool(a["speedup"] and a["speedup"] >= 1000),
                     "coverage_met": all(r["met"] for r in b.values()), "global_met": c["met"]},
-        "machine": {"python": sys.version.split()[0], "platform": platform.platform(),
+        "machine": {**provenance(), "python": sys.version.split()[0], "platform": platform.platform(),
                     "cpus": os.cpu_count(), "torch_threads": torch.get_num_threads(),
                     "load_avg_1min_start": load_start,
                     "load_avg_1min_end": os.getloadavg()[0] if hasattr(os, "getloadavg") else None,

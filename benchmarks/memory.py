@@ -25,6 +25,9 @@ import sys
 import time
 from pathlib import Path
 
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from _machine import provenance  # noqa: E402
+
 OUT = Path(__file__).resolve().parent / "results" / "memory.json"
 TARGET = {"points": 16384, "peak_mb": 300.0, "time_s": 3.0}
 
@@ -109,7 +112,8 @@ def main(argv=None):
         "target": TARGET,
         "met": at["peak_mb"] <= TARGET["peak_mb"] and at["identify_s"] <= TARGET["time_s"],
         "quick": args.quick,
-        "machine": {"python": sys.version.split()[0], "platform": platform.platform(), "cpus": os.cpu_count(),
+        "machine": {**provenance(), "python": sys.version.split()[0], "platform": platform.platform(),
+                    "cpus": os.cpu_count(),
                     "load_avg_1min": os.getloadavg()[0] if hasattr(os, "getloadavg") else None},
     }
     OUT.parent.mkdir(parents=True, exist_ok=True)

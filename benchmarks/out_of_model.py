@@ -40,6 +40,9 @@ import tempfile
 import time
 from pathlib import Path
 
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from _machine import provenance  # noqa: E402
+
 import numpy as np
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -362,7 +365,7 @@ def main(argv=None) -> int:
                 print(f"{p.name:22s} adequate={row['model_adequate']!s:5s} effects={row['effects']} "
                       f"reasons={row['reasons']} {row['seconds']:.1f} s", flush=True)
     result = {"benchmark": "out_of_model", "seed": args.seed, "scale": args.scale,
-              "machine": {"cpus": os.cpu_count(), "python": platform.python_version(),
+              "machine": {**provenance(), "cpus": os.cpu_count(), "python": platform.python_version(),
                           "load_average_1min": os.getloadavg()[0]},
               "command": "python -m satmd.cli discover FILE --json (one process per file, one BLAS thread)",
               **summarise(rows), "wall_seconds": time.perf_counter() - t0, "cases": rows,

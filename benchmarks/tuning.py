@@ -36,6 +36,9 @@ import warnings
 from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
 
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from _machine import provenance  # noqa: E402
+
 import numpy as np
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -217,7 +220,7 @@ def main():
     n = args.n or (4 if args.quick else 12)
     t0 = time.perf_counter()
     result = {"benchmark": "tuning", "quick": args.quick,
-              "machine": {"cpus": os.cpu_count(), "python": platform.python_version()}}
+              "machine": {**provenance(), "cpus": os.cpu_count(), "python": platform.python_version()}}
     result["textbook"] = textbook()
     with ProcessPoolExecutor(args.workers) as pool:
         result["noisy"] = cases(pool, n, "none", 1000)
