@@ -84,7 +84,7 @@ def _signal(path, v, spec, role):
         return vector_variable(path, key, a)
     if a.ndim != 2:
         raise FormatError(path, f"map {role}={spec}: {key!r} has shape {a.shape}, not a matrix of signals")
-    rows = a if a.shape[1] >= a.shape[0] else a.T  # signals along the long axis
+    rows = _signal_rows(a)
     if not 1 <= index <= rows.shape[0]:
         raise FormatError(path, f"map {role}={spec}: {key!r} holds {rows.shape[0]} signal(s) "
                                 f"(rows 1..{rows.shape[0]})")
@@ -117,6 +117,11 @@ def _parse_variable_map(path, spec) -> dict:
     return out
 
 
+def _signal_rows(a):
+    """A matrix of signals a row each: the long axis is time."""
+    return a if a.shape[1] >= a.shape[0] else a.T
+
+
 def _response_matrix(path, v):
     """(name, {acc1: row 1, acc2: row 2, ...}) from the one matrix of accelerations a lab's file holds beside its
     force (``Acceleration`` 3×N: rows 1, 2, 3 as acc1, acc2, acc3, the long axis being time); None when there is
@@ -126,7 +131,7 @@ def _response_matrix(path, v):
     if len(found) != 1:
         return None
     a = np.asarray(v[found[0]])
-    rows = a if a.shape[1] >= a.shape[0] else a.T  # signals along the long axis
+    rows = _signal_rows(a)
     if rows.shape[0] > MAX_MATRIX_ROWS:
         return None
     return found[0], {f"acc{i + 1}": vector_variable(path, f"{found[0]}[{i + 1}]", r) for i, r in enumerate(rows)}

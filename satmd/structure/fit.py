@@ -122,8 +122,7 @@ def fit_structure(recordings, between=None, law: str | None = None, channels=Non
             continue
         model = StructureModel(linear, Joint(between, law, c, aux, kappa), levels, reference=reference,
                                oversample=oversampling(linear, ref.fs_hz))
-        drives = [(Drive(model, np.asarray(r["force"], float)[:n], float(r.fs_hz), warmup_of(r)), m)
-                  for r, m, n in zip(recordings, measured, span)]
+        drives = _drives(model, recordings, measured, span)
         say(f"output-error fit of the {law} joint between {between[0]} and {between[1]} on {len(recordings)} "
             f"recordings (from the {start} linear part) ...")
         model = _output_error(_stable(model, drives), drives, ref, max_nfev, fixed_path=not free_path)
@@ -154,8 +153,7 @@ def _simulated_shape(linear, spectra, between, lw, d0, v0, aux, recordings, meas
             continue
         model = StructureModel(linear, Joint(between, lw.name, c, a, kappa), levels, reference=linear,
                                oversample=oversampling(linear, spectra[0].fs_hz))
-        drives = [(Drive(model, np.asarray(r["force"], float)[:n], float(r.fs_hz), warmup_of(r)), m)
-                  for r, m, n in zip(recordings, measured, span)]
+        drives = _drives(model, recordings, measured, span)
         cost = _cost(_stable(model, drives), drives)
         if cost < best_cost:
             best, best_cost = a, cost
@@ -201,6 +199,12 @@ def oversampling(linear, fs_hz: float) -> int:
     the force faster than the modes), at most 8 steps a sample."""
     top = float(np.abs(linear.poles).max()) / (2 * np.pi) if linear.poles.size else 0.0
     return int(np.clip(np.ceil(16 * top / fs_hz), 1, 8))
+
+
+def _drives(model, recordings, measured, span) -> list:
+    """(Drive, measured responses) of each recording's first ``span`` samples through ``model``."""
+    return [(Drive(model, np.asarray(r["force"], float)[:n], float(r.fs_hz), warmup_of(r)), m)
+            for r, m, n in zip(recordings, measured, span)]
 
 
 def _redrive(drive, model):
