@@ -102,6 +102,9 @@ def main(argv=None):
                 result["elements"][name] = [have[k] for k in sorted(have)]
             result["parts"].append({"file": p.name, "machine": part.get("machine"),
                                     "satmd_commit": part.get("satmd_commit"), "duration_s": part.get("duration_s")})
+        # the oldest part's machine: its commit is the one the merged figures are no newer than
+        dated = [q for q in result["parts"] if q["machine"]]
+        result["machine"] = min(dated, key=lambda q: q["machine"].get("date") or "")["machine"] if dated else None
     else:
         result = {"machine": machine(), "duration_s": args.duration, "satmd_commit": _commit(), "elements": {}}
         for name in args.elements.split(","):

@@ -55,6 +55,8 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
 RESULTS = ROOT / "benchmarks" / "results"
+sys.path.insert(0, str(ROOT / "benchmarks"))
+from _machine import provenance  # noqa: E402
 
 
 def main(argv=None):
@@ -97,6 +99,7 @@ def main(argv=None):
                        log=lambda m: print(m, file=sys.stderr, flush=True))
     res["benchmark_wall_s"] = time.perf_counter() - t0
     res["date"] = time.strftime("%Y-%m-%d %H:%M:%S")
+    res["machine"] = {**res.get("machine", {}), **provenance()}
     out.parent.mkdir(parents=True, exist_ok=True)
     out.write_text(json.dumps(res, indent=1, default=float), encoding="utf-8")
     write_markdown(res, out)
@@ -124,7 +127,7 @@ def time_training(threads: int, device=None, label: str = "") -> dict:
            "blind_mae_L": blind["mae_L"], "blind_coverage": blind["coverage"],
            "device": torch.cuda.get_device_name(0) if dev.startswith("cuda") else f"cpu ({os.cpu_count()} cores)",
            "torch": torch.__version__, "torch_threads": threads, "platform": platform.platform(),
-           "load_average": os.getloadavg(), "config": model.fit_info_["config"]}
+           "load_average": os.getloadavg(), "config": model.fit_info_["config"], **provenance()}
     path = RESULTS / "inverse_training.json"
     runs = json.loads(path.read_text(encoding="utf-8")) if path.is_file() else []
     runs.append(rec)

@@ -12,13 +12,17 @@ write (no number in a region is typed by hand). Text outside the markers is
 left alone.
 
     python benchmarks/readme_tables.py            # rewrite README.md and the docs pages in place
-    python benchmarks/readme_tables.py --check    # exit 1 (and name the regions) if one of them is stale
+    python benchmarks/readme_tables.py --check    # exit 1 if a region differs from the JSON or a result is
+                                                  # older than the code it measures (`--stale` lists those)
+    python benchmarks/readme_tables.py --check --sync-only   # only the regions against the JSON (the test suite)
 
 A region ``machine-NAME`` says where the results of `benchmarks/results/NAME.json` come from: the
 script that writes them and the machine it ran on (as the JSON records it).
 
-`tests/test_readme.py` runs the check, so README and results cannot drift:
-after a benchmark writes new JSON, run this script and commit both.
+`tests/test_readme.py` runs the check of the regions against the JSON (``--sync-only``), so README and
+results cannot drift: after a benchmark writes new JSON, run this script and commit both. The full ``--check``
+also fails while a result is older than the code it measures: a change to the code fails it until
+those benchmarks are rerun (`make bench`; hours), so the suite does not run it; a release does.
 """
 from __future__ import annotations
 
@@ -544,6 +548,7 @@ MEASURES = {
     "nonlinear": ["satmd/discovery/nonlinear", "satmd/identification/nonlinear", "satmd/signal",
                   "satmd/physics/nonlinear"],
     "nonlinear_model": ["satmd/identification/nonlinear", "satmd/physics/nonlinear"],
+    "nonlinear_model_weak": ["satmd/identification/nonlinear", "satmd/physics/nonlinear"],
     "out_of_model": ["satmd/discovery", "satmd/tuning"],
     "recordings": ["satmd/signal", "satmd/simulation"],
     "silverbox": ["satmd/discovery/nonlinear", "satmd/identification/nonlinear", "satmd/signal"],
@@ -555,32 +560,55 @@ MEASURES = {
 }
 
 
-def outdated() -> list[str]:
+def _machines(doc) -> list[dict]:
+    """Every machine record in a results document: its own, and each merged part's or run's (a list of runs: each)."""
+    found = []
+
+    def walk(node, under_machine):
+        if isinstance(node, dict):
+            if under_machine and ("commit" in node or "platform" in node or "device" in node):
+                found.append(node)
+            for key, val in node.items():
+                if key in ("cases", "rows", "table"):  # the figures themselves: no machine there
+                    continue
+                walk(val, under_machine or "machine" in key or key in ("runs", "parts"))
+        elif isinstance(node, list):
+            for item in node:
+                walk(item, under_machine)
+
+    walk(doc[-1:] if isinstance(doc, list) else doc, isinstance(doc, list))  # a list of runs: the latest counts
+    return found
+
+
+def outdated(results: Path = RESULTS, measures: dict | None = None) -> list[str]:
     """'NAME: measured at C (date), and PATHS changed since (latest: C2)' for every results file older than the code
-    its figures measure (`MEASURES`); the results measured with uncommitted changes are named too."""
+    its figures measure (`MEASURES`); a merged result is as old as its oldest part, and results measured with
+    uncommitted changes, or before figures carried their commit, are named too."""
     import subprocess
 
     out = []
-    for name, paths in MEASURES.items():
-        path = ROOT / "benchmarks" / "results" / f"{name}.json"
+    for name, paths in (MEASURES if measures is None else measures).items():
+        path = results / f"{name}.json"
         if not path.exists():
             continue
-        doc = json.loads(path.read_text())
-        mach = doc.get("machine", {}) if isinstance(doc, dict) else {}
-        mach = mach if isinstance(mach, dict) else {}  # an old result's machine was one line of text
-        commit = mach.get("commit")
-        if not commit:
+        machines = _machines(json.loads(path.read_text()))
+        if not machines or any(not m.get("commit") for m in machines):
             out.append(f"{name}: no commit recorded (measured before figures carried one)")
             continue
-        log = subprocess.run(["git", "log", "-1", "--format=%h %cs", f"{commit}..HEAD", "--", *paths], cwd=ROOT,
-                             capture_output=True, text=True)
-        if log.returncode != 0:
-            out.append(f"{name}: commit {commit} is not in this history")
-        elif log.stdout.strip():
-            out.append(f"{name}: measured at {commit} ({str(mach.get('date', ''))[:10]}); {', '.join(paths)} changed "
-                       f"since (latest {log.stdout.strip()})")
-        elif mach.get("tree_changed"):
-            out.append(f"{name}: measured at {commit} with uncommitted changes")
+        for mach in sorted(machines, key=lambda m: str(m.get("date", ""))):
+            commit = mach["commit"]
+            log = subprocess.run(["git", "log", "-1", "--format=%h %cs", f"{commit}..HEAD", "--", *paths], cwd=ROOT,
+                                 capture_output=True, text=True)
+            if log.returncode != 0:
+                out.append(f"{name}: commit {commit} is not in this history")
+            elif log.stdout.strip():
+                out.append(f"{name}: measured at {commit} ({str(mach.get('date', ''))[:10]}); {', '.join(paths)} "
+                           f"changed since (latest {log.stdout.strip()})")
+            elif mach.get("tree_changed"):
+                out.append(f"{name}: measured at {commit} with uncommitted changes")
+            else:
+                continue
+            break
     return out
 
 
@@ -631,7 +659,9 @@ def render(text: str) -> tuple[str, list[str]]:
 
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    ap.add_argument("--check", action="store_true", help="exit 1 if a file differs from the results")
+    ap.add_argument("--check", action="store_true",
+                    help="exit 1 if a file differs from the results, or a result is older than the code it measures")
+    ap.add_argument("--sync-only", action="store_true", help="with --check: only the files against the results")
     ap.add_argument("--stale", action="store_true",
                     help="list the results older than the code they measure (exit 1 if any): `make bench` reruns them")
     ap.add_argument("--readme", type=Path, default=None,
@@ -661,11 +691,14 @@ def main(argv=None) -> int:
             path.write_text(out, encoding="utf-8")
             rewritten += changed
     if args.check:
+        old = [] if args.sync_only else outdated()
         if stale:
             print("readme_tables: stale regions (run `python benchmarks/readme_tables.py`): " + "; ".join(stale),
                   file=sys.stderr)
-            return 1
-        return 0
+        if old:
+            print("readme_tables: results older than the code they measure (rerun them: `--stale` lists them):\n  "
+                  + "\n  ".join(old), file=sys.stderr)
+        return 1 if stale or old else 0
     print(f"readme_tables: {len(rewritten)} region(s) rewritten" + (f": {', '.join(rewritten)}" if rewritten else ""))
     return 0
 

@@ -71,9 +71,11 @@ MAX_SAMPLES = 600_000
 def machine_info(workers):
     import os
 
+    from _machine import provenance
+
     return {"python": platform.python_version(), "platform": platform.platform(),
             "processor": platform.processor() or platform.machine(), "workers": workers,
-            "load_average_1min": os.getloadavg()[0]}
+            "load_average_1min": os.getloadavg()[0], **provenance()}
 
 
 def draw_settings(rng):

@@ -73,6 +73,9 @@ def main(argv=None) -> int:
     median = {k: statistics.median(v) for k, v in times.items()}
     median_cpu = {k: statistics.median(v) for k, v in cpu.items()}
     heavy = heavy_modules_loaded()
+    sys.path.insert(0, str(Path(__file__).parent))
+    from _machine import machine  # after the timings: it imports numpy (and asks torch its version)
+
     result = {
         "median_s": median,
         "min_s": {k: min(v) for k, v in times.items()},
@@ -85,7 +88,7 @@ def main(argv=None) -> int:
         "meets_target_cpu": bool(median_cpu["import_satmd"] <= TARGET_S and median_cpu["satmd_help"] <= TARGET_S),
         "heavy_modules_after_import": heavy,
         "python": platform.python_version(),
-        "machine": platform.machine(),
+        "machine": machine(device="cpu", threads=1),
         "cpu_count": os.cpu_count(),
         "load_average": list(os.getloadavg()) if hasattr(os, "getloadavg") else None,
     }

@@ -12,12 +12,13 @@ Blocks
 
 Tables
 ------
-`benchmarks/readme_tables.py --check` must pass: every region between ``<!-- results:NAME -->`` markers
+`benchmarks/readme_tables.py --check --sync-only` must pass: every region between ``<!-- results:NAME -->`` markers
 is what the script writes from `benchmarks/results/*.json`.
 """
 from __future__ import annotations
 
 import contextlib
+import json
 import io
 import re
 import shlex
@@ -161,7 +162,7 @@ def test_readme_block(block, tmp_path, monkeypatch):
 
 
 def test_readme_tables_match_results():
-    proc = subprocess.run([sys.executable, str(ROOT / "benchmarks" / "readme_tables.py"), "--check"],
+    proc = subprocess.run([sys.executable, str(ROOT / "benchmarks" / "readme_tables.py"), "--check", "--sync-only"],
                           check=False, capture_output=True, text=True, cwd=ROOT)
     assert proc.returncode == 0, proc.stderr + proc.stdout
 
@@ -172,3 +173,34 @@ def test_output_matching_is_strict():
         check_output(["c", "a"], "a\nb\nc\n", "self-test")
     with pytest.raises(AssertionError):
         check_output(["a 66.0 Hz"], "a 65.9 Hz\n", "self-test")
+
+
+def _readme_tables():
+    import importlib.util
+
+    spec = importlib.util.spec_from_file_location("readme_tables", ROOT / "benchmarks" / "readme_tables.py")
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    return mod
+
+
+def test_staleness_counts_every_part_and_the_latest_run(tmp_path):
+    """A result is as old as its oldest part; a list of runs is as old as its latest; no commit is stale."""
+    head = subprocess.run(["git", "rev-parse", "--short", "HEAD"], cwd=ROOT, capture_output=True, text=True)
+    first = subprocess.run(["git", "rev-list", "--max-parents=0", "HEAD"], cwd=ROOT, capture_output=True, text=True)
+    if head.returncode or first.returncode or not head.stdout.strip():
+        pytest.skip("not a git checkout")
+    now, root = head.stdout.strip(), first.stdout.split()[0][:7]
+    rt = _readme_tables()
+    fresh = {"commit": now, "date": "2026-12-02", "platform": "x"}
+    old = {"commit": root, "date": "2026-11-01", "platform": "x"}
+    docs = {"fresh": {"machine": fresh, "cases": [{"machine": old}]},  # a case's record is not a machine's
+            "merged": {"machine": fresh, "runs": [{"machine": fresh}, {"machine": old}]},
+            "history": [{"platform": "x"}, fresh],
+            "bare": {"machine": {"platform": "x"}}}
+    for name, doc in docs.items():
+        (tmp_path / f"{name}.json").write_text(json.dumps(doc))
+    found = rt.outdated(tmp_path, {name: ["satmd"] for name in docs})
+    flagged = {line.split(":", 1)[0] for line in found}
+    assert flagged == {"merged", "bare"}, found
+    assert any(line.startswith(f"merged: measured at {root}") for line in found)
