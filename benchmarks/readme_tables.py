@@ -561,8 +561,9 @@ MEASURES = {
     "recordings": ["satmd/signal", "satmd/simulation"],
     "silverbox": ["satmd/discovery/nonlinear", "satmd/identification/nonlinear", "satmd/signal"],
     "startup": ["satmd/__init__.py", "satmd/cli"],
-    "structures_joint": ["satmd/structure/locate.py", "satmd/structure/laws.py", "satmd/structure/spectra.py"],
-    "structures_levels": ["satmd/modal", "satmd/discovery/nonlinear", "satmd/signal"],
+    "structures_joint": ["satmd/structure/locate.py", "satmd/structure/laws.py", "satmd/structure/spectra.py",
+                         "satmd/modal/fit.py", "satmd/modal/poles.py"],
+    "structures_levels": ["satmd/modal", "satmd/discovery/nonlinear", "satmd/signal", "satmd/structure"],
     "structures_predict": ["satmd/structure", "satmd/modal/rational.py"],
     "tuning": ["satmd/tuning"],
 }

@@ -242,7 +242,7 @@ def _output_error(model, drives, ref, max_nfev, fixed_path=False) -> StructureMo
 
     j = model.joint
     n_c = j.coefficients.size
-    shaped = [i for i, t in enumerate(j.terms) if t in ("contact", "sign(v)")]
+    shaped = [i for i, t in enumerate(j.terms) if t in SHAPE_GRID]
     step = max(1, int(ref.fs_hz / (8 * ref.freq_hz[-1])))  # the responses are band-limited well below Nyquist
     scales = [m.std(axis=1, keepdims=True) for _, m in drives]
 

@@ -19,19 +19,23 @@ import numpy as np
 from ..errors import DataError
 
 #: term name -> code of `term`
-TERM_CODES = {"d": 0, "v": 1, "d³": 2, "d|d|": 3, "contact": 4, "sign(v)": 5, "v|v|": 6, "d²": 7, "v³": 8}
+TERM_CODES = {"d": 0, "v": 1, "d³": 2, "d|d|": 3, "contact": 4, "sign(v)": 5, "v|v|": 6, "d²": 7, "v³": 8,
+              "tanh(d)": 9}
 #: term name -> the name of its coefficient in a model's parameters (force per term unit)
 TERM_PARAMETERS = {"d": "k", "v": "c", "d³": "k3", "d|d|": "k_soft", "contact": "k_contact", "sign(v)": "f_slip",
-                   "v|v|": "c2", "d²": "k2", "v³": "c3"}
+                   "v|v|": "c2", "d²": "k2", "v³": "c3", "tanh(d)": "k_sat"}
 #: term name -> the name of its shape constant
-SHAPE_PARAMETERS = {"contact": "gap", "sign(v)": "v_slip"}
+SHAPE_PARAMETERS = {"contact": "gap", "sign(v)": "v_slip", "tanh(d)": "d_sat"}
 FRICTION_SMOOTHING = 0.05  # a Coulomb force smoothed over 5 % of the reference velocity's RMS
 #: the shape constants tried for a shaped term, in units of the reference level's RMS stroke (a gap) or relative
 #: velocity (a friction's smoothing): the law's evidence is its best over them (`JointLaw.shapes`). A slip
 #: smoothed over up to 3 RMS velocities of the lowest level: a friction that slips only at the top levels (on
 #: chains, 8 smoothed friction joints were named 1 time in 8 with the grid stopping at 1, 4 with it at 3); beyond
 #: that a smoothed slip is a cubic damping of either sign and takes quadratic damping's place
-SHAPE_GRID = {"contact": (0.5, 1.0, 2.0, 3.0), "sign(v)": (FRICTION_SMOOTHING, 0.2, 0.5, 1.0, 2.0, 3.0)}
+#: A saturating spring's stroke from half the lowest level's RMS stroke to 8 of them (the top level of a test
+#: 20 dB wide): beyond that it is a cubic at every level measured.
+SHAPE_GRID = {"contact": (0.5, 1.0, 2.0, 3.0), "sign(v)": (FRICTION_SMOOTHING, 0.2, 0.5, 1.0, 2.0, 3.0),
+              "tanh(d)": (0.5, 1.0, 2.0, 4.0, 8.0)}
 
 
 def term(code, d, v, aux):
@@ -54,7 +58,10 @@ def term(code, d, v, aux):
         return v * np.abs(v), 0.0 * v, 2.0 * np.abs(v)
     if code == 7:
         return d * d, 2.0 * d, 0.0 * d
-    return v * v * v, 0.0 * v, 3.0 * v * v
+    if code == 8:
+        return v * v * v, 0.0 * v, 3.0 * v * v
+    t = np.tanh(d / aux)  # a spring that saturates: stiffness k_sat at small strokes, force k_sat·aux beyond aux
+    return aux * t, 1.0 - t * t, 0.0 * d
 
 
 @dataclass(frozen=True)
@@ -81,7 +88,7 @@ class JointLaw:
     @staticmethod
     def aux(term_name: str, d0: float, v0: float) -> float:
         """The shape constant of a term: the gap (the reference RMS stroke) or the friction's smoothing."""
-        if term_name == "contact":
+        if term_name in ("contact", "tanh(d)"):
             return float(d0)
         if term_name == "sign(v)":
             return float(FRICTION_SMOOTHING * v0)
@@ -100,7 +107,7 @@ class JointLaw:
             aux = self.auxes(d0, v0)
             for i in shaped:
                 t = self.all_terms[i]
-                aux[i] = SHAPE_GRID[t][k] * (d0 if t == "contact" else v0)
+                aux[i] = SHAPE_GRID[t][k] * (v0 if t == "sign(v)" else d0)
             out.append(aux)
         return out
 
@@ -120,14 +127,16 @@ class JointLaw:
         """The force written out, e.g. ``-3.1e+04·d + 2.2·v - 41·tanh(v/0.0012)``."""
         parts = []
         for c, t, a in zip(coefficients, self.all_terms, aux):
-            text = {"contact": f"(|d|>{a:.3g})·(d∓{a:.3g})", "sign(v)": f"tanh(v/{a:.3g})"}.get(t, t)
+            text = {"contact": f"(|d|>{a:.3g})·(d∓{a:.3g})", "sign(v)": f"tanh(v/{a:.3g})",
+                    "tanh(d)": f"{a:.3g}·tanh(d/{a:.3g})"}.get(t, t)
             parts.append(f"{c:+.3g}·{text}")
         return " ".join(parts).lstrip("+")
 
 
 LAWS = {law_.name: law_ for law_ in (
     JointLaw("cubic", ("d³",), "a cubic spring k3·d³ (hardening or softening by its sign)"),
-    JointLaw("softening", ("d|d|",), "a spring whose stiffness changes with the stroke, d|d| (softening when negative)"),
+    JointLaw("softening", ("tanh(d)",), "a saturating spring: stiff at small strokes, its force levelling off beyond "
+             "a stroke d_sat (k_sat·d_sat·tanh(d/d_sat))"),
     JointLaw("clearance", ("contact",), "a gap that closes: stiffer beyond ±gap"),
     JointLaw("friction", ("sign(v)",), "stick-slip: a Coulomb force opposing the relative velocity"),
     JointLaw("quadratic_damping", ("v|v|",), "damping that grows with speed, v|v|"),

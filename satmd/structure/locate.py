@@ -5,12 +5,19 @@ channels), with the lowest level as the linear reference ``H_o = A_o / F`` (its 
 approximation), every higher level's change ``E_o = A_o − H_o F`` is, at each excited line and on every
 channel o, the response to the joint's force: ``E_o(ω) = Σ_j T_oj(ω) G_j(ω)``, where ``G_j`` are the
 spectra of the law's terms of the pair's relative motion (`satmd.structure.laws`) and ``T_oj`` are
-unknown transfer functions on the structure's own poles (fitted at the reference level by
-`satmd.modal.fit_modes`): linear in their residues, so each pair and law is one weighted linear
-least-squares fit, all levels at once (the nonlinear force as a feedback input: FNSI, Noël &
-Kerschen 2013, here in the frequency domain with the poles known). The transfer functions are left
-free, not built from the mode shapes: a sensor's column of the structure was never measured, and
-a mass-normalised guess of it would carry the modal fit's error into the ranking.
+transfer functions on the structure's own poles (fitted at the reference level by `satmd.modal.fit_modes`),
+linear in their coefficients, so each pair and law is one weighted linear least-squares fit, all levels
+and channels at once (the nonlinear force as a feedback input: FNSI, Noël & Kerschen 2013, here in the
+frequency domain with the poles known). A force anywhere reaches channel o through mode r in proportion to
+the mode's shape there, which the measured column already holds (the reference residue A_or): so
+``T_oj = Σ_r κ_rj A_or / (iω − λ_r) + c.c.`` plus each channel's own residual terms (the modes outside the
+band), with the joint's input to each mode, κ_rj, one for every channel (`paths`). The input is left free,
+not built from the mode shapes at the two sensors: their column of the structure was never measured, and a
+guess of it (reciprocity through the driving point) ranked the F-16's true place last. Places are ranked
+with κ complex (a place is found whatever phase its modes take the force in); the laws at the best place
+with κ real (`real_inputs`: a law in the stroke and one in the velocity are then told apart) and each
+law's shape refined off its grid. On 40 chains (`benchmarks/structures_joint.py`) that placed 35 joints and
+named 32 laws; free per-channel transfers had placed 31 and named 26.
 
 Evidence: BIC = N ln(RSS/N) + p ln N per pair and law. Rows are weighted by each channel's mean response
 at that level, not by each line's noise: between levels far above the noise the misfit is the model's
@@ -32,7 +39,7 @@ import numpy as np
 from ..conventions import TINY
 from ..errors import DataError
 from ..validation import NAMES, Band, validate_params
-from .laws import LAWS
+from .laws import LAWS, SHAPE_GRID
 from .spectra import PeriodicSpectra, periodic_spectra
 
 #: ΔBIC within which two places (or two laws) are equally supported (SPEC §11).
@@ -127,39 +134,56 @@ def locate_joint(recordings, laws=None, band_hz=None, channels=None) -> JointLoc
         Fewer than two recordings, a force that is not periodic, recordings of another design (period,
         rate, channels), or fewer than two response channels.
     """
-    ref, others, names, rows, H, basis, modal = prepare(recordings, band_hz, channels)
+    ref, others, names, rows, H, transfer, modal = prepare(recordings, band_hz, channels)
     items = [ref, *others]
     places = [(a, b) for a, b in itertools.combinations(names, 2)] + [(a, "ground") for a in names]
     chosen = [LAWS[n] for n in (laws or LAWS)]
-    bic: dict = {}
-    shapes: dict = {}
-    for p in places:
-        for law_ in chosen:
-            bic[(p, law_.name)], shapes[(p, law_.name)] = best_shape(p, law_, others, ref, H, names, rows, basis)
-    bic[None] = _evidence(None, None, others, ref, H, names, rows, basis)
-    return _verdict(bic, places, chosen, ref, items, modal, shapes)
+    bic: dict = {(p, law_.name): best_shape(p, law_, others, ref, H, names, rows, transfer)[0]
+                 for p in places for law_ in chosen}
+    bic[None] = _evidence(None, None, others, ref, H, names, rows, transfer)
+    at = min(places, key=lambda p: (min(bic[(p, law_.name)] for law_ in chosen), p))
+    real = real_inputs(transfer)
+    named = {law_.name: best_shape(at, law_, others, ref, H, names, rows, real, refine=True) for law_ in chosen}
+    return _verdict(bic, places, chosen, ref, items, modal, named)
 
 
 def shape_of(recordings, between, law_name: str, channels=None) -> np.ndarray:
     """The shape constants of ``law_name`` at ``between`` that explain the level changes best (`best_shape`)."""
-    ref, others, names, rows, H, basis, _ = prepare(recordings, None, channels)
-    return best_shape(tuple(between), LAWS[law_name], others, ref, H, names, rows, basis)[1]
+    ref, others, names, rows, H, transfer, _ = prepare(recordings, None, channels)
+    return best_shape(tuple(between), LAWS[law_name], others, ref, H, names, rows, real_inputs(transfer), refine=True)[1]
 
 
-def best_shape(place, law_, others, ref, H, names, rows, basis):
-    """(BIC, shape constants) of a law at a place at its best shape (a gap, a friction's smoothing) of
-    `JointLaw.shapes`; one more parameter counted when there was a choice."""
+def best_shape(place, law_, others, ref, H, names, rows, transfer, refine=False):
+    """(BIC, shape constants) of a law at a place at its best shape (a gap, a friction's smoothing, a saturating
+    spring's stroke) of `JointLaw.shapes`; with ``refine``, the best of the grid is refined between its
+    neighbours (a joint's gap is seldom on the grid, and a law off its shape loses to the sparse library); one
+    more parameter counted when there was a choice."""
     d0, v0 = ref.scales(*place)
     tried = law_.shapes(d0, v0)
-    found = [(_evidence(place, law_, others, ref, H, names, rows, basis, aux), i) for i, aux in enumerate(tried)]
+    found = [(_evidence(place, law_, others, ref, H, names, rows, transfer, aux), i) for i, aux in enumerate(tried)]
     value, i = min(found)
+    best = tried[i]
+    if refine and len(tried) > 1:
+        from scipy.optimize import minimize_scalar
+
+        shaped = np.array([t in SHAPE_GRID for t in law_.all_terms])
+        ratio = [tried[j][shaped][0] / best[shaped][0] for j in (max(i - 1, 0), min(i + 1, len(tried) - 1))]
+        lo, hi = np.log(ratio[0]) if i > 0 else -np.log(2.0), np.log(ratio[1]) if i < len(tried) - 1 else np.log(2.0)
+
+        def scaled(u):
+            return np.where(shaped, best * np.exp(u), best)
+
+        res = minimize_scalar(lambda u: _evidence(place, law_, others, ref, H, names, rows, transfer, scaled(u)),
+                              bounds=(lo, hi), method="bounded", options={"xatol": 0.05, "maxiter": 12})
+        if res.fun < value:
+            value, best = float(res.fun), scaled(res.x)
     n = sum(2 * k.size for k in rows.values() if k is not rows[id(ref)]) * len(names)
-    return value + (np.log(n) if len(tried) > 1 else 0.0), tried[i]
+    return value + (np.log(n) if len(tried) > 1 else 0.0), best
 
 
 def prepare(recordings, band_hz=None, channels=None):
     """What locating and fitting share: (reference, other levels, channels, rows of the common lines in each,
-    the reference FRF per channel, the poles' basis there, the modal fit)."""
+    the reference FRF per channel, the joint's transfer columns per channel (`paths`), the modal fit)."""
     from ..modal import fit_modes
 
     items = [r if isinstance(r, PeriodicSpectra) else periodic_spectra(r) for r in recordings]
@@ -188,56 +212,99 @@ def prepare(recordings, band_hz=None, channels=None):
     rows = {id(s): np.searchsorted(s.lines, common) for s in items}
     H = {c: ref.responses[c][rows[id(ref)]] / ref.force[rows[id(ref)]] for c in names}
     modal = fit_modes(freq, H, band_hz=(float(freq[0]), float(freq[-1])))
-    basis = modal.basis(freq)
     others = [s for s in items if s is not ref]
-    return ref, others, names, rows, H, basis, modal
+    return ref, others, names, rows, H, paths(modal, modal.basis(freq), names), modal
 
 
-def _evidence(place, law_, others, ref, H, names, rows, basis, aux=None) -> float:
-    """BIC of one place and law: every channel, every higher level, one weighted linear least-squares fit each
-    (``place`` None: no joint, the levels one linear structure)."""
+def paths(modal, basis, names) -> dict:
+    """{channel: (shared, own)}: the columns of the joint's transfer to each channel. ``shared`` (K, 2 modes):
+    mode r's pair scaled by the channel's reference residue A_or, times the real and the imaginary part of the
+    joint's input to mode r, κ_r, which every channel shares; ``own`` (K, 6): the residual terms of the modes
+    outside the band, the channel's own. `real_inputs` keeps κ real."""
+    n = len(modal.modes)
+    a = (basis[:, 0:2 * n:2] - 1j * basis[:, 1:2 * n:2]) / 2  # 1/(iω − λ_r), from the basis's (a + b, i(a − b))
+    b = (basis[:, 0:2 * n:2] + 1j * basis[:, 1:2 * n:2]) / 2  # 1/(iω − λ_r*)
+    out = {}
+    for c in names:
+        psi = np.array([m.residues[c] for m in modal.modes], complex)
+        shared = np.stack([psi * a + psi.conj() * b, 1j * (psi * a - psi.conj() * b)], axis=2).reshape(a.shape[0], -1)
+        out[c] = (shared, basis[:, 2 * n:])
+    return out
+
+
+def real_inputs(transfer) -> dict:
+    """`paths` with each mode's input κ_r real: a structure's real modes take a joint's force as the real
+    difference of their shapes at its two ends, so its phase is the measured column's, and a law's terms in the
+    stroke and in the velocity (a quarter period apart) are told apart."""
+    return {c: (shared[:, 0::2], own) for c, (shared, own) in transfer.items()}
+
+
+def _evidence(place, law_, others, ref, H, names, rows, transfer, aux=None) -> float:
+    """BIC of one place and law: every channel and higher level in one weighted linear least-squares fit, the
+    joint's input to each mode shared by every channel (``place`` None: no joint, the levels one linear
+    structure)."""
     G: dict = {id(s): [] for s in others}
     if place is not None:
         d0, v0 = ref.scales(*place)
         for s in others:
             G[id(s)] = [s.at_lines(t)[rows[id(s)]] for t in law_.columns(*s.relative(*place), d0, v0, aux)]
-    rss, n_rows, n_par = 0.0, 0, 0
-    for c in names:
-        X_parts, y_parts = [], []
+    n_terms = len(G[id(others[0])])
+    S_parts, y_parts, n_par = [], [], 0
+    for c in names:  # each channel's own residual terms projected out first: the shared fit is then small
+        shared, own = transfer[c]
+        S_c, R_c, y_c = [], [], []
         for s in others:
             k = rows[id(s)]
             E = s.responses[c][k] - H[c] * s.force[k]
-            sd = np.full(k.size, np.mean(np.abs(s.responses[c][k])))
-            X = (np.hstack([basis * g[:, None] for g in G[id(s)]]) if G[id(s)] else np.zeros((k.size, 0))) / sd[:, None]
-            X_parts += [X.real, X.imag]
-            y_parts += [E.real / sd, E.imag / sd]
-        X, y = np.vstack(X_parts), np.concatenate(y_parts)
-        r = y - X @ np.linalg.lstsq(X, y, rcond=None)[0] if X.shape[1] else y
-        rss += float(r @ r)
-        n_rows += y.size
-        n_par += X.shape[1]
-    return n_rows * np.log(max(rss, TINY) / n_rows) + n_par * np.log(n_rows)
+            sd = np.mean(np.abs(s.responses[c][k]))
+            S = np.hstack([shared * g[:, None] for g in G[id(s)]]) if n_terms else np.zeros((k.size, 0))
+            R = np.hstack([own * g[:, None] for g in G[id(s)]]) if n_terms else np.zeros((k.size, 0))
+            S_c += [S.real / sd, S.imag / sd]
+            R_c += [R.real / sd, R.imag / sd]
+            y_c += [E.real / sd, E.imag / sd]
+        S, R, y = np.vstack(S_c), _unit_columns(np.vstack(R_c)), np.concatenate(y_c)
+        if R.shape[1]:
+            U, sv, _ = np.linalg.svd(R, full_matrices=False)
+            U = U[:, sv > sv[0] * 1e-10] if sv[0] > 0 else U[:, :0]
+            S, y = S - U @ (U.T @ S), y - U @ (U.T @ y)
+            n_par += U.shape[1]
+        S_parts.append(S)
+        y_parts.append(y)
+    S, y = _unit_columns(np.vstack(S_parts)), np.concatenate(y_parts)
+    r = y - S @ np.linalg.lstsq(S, y, rcond=None)[0] if S.shape[1] else y
+    rss, n_rows = float(r @ r), y.size
+    return n_rows * np.log(max(rss, TINY) / n_rows) + (n_par + S.shape[1]) * np.log(n_rows)
 
 
-def _verdict(bic, places, laws, ref, items, modal, shapes) -> JointLocation:
+def _unit_columns(X):
+    """X with every column scaled to unit length: a cubic's column is 1e-8 of a stroke's, and a rank cut relative to
+    the largest column would drop it."""
+    norm = np.linalg.norm(X, axis=0)
+    return X / np.where(norm > 0, norm, 1.0)
+
+
+def _verdict(bic, places, laws, ref, items, modal, named) -> JointLocation:
+    """The places ranked by their best law's evidence (each mode's input complex: a place is found whatever the
+    phase its modes take the force in); the laws at the best place ranked by ``named``, {law: (BIC, shape)} with
+    real inputs (`real_inputs`)."""
     per_place = {p: min(((bic[(p, law_.name)], law_.name) for law_ in laws)) for p in places}
     ranked = sorted(places, key=lambda p: (per_place[p][0], p))
     best_bic = per_place[ranked[0]][0]
-    location = [{"between": list(p), "delta_bic": round(float(per_place[p][0] - best_bic), 1),
-                 "law": per_place[p][1]} for p in ranked]
     at = ranked[0]
-    law_bic = sorted(((bic[(at, law_.name)], law_.name) for law_ in laws))
-    named = [x for x in law_bic if x[1] != "sparse"]
+    law_bic = sorted(((named[law_.name][0], law_.name) for law_ in laws))
+    plain = [x for x in law_bic if x[1] != "sparse"]
     sparse = [x for x in law_bic if x[1] == "sparse"]
-    if named and not (sparse and sparse[0][0] < named[0][0] - EQUIVALENT):
-        chosen_bic, chosen = named[0]
+    if plain and not (sparse and sparse[0][0] < plain[0][0] - EQUIVALENT):
+        chosen_bic, chosen = plain[0]
     else:
         chosen_bic, chosen = law_bic[0]
+    location = [{"between": list(p), "delta_bic": round(float(per_place[p][0] - best_bic), 1),
+                 "law": chosen if p == at else per_place[p][1]} for p in ranked]
     laws_out = [{"law": n, "delta_bic": round(float(v - chosen_bic), 1)} for v, n in law_bic]
     return JointLocation(
         between=tuple(at), location=location, law=chosen, laws=laws_out,
         equivalent_places=[e for e in location[1:] if e["delta_bic"] <= EQUIVALENT],
         equivalent_laws=[e for e in laws_out if e["law"] != chosen and e["delta_bic"] <= EQUIVALENT],
-        reference=ref.source, levels=[round(float(s.level), 6) for s in items], shape=shapes[(tuple(at), chosen)],
+        reference=ref.source, levels=[round(float(s.level), 6) for s in items], shape=named[chosen][1],
         poles_hz=[(round(float(m.f_hz), 4), round(float(m.zeta), 5)) for m in modal.modes],
         evidence=float(bic[None] - best_bic))

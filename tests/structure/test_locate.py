@@ -29,6 +29,29 @@ def test_a_cubic_joint_between_two_masses_is_placed_and_named(cubic_between_3_an
     assert d["name"] == "joint" and d["between"] == ["acc3", "acc4"] and d["location"][0]["delta_bic"] == 0.0
 
 
+def test_the_joints_paths_share_the_modes_of_the_measured_column(cubic_between_3_and_4):
+    """A force on mode r reaches channel o in proportion to its reference residue A_or: with every mode's input
+    κ_r = 1 the shared columns are the reference FRF's modal part, the same coefficients for every channel."""
+    from satmd.structure.locate import prepare
+
+    ref, _, names, rows, H, transfer, modal = prepare(cubic_between_3_and_4)
+    n = len(modal.modes)
+    fitted = modal.predict(ref.freq_hz[rows[id(ref)]])
+    for c in names:
+        shared, own = transfer[c]
+        assert shared.shape[1] == 2 * n and own.shape[1] == 6
+        rebuilt = shared @ np.tile([1.0, 0.0], n) + own @ modal.coefficients[c][2 * n:]  # κ = 1 + 0i everywhere
+        assert np.linalg.norm(rebuilt - fitted[c]) < 1e-12 * np.linalg.norm(fitted[c]), c
+
+
+def test_a_saturating_mount_is_named_softening():
+    """A spring that gives way beyond 0.2 mm (ks·g·tanh(d/g)), between masses 2 and 3: placed, and named as the
+    saturating spring it is, not as a cubic."""
+    recs = simulate_chain(joint=(1, 2), law=lambda d, v: 2e4 * 2e-4 * np.tanh(d / 2e-4), seed=6)
+    loc = locate_joint(recs)
+    assert loc.between == ("acc2", "acc3") and loc.law == "softening", loc.laws
+
+
 def test_a_joint_to_the_ground_is_placed_there():
     recs = simulate_chain(joint=(1, None), law=lambda d, v: 3e9 * d ** 3, levels=(1.0, 4.0), seed=2)
     loc = locate_joint(recs)
