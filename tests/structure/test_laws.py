@@ -34,3 +34,22 @@ def test_a_saturating_spring_is_linear_small_and_levels_off_large():
     assert abs(term(9, d, 0.0, d_sat)[0] - (d - d ** 3 / (3 * d_sat ** 2))) <= (2 / 15) * 1.01 * d ** 5 / d_sat ** 4  # the next term
     assert law.formula([3e4, 1e3, 0.5], [d_sat, 1.0, 1.0]).startswith("3e+04·0.0002·tanh(d/0.0002)")
     assert law.shapes(1e-4, 1.0)[-1][0] == SHAPE_GRID["tanh(d)"][-1] * 1e-4  # strokes on the lowest level's scale
+
+
+def test_the_best_fitting_law_is_kept_and_the_sparse_library_only_by_a_margin():
+    """`best_fitting`: the model that simulates the recordings best; a sparse law's extra terms must earn their keep."""
+    from types import SimpleNamespace
+
+    from satmd.structure.fit import SPARSE_MARGIN, best_fitting
+
+    def model(law, nrmse):
+        return SimpleNamespace(joint=SimpleNamespace(law=law), fit={"nonlinear": [[nrmse, nrmse], [nrmse, nrmse]]})
+
+    clearance, friction = model("clearance", 0.32), model("friction", 0.26)
+    assert best_fitting([clearance, friction]) is friction
+    close = model("sparse", 0.26 * (1 - SPARSE_MARGIN / 2))
+    assert best_fitting([close, clearance, friction]) is friction
+    far = model("sparse", 0.26 * (1 - 2 * SPARSE_MARGIN))
+    assert best_fitting([far, clearance, friction]) is far
+    none = SimpleNamespace(joint=None, fit={"nonlinear": [[0.1]]})
+    assert best_fitting([none, clearance]) is clearance and best_fitting([none]) is none

@@ -201,10 +201,10 @@ def with_joint(report, recordings):
     old = report.findings[0]
     law = model.joint.law if model is not None and model.joint is not None else loc.law
     equivalent = [{"law": e["law"], "delta_bic": e["delta_bic"]} for e in loc.equivalent_laws if e["law"] != law]
-    if law != loc.law:  # the sparse library fitted the levels best, the named law predicted a level left out better
+    if law != loc.law:  # the levels' spectra preferred another law; simulated on every level, this one fitted best
         equivalent.insert(0, {"law": loc.law, "delta_bic": 0.0})
-        explanation += (f"; {law}, not the {loc.law} library the levels' spectra preferred: fitted without a middle "
-                        f"level, it predicted that level better")
+        explanation += (f"; {law}, not the {loc.law} the levels' spectra preferred: simulated from the force, "
+                        f"it fitted every level better")
     ci95 = dict(model.joint.ci95) if model is not None and model.joint is not None else {}
     joint = NonlinearFinding("joint", between=[a, b], location=loc.location, law=law, parameters=parameters or {},
                              ci95=ci95, equivalent=equivalent,
