@@ -44,8 +44,10 @@ def provenance() -> dict:
     try:
         out["commit"] = subprocess.run(["git", "rev-parse", "--short", "HEAD"], cwd=root, capture_output=True,
                                        text=True, timeout=10).stdout.strip() or None
-        dirty = subprocess.run(["git", "status", "--porcelain", "--untracked-files=no"], cwd=root,
-                               capture_output=True, text=True, timeout=10).stdout.strip()
+        # the results an earlier benchmark of the same run wrote are not a change of what is measured
+        dirty = subprocess.run(["git", "status", "--porcelain", "--untracked-files=no", "--", ".",
+                                ":(exclude)benchmarks/results"], cwd=root, capture_output=True, text=True,
+                               timeout=10).stdout.strip()
         out["tree_changed"] = bool(dirty)
     except (OSError, subprocess.SubprocessError):
         out["commit"] = None

@@ -577,6 +577,7 @@ def _machines(doc) -> list[dict]:
         if isinstance(node, dict):
             if under_machine and ("commit" in node or "platform" in node or "device" in node):
                 found.append(node)
+                return  # a machine record: what it holds (a run's config) is not another machine
             for key, val in node.items():
                 if key in ("cases", "rows", "table"):  # the figures themselves: no machine there
                     continue

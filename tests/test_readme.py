@@ -196,7 +196,7 @@ def test_staleness_counts_every_part_and_the_latest_run(tmp_path):
     old = {"commit": root, "date": "2026-11-01", "platform": "x"}
     docs = {"fresh": {"machine": fresh, "cases": [{"machine": old}]},  # a case's record is not a machine's
             "merged": {"machine": fresh, "runs": [{"machine": fresh}, {"machine": old}]},
-            "history": [{"platform": "x"}, fresh],
+            "history": [{"platform": "x"}, {**fresh, "config": {"device": "cpu"}}],  # a run's config: no machine
             "bare": {"machine": {"platform": "x"}}}
     for name, doc in docs.items():
         (tmp_path / f"{name}.json").write_text(json.dumps(doc))
