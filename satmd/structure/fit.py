@@ -170,16 +170,23 @@ def _simulated_shape(linear, spectra, between, lw, d0, v0, aux, recordings, meas
 def best_fitting(models) -> StructureModel:
     """Of models of one structure with different laws, the one that simulates its recordings best (mean NRMSE
     over every recording and channel); the sparse library only where it beats every named law by more than
-    `SPARSE_MARGIN` (its terms fit what a named law leaves, and predict the levels it did not see no better)."""
+    `SPARSE_MARGIN` (its terms fit what a named law leaves, and predict the levels it did not see no better);
+    a "softening" whose fit stiffens is not one (`_stiffens`)."""
     def score(m):
         return float(np.mean(m.fit["nonlinear"])) if m.joint is not None else np.inf
 
-    named = [m for m in models if m.joint is not None and m.joint.law != "sparse"]
+    named = [m for m in models if m.joint is not None and m.joint.law != "sparse" and not _stiffens(m.joint)]
     sparse = [m for m in models if m.joint is not None and m.joint.law == "sparse"]
     best = min(named, key=score) if named else None
     if sparse and (best is None or score(sparse[0]) < (1 - SPARSE_MARGIN) * score(best)):
         best = sparse[0]
     return best if best is not None else models[0]
+
+
+def _stiffens(joint) -> bool:
+    """A saturating spring fitted in newtons with k_sat < 0: its stiffness grows with the stroke, so it is no
+    softening, whatever it fits (in relative units the path's sign leaves k_sat's open, and it is kept)."""
+    return joint.law == "softening" and joint.units == "N" and joint.parameters().get("k_sat", 0.0) < 0
 
 
 def _fit_span(recording) -> int:

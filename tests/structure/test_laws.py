@@ -43,7 +43,7 @@ def test_the_best_fitting_law_is_kept_and_the_sparse_library_only_by_a_margin():
     from satmd.structure.fit import SPARSE_MARGIN, best_fitting
 
     def model(law, nrmse):
-        return SimpleNamespace(joint=SimpleNamespace(law=law), fit={"nonlinear": [[nrmse, nrmse], [nrmse, nrmse]]})
+        return SimpleNamespace(joint=SimpleNamespace(law=law, units="relative"), fit={"nonlinear": [[nrmse, nrmse], [nrmse, nrmse]]})
 
     clearance, friction = model("clearance", 0.32), model("friction", 0.26)
     assert best_fitting([clearance, friction]) is friction
@@ -53,3 +53,21 @@ def test_the_best_fitting_law_is_kept_and_the_sparse_library_only_by_a_margin():
     assert best_fitting([far, clearance, friction]) is far
     none = SimpleNamespace(joint=None, fit={"nonlinear": [[0.1]]})
     assert best_fitting([none, clearance]) is clearance and best_fitting([none]) is none
+
+
+def test_a_saturating_spring_that_stiffens_is_no_softening():
+    """In newtons a negative k_sat is a spring that stiffens with the stroke: not the law its name says."""
+    from types import SimpleNamespace
+
+    from satmd.structure.fit import best_fitting
+
+    def model(law, nrmse, k_sat=None, units="N"):
+        joint = SimpleNamespace(law=law, units=units, parameters=lambda: {} if k_sat is None else {"k_sat": k_sat})
+        return SimpleNamespace(joint=joint, fit={"nonlinear": [[nrmse]]})
+
+    cubic = model("cubic", 0.020)
+    assert best_fitting([model("softening", 0.019, k_sat=-2e4), cubic]) is cubic
+    soft = model("softening", 0.019, k_sat=2e4)
+    assert best_fitting([soft, cubic]) is soft
+    relative = model("softening", 0.019, k_sat=-2e4, units="relative")  # the path's sign leaves k_sat's open
+    assert best_fitting([relative, cubic]) is relative
