@@ -73,6 +73,27 @@ def summary(result) -> str:
     return "; ".join(parts)
 
 
+def readme_markdown(result) -> str:
+    """Region ``discover_intervals`` of the results page: per element, named right, the truth inside the 95 %
+    interval, and the mean / RMS of (estimate − truth)/σ with σ the interval's half-width / 1.96."""
+    lines = ["| element | named right | truth inside the 95 % interval | mean / RMS of (estimate − truth)/σ |",
+             "|---|---|---|---|"]
+    for name, cases in result["elements"].items():
+        key = SCORED[name][0]
+        named = [c for c in cases if c["named"] == name]
+        covered = sum(all(c["covered"].values()) for c in named)
+        z = np.array([(c["parameters"][key] - c["truth"][key]) / ((c["ci95"][key][1] - c["ci95"][key][0]) / 2 / 1.96)
+                      for c in named if key in c["ci95"] and c["ci95"][key][1] > c["ci95"][key][0]])
+        share = f" ({100 * covered / len(named):.0f} %)" if named and covered < len(named) else ""
+        stats = f"{z.mean():+.2f} / {np.sqrt(np.mean(z ** 2)):.2f}".replace("-", "−") if z.size else "—"
+        lines.append(f"| `{name}` ({key}) | {len(named)}/{len(cases)} | {covered}/{len(named)}{share} | {stats} |")
+    m = result.get("machine") or {}
+    lines.append("")
+    lines.append(f"{len(next(iter(result['elements'].values())))} rigs per element, measured at {m.get('commit', '?')} "
+                 f"({str(m.get('date', '?'))[:10]}).")
+    return "\n".join(lines) + "\n"
+
+
 def _commit():
     import subprocess
 
