@@ -86,6 +86,15 @@ def jacobian_covariance(jac, noise_variance: float = 1.0) -> np.ndarray:
     return A * np.outer(sc, sc) * noise_variance
 
 
+def unit_columns(X):
+    """(X with every nonzero column scaled to unit length, the scales): a least squares whose columns differ by
+    orders of magnitude (a cubic's column is 1e-8 of a stroke's) otherwise loses the small ones to its rank cut;
+    coefficients of the scaled columns divided by the scales are those of X."""
+    norm = np.linalg.norm(X, axis=0)
+    norm = np.where(norm > 0, norm, 1.0)
+    return X / norm, norm
+
+
 def inverse_gram(Js):
     """(JᵀJ)⁻¹ through the SVD (all inf when J is numerically rank deficient), and the singular values."""
     _, sv, vt = np.linalg.svd(Js, full_matrices=False)

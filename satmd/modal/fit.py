@@ -19,7 +19,7 @@ import numpy as np
 
 from ..validation import Band, Interval, Whole, validate_params
 
-from ..numerics import jacobian_covariance
+from ..numerics import jacobian_covariance, unit_columns
 from .poles import stable_poles
 
 Z95 = 1.959963984540054  # two-sided 95 % normal quantile
@@ -215,9 +215,8 @@ class _Poles:
             G = C / s[:, None]
             A = np.vstack([G.real, G.imag])
             b = np.concatenate([(h / s).real, (h / s).imag])
-            norm = np.linalg.norm(A, axis=0)
-            norm[norm == 0] = 1.0
-            Q, R = np.linalg.qr(A / norm)
+            A, norm = unit_columns(A)
+            Q, R = np.linalg.qr(A)
             qb = Q.T @ b
             coefs.append(np.linalg.lstsq(R, qb, rcond=None)[0] / norm)
             res.append(Q @ qb - b)  # minus the part of b off the model's columns

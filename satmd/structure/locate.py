@@ -37,6 +37,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..conventions import TINY
+from ..numerics import unit_columns
 from ..errors import DataError
 from ..validation import NAMES, Band, validate_params
 from .laws import LAWS, SHAPE_GRID
@@ -167,8 +168,10 @@ def best_shape(place, law_, others, ref, H, names, rows, transfer, refine=False)
         from scipy.optimize import minimize_scalar
 
         shaped = np.array([t in SHAPE_GRID for t in law_.all_terms])
-        ratio = [tried[j][shaped][0] / best[shaped][0] for j in (max(i - 1, 0), min(i + 1, len(tried) - 1))]
-        lo, hi = np.log(ratio[0]) if i > 0 else -np.log(2.0), np.log(ratio[1]) if i < len(tried) - 1 else np.log(2.0)
+        def step(j):  # log of the grid's step to neighbour j (a factor 2 past either end)
+            return np.log(tried[j][shaped][0] / best[shaped][0]) if 0 <= j < len(tried) else np.log(2.0) * (j - i)
+
+        lo, hi = step(i - 1), step(i + 1)
 
         def scaled(u):
             return np.where(shaped, best * np.exp(u), best)
@@ -262,7 +265,7 @@ def _evidence(place, law_, others, ref, H, names, rows, transfer, aux=None) -> f
             S_c += [S.real / sd, S.imag / sd]
             R_c += [R.real / sd, R.imag / sd]
             y_c += [E.real / sd, E.imag / sd]
-        S, R, y = np.vstack(S_c), _unit_columns(np.vstack(R_c)), np.concatenate(y_c)
+        S, R, y = np.vstack(S_c), unit_columns(np.vstack(R_c))[0], np.concatenate(y_c)
         if R.shape[1]:
             U, sv, _ = np.linalg.svd(R, full_matrices=False)
             U = U[:, sv > sv[0] * 1e-10] if sv[0] > 0 else U[:, :0]
@@ -270,17 +273,10 @@ def _evidence(place, law_, others, ref, H, names, rows, transfer, aux=None) -> f
             n_par += U.shape[1]
         S_parts.append(S)
         y_parts.append(y)
-    S, y = _unit_columns(np.vstack(S_parts)), np.concatenate(y_parts)
+    S, y = unit_columns(np.vstack(S_parts))[0], np.concatenate(y_parts)
     r = y - S @ np.linalg.lstsq(S, y, rcond=None)[0] if S.shape[1] else y
     rss, n_rows = float(r @ r), y.size
     return n_rows * np.log(max(rss, TINY) / n_rows) + (n_par + S.shape[1]) * np.log(n_rows)
-
-
-def _unit_columns(X):
-    """X with every column scaled to unit length: a cubic's column is 1e-8 of a stroke's, and a rank cut relative to
-    the largest column would drop it."""
-    norm = np.linalg.norm(X, axis=0)
-    return X / np.where(norm > 0, norm, 1.0)
 
 
 def _verdict(bic, places, laws, ref, items, modal, named) -> JointLocation:
