@@ -1,0 +1,169 @@
+"""Ground vibration tests of structures satmd never saw (issue 47): the joint located, named, its levels predicted.
+
+Each test comes from an independent simulator (`benchmarks/_indep_gvt.py`, numpy/scipy only): a chain, a
+lumped frame, a beam on supports or a wing with a payload on a pylon, 4–8 accelerometers, one shaker, one
+joint (cubic, softening, clearance, friction, quadratic damping) at a drawn place, or none (a null); seven
+levels √2 apart. Written to plain CSV files and run through the command line as a user would:
+
+    satmd discover L1.csv L3.csv L5.csv L7.csv --json --save-model model.json
+    satmd predict model.json L2.csv L4.csv L6.csv --json
+
+Scored as the issue asks: the joint between the right two sensors (or sensor and ground), its law, the
+held-out levels' worst-channel NRMSE within 3× the noise floor (the accelerometers' noise, as an NRMSE) and
+below a quarter of the level-1 linear model's; nulls with no joint.
+
+    python benchmarks/structures_gvt.py [--count 24] [--seed0 0] [--out PATH]
+    python benchmarks/structures_gvt.py --merge part1.json part2.json [--out PATH]
+
+Writes benchmarks/results/structures_gvt.json and prints one line of figures.
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT / "benchmarks"))
+import _indep_gvt as sim  # noqa: E402
+from _machine import describe, load_after, machine  # noqa: E402
+
+FITTED, HELD = (1, 3, 5, 7), (2, 4, 6)
+OUT = ROOT / "benchmarks" / "results" / "structures_gvt.json"
+
+
+def plan(count: int, seed0: int) -> list:
+    """(structure, law, seed): structures in turn, each law and the null in turn."""
+    laws = (*sim.LAWS, None)
+    return [(sim.STRUCTURES[i % 4], laws[(i // 4) % len(laws)], i) for i in range(seed0, seed0 + count)]
+
+
+def _satmd(*args, cwd) -> dict:
+    env = dict(os.environ, OMP_NUM_THREADS="1", OPENBLAS_NUM_THREADS="1", MKL_NUM_THREADS="1")
+    run = subprocess.run([sys.executable, "-m", "satmd", *args], cwd=cwd, capture_output=True, text=True, env=env)
+    if run.returncode != 0:
+        return {"error": (run.stderr.strip().splitlines() or ["exit %d" % run.returncode])[-1]}
+    return json.loads(run.stdout)
+
+
+def case(structure: str, law: str | None, seed: int) -> dict:
+    test = sim.make_test(seed, structure, law)
+    t0 = time.perf_counter()
+    recs = sim.simulate(test)
+    row = {**test.describe(), "simulate_s": round(time.perf_counter() - t0, 1)}
+    with tempfile.TemporaryDirectory() as tmp:
+        for lv, rec in enumerate(recs, 1):
+            sim.write_csv(rec, Path(tmp) / f"L{lv}.csv")
+        t0 = time.perf_counter()
+        found = _satmd("discover", *(f"L{lv}.csv" for lv in FITTED), "--json", "--save-model", "model.json", cwd=tmp)
+        row["discover_s"] = round(time.perf_counter() - t0, 1)
+        if "error" in found:
+            row["error"] = found["error"]
+            return row
+        joint = next((f for f in (found.get("nonlinear") or {}).get("findings", []) if f.get("name") == "joint"), None)
+        row["found_between"] = joint["between"] if joint else None
+        row["found_law"] = joint["law"] if joint else None
+        row["equivalent"] = [e["between"] for e in joint.get("location", [])[1:] if e.get("delta_bic", 99) <= 10] \
+            if joint else []
+        if (Path(tmp) / "model.json").exists():
+            pred = _satmd("predict", "model.json", *(f"L{lv}.csv" for lv in HELD), "--json", cwd=tmp)
+            if "error" in pred:
+                row["predict_error"] = pred["error"]
+            else:
+                row["held"] = [{"level": lv, "nrmse": r["nrmse"], "linear_nrmse": r["linear_nrmse"]}
+                               for lv, r in zip(HELD, pred["recordings"])]
+    return _score(row)
+
+
+def _score(row: dict) -> dict:
+    truth = row["law"]
+    if truth is None:
+        row["right"] = {"null": row.get("found_between") is None}
+    else:
+        row["right"] = {"placed": sorted(row.get("found_between") or []) == sorted(row["between"]),
+                        "named": row.get("found_law") == truth}
+    floor = row["noise"]["acc"]
+    held = row.get("held")
+    if held:
+        worst = [max(h["nrmse"]) for h in held]
+        row["right"]["within_3x_noise"] = all(w <= 3 * floor for w in worst)
+        row["right"]["below_quarter_linear"] = all(max(h["nrmse"]) < 0.25 * max(h["linear_nrmse"]) for h in held
+                                                   if max(h["linear_nrmse"]) > 3 * floor)
+    return row
+
+
+def summarise(rows: list) -> dict:
+    joints = [r for r in rows if r["law"] is not None]
+    nulls = [r for r in rows if r["law"] is None]
+
+    def share(sel, key):
+        n = [r for r in sel if key in r.get("right", {})]
+        return {"n": len(n), "right": sum(bool(r["right"][key]) for r in n)}
+
+    out = {"structures": len(rows), "joints": len(joints), "nulls": len(nulls),
+           "placed": share(joints, "placed"), "named": share(joints, "named"),
+           "within_3x_noise": share(rows, "within_3x_noise"),
+           "below_quarter_linear": share(joints, "below_quarter_linear"), "null_clean": share(nulls, "null"),
+           "errors": sum("error" in r or "predict_error" in r for r in rows), "by": {}}
+    for key in ("structure", "law"):
+        for val in sorted({str(r[key]) for r in rows}):
+            sel = [r for r in rows if str(r[key]) == val]
+            out["by"][f"{key}={val}"] = {k: share(sel, k) for k in ("placed", "named", "within_3x_noise", "null")}
+    return out
+
+
+def line(result: dict) -> str:
+    s = result["summary"]
+
+    def f(k):
+        return f"{s[k]['right']}/{s[k]['n']}"
+
+    return (f"structures_gvt: {s['structures']} tests ({s['nulls']} nulls): placed {f('placed')}, law {f('named')}, "
+            f"held-out levels within 3x noise {f('within_3x_noise')}, below a quarter of linear "
+            f"{f('below_quarter_linear')}, nulls clean {f('null_clean')}, errors {s['errors']}")
+
+
+def merge(paths, out: Path) -> dict:
+    parts = [json.loads(Path(p).read_text()) for p in paths]
+    rows = [r for p in parts for r in p["rows"]]
+    result = {"machine": parts[-1]["machine"], "runs": [{"file": str(p), "machine": q["machine"]}
+                                                        for p, q in zip(paths, parts)],
+              "rows": rows, "summary": summarise(rows),
+              "benchmark_seconds": sum(q.get("benchmark_seconds", 0.0) for q in parts)}
+    out.write_text(json.dumps(result, indent=1))
+    return result
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--count", type=int, default=24, help="tests (structures and laws in turn, every sixth a null)")
+    ap.add_argument("--seed0", type=int, default=0)
+    ap.add_argument("--out", type=Path, default=OUT)
+    ap.add_argument("--merge", nargs="+", default=None)
+    args = ap.parse_args(argv)
+    if args.merge:
+        print(line(merge(args.merge, args.out)))
+        return 0
+    t0 = time.perf_counter()
+    result = {"machine": machine(threads=1), "fitted_levels": list(FITTED), "held_levels": list(HELD), "rows": []}
+    for i, (structure, law, seed) in enumerate(plan(args.count, args.seed0)):
+        row = case(structure, law, seed)
+        result["rows"].append(row)
+        print(f"[{i + 1}/{args.count}] {structure} {law} seed {seed}: {row.get('found_between')} "
+              f"{row.get('found_law')} {row.get('right')} ({row.get('discover_s')} s)", file=sys.stderr, flush=True)
+        result["summary"] = summarise(result["rows"])
+        args.out.write_text(json.dumps(result, indent=1))
+    result["benchmark_seconds"] = time.perf_counter() - t0
+    result["machine"].update(load_after())
+    args.out.write_text(json.dumps(result, indent=1))
+    print(line(result) + " | " + describe(result["machine"]))
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
