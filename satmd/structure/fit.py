@@ -171,11 +171,11 @@ def best_fitting(models) -> StructureModel:
     """Of models of one structure with different laws, the one that simulates its recordings best (mean NRMSE
     over every recording and channel); the sparse library only where it beats every named law by more than
     `SPARSE_MARGIN` (its terms fit what a named law leaves, and predict the levels it did not see no better);
-    a "softening" whose fit stiffens is not one (`_stiffens`)."""
+    a law whose fitted sign contradicts its name is not that law (`_contradicts`)."""
     def score(m):
         return float(np.mean(m.fit["nonlinear"])) if m.joint is not None else np.inf
 
-    named = [m for m in models if m.joint is not None and m.joint.law != "sparse" and not _stiffens(m.joint)]
+    named = [m for m in models if m.joint is not None and m.joint.law != "sparse" and not _contradicts(m.joint)]
     sparse = [m for m in models if m.joint is not None and m.joint.law == "sparse"]
     best = min(named, key=score) if named else None
     if sparse and (best is None or score(sparse[0]) < (1 - SPARSE_MARGIN) * score(best)):
@@ -183,10 +183,17 @@ def best_fitting(models) -> StructureModel:
     return best if best is not None else models[0]
 
 
-def _stiffens(joint) -> bool:
-    """A saturating spring fitted in newtons with k_sat < 0: its stiffness grows with the stroke, so it is no
-    softening, whatever it fits (in relative units the path's sign leaves k_sat's open, and it is kept)."""
-    return joint.law == "softening" and joint.units == "N" and joint.parameters().get("k_sat", 0.0) < 0
+#: law -> its coefficient whose sign the name fixes: a saturating spring with k_sat < 0 stiffens with the stroke,
+#: a clearance with k_contact < 0 gives way beyond its gap (on an independent chain with a saturating joint, the
+#: latter simulated the levels best and was named a clearance)
+NAMED_SIGN = {"softening": "k_sat", "clearance": "k_contact"}
+
+
+def _contradicts(joint) -> bool:
+    """A law fitted in newtons with the sign its name excludes (`NAMED_SIGN`): not that law, whatever it fits (in
+    relative units the path's sign leaves the coefficient's open, and it is kept)."""
+    key = NAMED_SIGN.get(joint.law)
+    return key is not None and joint.units == "N" and joint.parameters().get(key, 0.0) < 0
 
 
 def _fit_span(recording) -> int:

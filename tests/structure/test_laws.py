@@ -71,3 +71,19 @@ def test_a_saturating_spring_that_stiffens_is_no_softening():
     assert best_fitting([soft, cubic]) is soft
     relative = model("softening", 0.019, k_sat=-2e4, units="relative")  # the path's sign leaves k_sat's open
     assert best_fitting([relative, cubic]) is relative
+
+
+def test_a_clearance_whose_contact_gives_way_is_no_clearance():
+    """In newtons a negative contact stiffness softens beyond the gap: a clearance only closes (SPEC §11)."""
+    from types import SimpleNamespace
+
+    from satmd.structure.fit import best_fitting
+
+    def model(law, nrmse, **par):
+        joint = SimpleNamespace(law=law, units="N", parameters=lambda: par)
+        return SimpleNamespace(joint=joint, fit={"nonlinear": [[nrmse]]})
+
+    soft = model("softening", 0.30, k_sat=3e4)
+    assert best_fitting([model("clearance", 0.25, k_contact=-5e4, gap=1e-4), soft]) is soft
+    closing = model("clearance", 0.25, k_contact=5e4, gap=1e-4)
+    assert best_fitting([closing, soft]) is closing
