@@ -14,6 +14,7 @@ from .laws import law as law_named
 from .linear import fit_linear
 from .locate import shape_of
 from .model import Drive, Joint, StructureModel, nrmse, warmup_of
+from .outside import above_band
 from .spectra import periodic_spectra
 from .starts import measured_start, underlying_start
 
@@ -121,15 +122,17 @@ def fit_structure(recordings, between=None, law: str | None = None, channels=Non
     for start in starts:  # the lowest level as the linear part, or the structure under the joint: the better kept
         if start == "underlying":
             say("the structure under the joint and the joint's path, from every level at once ...")
-            linear, c, kappa = underlying_start(reference, spectra, between, lw, d0, v0, aux)
+            try:
+                linear, c, kappa = underlying_start(reference, spectra, between, lw, d0, v0, aux)
+            except np.linalg.LinAlgError:  # a vector fit that did not converge: as a start without a joint
+                linear, c, kappa = reference, np.full(len(lw.all_terms), np.nan), np.zeros(reference.poles.size)
         else:
             linear, (c, kappa) = reference, measured_start(reference, spectra, between, lw, d0, v0, aux)
         if not (np.all(np.isfinite(c)) and np.all(np.isfinite(kappa)) and np.all(np.isfinite(linear.residues))):
             say(f"the {start} start has no finite joint: left out")
             continue
-        model = StructureModel(linear, Joint(between, law, c, aux, kappa), levels, reference=reference,
-                               oversample=oversampling(linear, ref.fs_hz))
-        drives = _drives(model, recordings, measured, span)
+        model, drives = _with_modes_above(StructureModel(linear, Joint(between, law, c, aux, kappa), levels,
+                                                         reference=reference), spectra, recordings, measured, span)
         say(f"output-error fit of the {law} joint between {between[0]} and {between[1]} on {len(recordings)} "
             f"recordings (from the {start} linear part) ...")
         model = _output_error(_stable(model, drives), drives, ref, max_nfev, fixed_path=not free_path)
@@ -165,6 +168,18 @@ def _simulated_shape(linear, spectra, between, lw, d0, v0, aux, recordings, meas
         if cost < best_cost:
             best, best_cost = a, cost
     return best
+
+
+def _with_modes_above(model, spectra, recordings, measured, span):
+    """(model, its drives): the start with the modes above the band its joint's harmonics drive (`above_band`)
+    where its simulation of the recordings is the closer (an added mode can also carry the joint's feedback
+    away: on a chain with a cubic joint it did), else the start as it was."""
+    wider = above_band(model, spectra)
+    runs = []
+    for m in (model,) if wider is model else (model, wider):
+        m = replace(m, oversample=oversampling(m.linear, spectra[0].fs_hz))
+        runs.append((m, _drives(m, recordings, measured, span)))
+    return min(runs, key=lambda run: _cost(_stable(*run), run[1]))
 
 
 def best_fitting(models) -> StructureModel:

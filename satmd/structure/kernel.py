@@ -98,9 +98,12 @@ def _compiled():
         except ImportError:  # pragma: no cover - exercised where numba is absent
             _STATE["pass"] = None
         else:
+            from .. import _compiled
+            from . import laws
+
             global term, _law
-            jit = numba.njit(cache=True, fastmath=False)
-            term = jit(term)  # _law calls it by this name
-            _law = jit(_law)  # _pass calls it by this name
-            _STATE["pass"] = jit(_pass)
+            sources = [__file__, laws.__file__]  # the law's text is compiled into the pass
+            term = numba.njit(cache=True, fastmath=False)(term)  # _law calls it by this name
+            _law = _compiled.njit_cached(numba, _law, sources)  # _pass calls it by this name
+            _STATE["pass"] = _compiled.njit_cached(numba, _pass, sources)
     return _STATE["pass"]

@@ -30,6 +30,8 @@ class PeriodicSpectra:
     force : (K,) complex mean spectrum of the force
     responses : {channel: (K,) complex mean spectrum}
     std : {channel: (K,) std of the mean's real and imaginary parts, from the spread over periods}
+    whole : {channel: (n // 2 + 1,) complex mean spectrum at every line}: what a joint throws outside the lines
+        the force excites (`satmd.structure.outside`); None where not kept
     """
 
     source: str
@@ -40,20 +42,27 @@ class PeriodicSpectra:
     force: np.ndarray
     responses: dict
     std: dict
+    whole: dict | None = None
 
     @property
     def freq_hz(self) -> np.ndarray:
         return self.lines * self.fs_hz / self.period_samples
 
-    def motion(self, channel: str):
-        """(displacement, velocity) over one period of ``channel`` (zeros for ``"ground"``)."""
+    def motion(self, channel: str, whole: bool = False):
+        """(displacement, velocity) over one period of ``channel`` (zeros for ``"ground"``); ``whole``: from every
+        line from the band's lowest up to 0.8 of the Nyquist frequency (the harmonics a joint makes above the
+        band move the sensors too; below the band the accelerometers' noise, divided by ω², would swamp it)."""
         if channel == "ground":
             return np.zeros(self.period_samples), np.zeros(self.period_samples)
+        if whole and self.whole is not None:
+            lines = np.arange(int(self.lines.min()), int(0.8 * (self.period_samples // 2)) + 1)
+            return motion(self.whole[channel][lines], lines, self.fs_hz, self.period_samples)
         return motion(self.responses[channel], self.lines, self.fs_hz, self.period_samples)
 
-    def relative(self, a: str, b: str):
-        """(d, v): the relative displacement and velocity of sensor a to sensor b (or the ground) over one period."""
-        (da, va), (db, vb) = self.motion(a), self.motion(b)
+    def relative(self, a: str, b: str, whole: bool = False):
+        """(d, v): the relative displacement and velocity of sensor a to sensor b (or the ground) over one period
+        (``whole``: see `motion`)."""
+        (da, va), (db, vb) = self.motion(a, whole), self.motion(b, whole)
         return da - db, va - vb
 
     def scales(self, a: str, b: str):
@@ -112,13 +121,16 @@ def periodic_spectra(recording) -> PeriodicSpectra:
     n = exc.period_samples
     lines = np.asarray(exc.lines, int)
     force = signal_spectra(rec, exc, "force").mean(axis=0)  # (steady periods, lines) of the periodic estimator
-    responses, std = {}, {}
+    responses, std, whole = {}, {}, {}
     for name in rec.channels:
         if name == "force":
             continue
         Y = signal_spectra(rec, exc, name)
         responses[name] = Y.mean(axis=0)
+        x = np.asarray(rec[name], float)[: exc.periods * n].reshape(exc.periods, n)[list(exc.steady)]
+        whole[name] = np.fft.rfft(x.mean(axis=0))
         std[name] = np.sqrt(np.var(Y, axis=0, ddof=1) / Y.shape[0] / 2.0)
     if not responses:
         raise DataError(f"{source}: no response channel beside the force")
-    return PeriodicSpectra(source, force_level(rec["force"]), float(rec.fs_hz), int(n), lines, force, responses, std)
+    return PeriodicSpectra(source, force_level(rec["force"]), float(rec.fs_hz), int(n), lines, force, responses, std,
+                           whole)

@@ -1,0 +1,127 @@
+"""Modes above the force's band, seen through the joint's harmonics (SPEC §11: predict what was not measured).
+
+A multisine puts nothing above its band, so the lowest level's FRF knows no mode there; but a joint's force
+carries harmonics and sum frequencies of the band, and where they reach a mode just above it the response at
+the lines the force does not excite can be most of a sensor's RMS (on independent ground vibration tests,
+`benchmarks/structures_gvt.py`, the held-out levels' worst errors were that share almost entirely). The
+joint's force is an input like the shaker's (FNSI's feedback form, Noël & Kerschen 2013): at a line above the
+band, each channel's response is the joint's column there times the spectrum of g(d, v), the law evaluated on
+the measured stroke. What the modes in the model leave of it is fitted by a few more poles (vector fitting),
+whose residues T are the joint's column alone: the force reaches them only through their tails, which the
+lowest level's fit already holds in its flat terms, so they join the model with ``T = A κ`` at a large κ (the
+shaker's path through them 1e-6 of the joint's).
+"""
+from __future__ import annotations
+
+from dataclasses import replace
+
+import numpy as np
+
+from ..conventions import TINY
+from .laws import law as law_named
+from .linear import LinearStructure
+
+MAX_PAIRS = 4          # poles tried above the band
+TOP_SHARE = 0.8        # of the Nyquist frequency: beyond it an acquisition's anti-alias filter takes the response
+GAIN = 1e6             # κ of a mode the joint alone drives (its shaker residue is T/κ)
+MIN_GAIN = 0.3         # the fit must explain this share of what the model leaves above the band
+
+
+def above_band(model, spectra):
+    """``model`` with modes above the force's band that the joint's harmonics drive, where they explain most
+    of what the model leaves at the lines above the band (on every level but the lowest); else ``model``.
+
+    Parameters
+    ----------
+    model : StructureModel with a joint (its start: coefficients and path from the spectra)
+    spectra : the levels' `PeriodicSpectra` (with each channel's whole spectrum, `PeriodicSpectra.whole`)
+
+    Returns
+    -------
+    StructureModel
+    """
+    from ..modal.rational import vector_fit_inputs
+
+    ref = min(spectra, key=lambda s: s.level)
+    blocks = [b for b in (_block(model, s) for s in spectra if s is not ref) if b is not None]
+    if not blocks:
+        return model
+    before = sum(float(np.sum(np.abs(E * W) ** 2)) for _, _, E, W, _ in blocks)
+    best, best_rss = None, before
+    fs, top_line = spectra[0].fs_hz, max(int(s.lines.max()) for s in spectra)
+    band_top = top_line * fs / spectra[0].period_samples
+    for pairs in range(1, MAX_PAIRS + 1):
+        try:
+            poles, _, _ = vector_fit_inputs([(f, G[None, :], E, W) for f, G, E, W, _ in blocks], pairs)
+        except np.linalg.LinAlgError:
+            continue
+        f_hz = poles.imag / (2 * np.pi)
+        zeta = -poles.real / np.maximum(np.abs(poles), TINY)
+        poles = poles[(f_hz > band_top) & (zeta > 0) & (zeta < 0.3)]
+        if poles.size == 0:
+            continue
+        T, rss = _residues(poles, blocks)
+        n_rows = sum(2 * E.size for _, _, E, _, _ in blocks)
+        penalty = 2 * poles.size * T.shape[0] * np.log(n_rows) * before / n_rows  # BIC's, in the RSS's units
+        if rss + penalty < best_rss:
+            best, best_rss = (poles, T), rss + penalty
+    if best is None or best_rss > (1 - MIN_GAIN) * before:
+        return model
+    poles, T = best
+    lin = model.linear
+    extra = LinearStructure(lin.channels, np.concatenate([lin.poles, poles]),
+                            np.hstack([lin.residues, T / GAIN]), lin.feedthrough)
+    joint = replace(model.joint, coupling=np.concatenate([np.asarray(model.joint.coupling, complex),
+                                                          np.full(poles.size, GAIN, complex)]))
+    return replace(model, linear=extra, joint=joint)
+
+
+def _block(model, s):
+    """(freq, G, E, W, rows) at the lines above the band of one level: the joint's force spectrum, what the
+    model's modes leave of each channel's response there, and the channels' weights; None without such lines."""
+    lin, joint = model.linear, model.joint
+    n = s.period_samples
+    top = int(TOP_SHARE * (n // 2))
+    lines = np.arange(int(s.lines.max()) + 1, top + 1)
+    if lines.size < 4 or s.whole is None:
+        return None
+    f = lines * s.fs_hz / n
+    d, v = s.relative(*joint.between, whole=True)
+    g = law_named(joint.law).force(joint.coefficients, d, v, joint.aux)
+    G = np.fft.rfft(g, n)[lines]
+    column = _column(lin.poles, lin.residues * np.asarray(joint.coupling)[None, :], f)
+    A = np.array([s.whole[c][lines] for c in lin.channels])
+    E = A - column * G[None, :]
+    W = np.repeat(np.array([[1.0 / max(float(np.mean(np.abs(s.responses[c]))), TINY)] for c in lin.channels]),
+                  lines.size, axis=1)
+    return f, G, E, W, lines
+
+
+def _column(poles, T, f):
+    """(C, M) the joint's accelerance column of residues T (C, K) at ``f`` Hz, zero at rest (`model.Drive`)."""
+    iw = 2j * np.pi * np.asarray(f, float)[None, :, None]
+    lam = poles[None, None, :]
+    R = T[:, None, :]
+    return (R * (1 / (iw - lam) + 1 / lam) + R.conj() * (1 / (iw - lam.conj()) + 1 / lam.conj())).sum(axis=2)
+
+
+def _residues(poles, blocks):
+    """(T (C, K), weighted RSS): the joint's residues at ``poles``, per channel in least squares over the levels."""
+    n_out = blocks[0][2].shape[0]
+    T = np.zeros((n_out, poles.size), complex)
+    rss = 0.0
+    for o in range(n_out):
+        rows, rhs = [], []
+        for f, G, E, W, _ in blocks:
+            iw = 2j * np.pi * f[:, None]
+            a = (1 / (iw - poles[None, :]) + 1 / poles[None, :]) * G[:, None]
+            b = (1 / (iw - poles.conj()[None, :]) + 1 / poles.conj()[None, :]) * G[:, None]
+            X = np.hstack([a + b, 1j * (a - b)]) * W[o][:, None]
+            rows.append(X)
+            rhs.append(E[o] * W[o])
+        X, y = np.vstack(rows), np.concatenate(rhs)
+        Xr, yr = np.vstack([X.real, X.imag]), np.concatenate([y.real, y.imag])
+        coef, *_ = np.linalg.lstsq(Xr, yr, rcond=None)
+        T[o] = coef[:poles.size] + 1j * coef[poles.size:]
+        rss += float(np.sum((yr - Xr @ coef) ** 2))
+    return T, rss
