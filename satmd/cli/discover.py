@@ -64,10 +64,7 @@ def run(args):
     else:
         rep = discover(load_data(args), free=free, candidates=candidates, channels=channels, alpha=args.alpha)
     if args.save_model:
-        if rep.model is None:
-            raise SatmdError("--save-model: no structure model was fitted (it needs recordings of one structure at "
-                             "two or more levels, a periodic force and two or more response channels)")
-        model = rep.model
+        model = rep.model if rep.model is not None else _linear_structure(args, items if args.more else None, told)
         if args.driving_point:
             from ..structure.fit import in_newtons
 
@@ -80,6 +77,24 @@ def run(args):
     else:
         print(rep.report())
     return 0
+
+
+def _linear_structure(args, items, told):
+    """The model a structure with no joint gets (SPEC §11: its linear part predicts every level), or a refusal
+    that says what the recordings lack."""
+    from ..errors import DataError, SatmdError
+
+    if not items or not all(hasattr(r, "fs_hz") for r in items):
+        raise SatmdError("--save-model: a structure's model is fitted from time recordings at two or more levels "
+                         "(a periodic force, two or more response channels); these are "
+                         + ("one recording" if not items else "FRF files"))
+    from ..structure import fit_structure
+
+    told.step("no joint: the structure's linear model from the lowest level, for `satmd predict` ...", force=True)
+    try:
+        return fit_structure(items, channels=parse_list(args.channels), progress=lambda text: None)
+    except DataError as exc:
+        raise SatmdError(f"--save-model: {exc}") from None
 
 
 def _load_one(args, path):

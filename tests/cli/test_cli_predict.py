@@ -55,3 +55,19 @@ def test_save_model_needs_a_structure(capsys, levels, tmp_path):
     out = tmp_path / "m.json"
     refused(capsys, "discover", levels / "L1.csv", "--save-model", out, says=("--save-model",), alone=False)
     assert not out.exists()
+
+
+def test_a_structure_with_no_joint_saves_its_linear_model(capsys, tmp_path):
+    """SPEC §11: no joint, no joint finding, and the linear model predicts every level within the noise; its
+    model is saved as asked, not refused (a ground vibration test of a linear structure is a result too)."""
+    recs = simulate_chain(joint=(2, 3), law=lambda dd, v: 0.0 * dd, levels=(1.0, 3.0, 8.0), seed=2)
+    for r, name in zip(recs, ("L1", "L3", "L8")):
+        save_recording(r, tmp_path / f"{name}.csv")
+    model = tmp_path / "linear.json"
+    rc, out, err = run(capsys, "discover", tmp_path / "L1.csv", tmp_path / "L8.csv", "--save-model", model, "--json")
+    assert rc == 0, err
+    assert not any(f["name"] == "joint" for f in (json.loads(out).get("nonlinear") or {}).get("findings", []))
+    rc, out, err = run(capsys, "predict", model, tmp_path / "L3.csv", "--json")
+    assert rc == 0, err
+    (p,) = json.loads(out)["recordings"]
+    assert max(p["nrmse"]) < 0.03 and p["nrmse"] == p["linear_nrmse"]  # 1 % noise on every channel
