@@ -221,7 +221,7 @@ def readme_markdown(result: dict) -> str:
               f"of the held-out misses (beyond 3× noise), {s.get('misses_outside_band', 0)} of "
               f"{s['within_3x_noise']['n'] - s['within_3x_noise']['right']} are the response outside the force's band "
               f"(the joint's harmonics and the modes they reach: at the worst channel that share is at least half the "
-              f"NRMSE), which a linear part known only in the band cannot simulate; "
+              f"NRMSE): what the model's modes above the band (`satmd.structure.outside`) did not capture; "
               f"the held-out worst channel below a quarter of the level-1 linear model's in {f(s['below_quarter_linear'])} "
               f"tests (the levels where a quarter of the linear model's miss is above 3× the noise); errors {s['errors']}; `discover` median "
               f"{secs[len(secs) // 2] if secs else float('nan'):.0f} s (longest {secs[-1] if secs else float('nan'):.0f} s) "
