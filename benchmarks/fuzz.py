@@ -59,6 +59,14 @@ class _Timeout(BaseException):
     pass
 
 
+
+def portable(text: str, root=ROOT) -> str:
+    """A case's output with this machine's paths named for what they are (a traceback quotes its files): the
+    results file is read on other machines."""
+    for path, name in ((str(root), "{repo}"), (sys.base_prefix, "{python}"), (str(Path.home()), "~")):
+        text = text.replace(path, name)
+    return text
+
 def _alarm(signum, frame):  # noqa: ARG001
     raise _Timeout()
 
@@ -505,7 +513,7 @@ def main():
     for c, r in zip(cases, results):
         families.setdefault(c["family"], Counter())[r["class"]] += 1
     failures = [{"id": c["id"], "family": c["family"], "case": describe(c), "class": r["class"],
-                 "detail": r["detail"]} for c, r in zip(cases, results) if r["class"] not in GOOD]
+                 "detail": portable(r["detail"])} for c, r in zip(cases, results) if r["class"] not in GOOD]
     result.update({
         "cases": len(cases), "workers": args.workers, "memory_limit_gib": args.memory_gib, "timeout_s": args.timeout,
         "wall_s": round(time.perf_counter() - t0, 1),
@@ -513,7 +521,7 @@ def main():
         "families": {f: {k: v for k, v in sorted(n.items())} for f, n in families.items()},
         "kinds": dict(Counter(c["kind"] for c in cases)),
         "failures": failures,
-        "examples": {cls: next((f"{describe(c)} -> {r['detail']}" for c, r in zip(cases, results)
+        "examples": {cls: next((f"{describe(c)} -> {portable(r['detail'])}" for c, r in zip(cases, results)
                                 if r["class"] == cls), None) for cls in GOOD},
     })
     result["machine"].update(load_after())
