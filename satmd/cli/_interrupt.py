@@ -6,6 +6,7 @@ they load is handled like any other.
 """
 from __future__ import annotations
 
+import _thread
 import contextlib
 import signal
 import sys
@@ -15,6 +16,7 @@ INTERRUPTED = 130  # 128 + SIGINT, the status a shell reports for a command ende
 GRACE_S = 1.0  # a second Ctrl-C this soon after the first is not acted on: the clean-up the first started finishes
 
 _first: list = [None]  # time.monotonic() of this command's first Ctrl-C, or None
+_caller_hook: list = [sys.unraisablehook]  # the unraisable-exception hook ours stands in front of
 
 
 def _on_sigint(signum, frame):  # noqa: ARG001 - signal handler signature
@@ -23,6 +25,21 @@ def _on_sigint(signum, frame):  # noqa: ARG001 - signal handler signature
         return  # a double press: the first is already ending the command
     _first[0] = now
     raise KeyboardInterrupt
+
+
+def _on_unraisable(unraisable):
+    """A Ctrl-C raised where Python cannot raise (a weakref callback, a ``__del__``) is delivered again, not printed.
+
+    Python would print it as "Exception ignored in ..." with a traceback and
+    carry on, the press lost. Pressed again from another thread, it reaches
+    the main thread's next steps (from this one it would land in this hook,
+    where it cannot be raised either).
+    """
+    if unraisable.exc_type is not None and issubclass(unraisable.exc_type, KeyboardInterrupt):
+        _first[0] = None  # not a second press: the first one never arrived
+        _thread.start_new_thread(_thread.interrupt_main, (signal.SIGINT,))
+        return
+    _caller_hook[0](unraisable)
 
 
 @contextlib.contextmanager
@@ -37,21 +54,28 @@ def catching_interrupts(exiting: bool = False):
     interruption ours stays (past `GRACE_S` it raises as Python's would), and
     with ``exiting`` (the ``satmd`` program itself, whose process ends next)
     the process ends here, by `_exit_now`: a press while the interpreter
-    shuts down can then neither print a traceback nor kill it mid-way.
+    shuts down can then neither print a traceback nor kill it mid-way. With
+    ``exiting`` and no interruption, a press after the work is done is
+    ignored: CPython resets its own handler to the signal's default as it
+    shuts down, and the press would kill the process by SIGINT, not with the
+    command's status.
     """
     installed = None
     with contextlib.suppress(ValueError, OSError):  # ValueError: not the main thread, where no handler can be set
         if signal.getsignal(signal.SIGINT) is signal.default_int_handler:
             installed = signal.signal(signal.SIGINT, _on_sigint)
+            _caller_hook[0], sys.unraisablehook = sys.unraisablehook, _on_unraisable
     _first[0] = None
     try:
         yield
     except KeyboardInterrupt:  # after the command's own `except`: still one line, no traceback
         interrupted()
     finally:
+        if installed is not None:
+            sys.unraisablehook = _caller_hook[0]
         if installed is not None and _first[0] is None:
             with contextlib.suppress(ValueError, OSError):
-                signal.signal(signal.SIGINT, installed)
+                signal.signal(signal.SIGINT, signal.SIG_IGN if exiting else installed)
         elif installed is not None and exiting:
             _exit_now()
 

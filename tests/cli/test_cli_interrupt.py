@@ -93,3 +93,47 @@ def test_the_callers_sigint_handler_comes_back(capsys):
         assert signal.getsignal(signal.SIGINT) is signal.SIG_IGN
     finally:
         signal.signal(signal.SIGINT, before)
+
+
+def test_ctrl_c_inside_a_weakref_callback_still_ends_the_command(capsys):
+    """Python cannot raise from a weakref callback: the press is delivered again, not printed as ignored (fuzz 1575)."""
+    import weakref
+
+    from satmd.cli._interrupt import catching_interrupts
+
+    class Thing:
+        pass
+
+    def pressed_during_callback(_):
+        signal.raise_signal(signal.SIGINT)  # the handler runs here, inside the callback
+
+    reached = []
+    before = signal.signal(signal.SIGINT, signal.default_int_handler)
+    try:
+        with catching_interrupts():
+            thing = Thing()
+            ref = weakref.ref(thing, pressed_during_callback)
+            del thing
+            start = time.monotonic()
+            while time.monotonic() - start < 5:  # the command's next steps, where the press lands again
+                pass
+            reached.append(ref)
+    finally:
+        signal.signal(signal.SIGINT, before)
+    err = capsys.readouterr().err
+    assert not reached and err == "satmd: interrupted\n", err
+
+
+def test_ctrl_c_as_the_finished_program_shuts_down_keeps_its_status(tmp_path):
+    """A press after the work is done, while Python shuts down, is ignored: not a traceback, not death by SIGINT
+    (CPython hands SIGINT back to its default as it shuts down: exit -2 in fuzz 1576, 1646, 1653, 1673)."""
+    code = ("import atexit, os, signal, sys, time\n"
+            "from satmd.cli import main\n"
+            "atexit.register(lambda: (os.kill(os.getpid(), signal.SIGINT), time.sleep(0.2)))\n"
+            "sys.argv = ['satmd', '--version']\n"
+            "sys.exit(main())\n")
+    env = {**os.environ, "PYTHONPATH": str(ROOT)}
+    p = subprocess.run([sys.executable, "-c", code], cwd=tmp_path, env=env, capture_output=True, text=True,
+                       timeout=60, preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
+    assert p.returncode == 0 and "Traceback" not in p.stderr and p.stdout.startswith("satmd "), (p.returncode,
+                                                                                              p.stderr)
