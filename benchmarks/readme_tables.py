@@ -447,7 +447,7 @@ def recordings() -> str:
         rows.append(f"| `discover(estimate_frf(rec))` per 120 s recording at 2 kHz | "
                     f"{timing['null']['median_s']:.1f} s with nothing missing; median "
                     f"{timing['hidden_effect']['median_s']:.1f} s with a hidden effect |")
-    rows.append(f"| benchmark wall time ({r['machine']['workers']} workers, load average "
+    rows.append(f"| benchmark wall time ({_workers(r['machine']['workers'])}, load average "
                 f"{r['machine'].get('load_average_1min', float('nan')):.1f}) | {r['benchmark_seconds']:.0f} s |")
     return "\n".join(rows)
 
@@ -512,7 +512,7 @@ def machine(name: str) -> str:
     if load_avg is not None:
         parts.append(f"load average {load_avg:.1f}")
     if m.get("workers"):
-        parts.append(f"{m['workers']} workers")
+        parts.append(_workers(m["workers"]))
     parts += [f"{k} {m[k]}" for k in ("python", "numpy", "torch") if m.get(k)]
     if m.get("torch_threads"):
         parts.append(f"{m['torch_threads']} torch thread{'s' if m['torch_threads'] > 1 else ''}")
@@ -570,6 +570,10 @@ MEASURES = {
     "structures_predict": ["satmd/structure", "satmd/modal/rational.py"],
     "tuning": ["satmd/tuning"],
 }
+
+
+def _workers(n) -> str:
+    return f"{n} worker" + ("" if n == 1 else "s")
 
 
 def _machines(doc) -> list[dict]:
