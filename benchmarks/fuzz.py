@@ -548,7 +548,7 @@ def readme_markdown(result: dict) -> str:
     rows.append("")
     rows.append(f"{result['cases']} cases: {kinds.get('api', 0)} API calls and {kinds.get('cli', 0)} command lines "
                 f"in worker processes, {kinds.get('proc', 0)} `python -m satmd` processes (sent SIGINT or SIGTERM, "
-                f"or writing to a full disk); {result['workers']} workers, each under a "
+                f"or writing to a full disk); {result['workers']} worker{'' if result['workers'] == 1 else 's'}, each under a "
                 f"{result['memory_limit_gib']:g} GiB address-space limit and {result['timeout_s']:g} s per case; "
                 f"{result['wall_s']:.0f} s on a shared 2-core machine"
                 + (f" (load {load[0] if isinstance(load, list) else load})" if load else "")
