@@ -99,8 +99,9 @@ def by_period(model_path: Path, csv: Path) -> dict:
     for c in p.channels:
         measured, _, simulated = p.signals[c]
         err2, scale = (simulated - measured) ** 2, float(np.std(measured)) or 1.0
-        first.append(round(float(np.sqrt(err2[:sim.PERIOD].mean())) / scale, 4))
-        steady.append(round(float(np.sqrt(err2[sim.PERIOD:].mean())) / scale, 4))
+        for out, part in ((first, err2[:sim.PERIOD]), (steady, err2[sim.PERIOD:])):
+            value = float(np.sqrt(part.mean())) / scale
+            out.append(round(value, 4) if np.isfinite(value) else None)  # None: the simulation ran away
     return {"first_period_nrmse": first, "steady_nrmse": steady}
 
 
@@ -117,6 +118,11 @@ def outside_band(rec: dict, sensors) -> list:
     return out
 
 
+def _finite(values) -> list:
+    """NRMSEs with a simulation that ran away (null in `satmd predict`'s JSON: it is infinite) as inf."""
+    return [float("inf") if v is None or not np.isfinite(v) else float(v) for v in values]
+
+
 def _score(row: dict) -> dict:
     truth = row["law"]
     if truth is None:
@@ -127,12 +133,13 @@ def _score(row: dict) -> dict:
     floor = row["noise"]["acc"]
     held = row.get("held")
     if held:
-        worst = [max(h["nrmse"]) for h in held]
+        worst = [max(_finite(h["nrmse"])) for h in held]
         row["right"]["within_3x_noise"] = all(w <= 3 * floor for w in worst)
         # a quarter of the linear model's miss, where that is above the 3x-noise allowance (below it, the noise)
-        judged = [h for h in held if 0.25 * max(h["linear_nrmse"]) > 3 * floor]
+        judged = [h for h in held if 0.25 * max(_finite(h["linear_nrmse"])) > 3 * floor]
         if judged and row["law"] is not None:
-            row["right"]["below_quarter_linear"] = all(max(h["nrmse"]) < 0.25 * max(h["linear_nrmse"]) for h in judged)
+            row["right"]["below_quarter_linear"] = all(max(_finite(h["nrmse"])) < 0.25 * max(_finite(h["linear_nrmse"]))
+                                                        for h in judged)
     return row
 
 
@@ -142,9 +149,9 @@ def _outside_band_miss(row) -> bool:
     held = row.get("held") or []
     if not held:
         return False
-    h = max(held, key=lambda h: max(h["nrmse"]))
-    c = int(np.argmax(h["nrmse"]))
-    return row["outside_band"][str(h["level"])][c] >= 0.5 * h["nrmse"][c]
+    h = max(held, key=lambda h: max(_finite(h["nrmse"])))
+    c = int(np.argmax(_finite(h["nrmse"])))
+    return row["outside_band"][str(h["level"])][c] >= 0.5 * _finite(h["nrmse"])[c]
 
 
 def _start_up_misses(rows) -> dict:
@@ -152,7 +159,7 @@ def _start_up_misses(rows) -> dict:
     first within 3x the noise at every held-out level and channel)."""
     timed = [r for r in rows if not r.get("right", {}).get("within_3x_noise", True)
              and all("steady_nrmse" in h for h in r.get("held") or [{}])]
-    alone = [r for r in timed if all(max(h["steady_nrmse"]) <= 3 * r["noise"]["acc"] for h in r["held"])]
+    alone = [r for r in timed if all(max(_finite(h["steady_nrmse"])) <= 3 * r["noise"]["acc"] for h in r["held"])]
     return {"n": len(timed), "start_up_alone": len(alone)}
 
 
@@ -170,7 +177,8 @@ def summarise(rows: list) -> dict:
            "below_quarter_linear": share(joints, "below_quarter_linear"), "null_clean": share(nulls, "null"),
            "errors": sum("error" in r or "predict_error" in r for r in rows), "by": {},
            "misses_outside_band": sum(_outside_band_miss(r) for r in rows if not r.get("right", {}).get("within_3x_noise", True)),
-           "misses_start_up": _start_up_misses(rows)}
+           "misses_start_up": _start_up_misses(rows),
+           "ran_away": sum(any(v is None for h in r.get("held") or [] for v in h["nrmse"]) for r in rows)}
     for key in ("structure", "law"):
         for val in sorted({str(r[key]) for r in rows}):
             sel = [r for r in rows if str(r[key]) == val]
@@ -254,7 +262,9 @@ def readme_markdown(result: dict) -> str:
                  f"modes above the band; the periods after it within 3× the noise); "
                  if (s.get("misses_start_up") or {}).get("n") else "") +
               f"the held-out worst channel below a quarter of the level-1 linear model's in {f(s['below_quarter_linear'])} "
-              f"tests (the levels where a quarter of the linear model's miss is above 3× the noise); errors {s['errors']}; `discover` median "
+              f"tests (the levels where a quarter of the linear model's miss is above 3× the noise); errors {s['errors']}; "
+              + (f"models that ran away at a held-out level {s['ran_away']}; " if s.get("ran_away") else "") +
+              f"`discover` median "
               f"{secs[len(secs) // 2] if secs else float('nan'):.0f} s (longest {secs[-1] if secs else float('nan'):.0f} s) "
               f"on one core. The issue's targets: placed ≥ 95 %, law ≥ 90 %, within 3× noise ≥ 90 % over ≥ 100 "
               f"structures, nulls ≥ 99 %."]
