@@ -89,7 +89,7 @@ def rescued_by_one_effect(verdict, search, nominal, rig) -> bool:
     """
     if any(r.kind in MISTAKES for r in verdict.reasons):
         return False
-    for c in search.candidates:
+    for c in search.options(nominal):
         one = search.add(nominal, c)
         if trusted(one.fit) and not effects_at_edge(one.effects, rig):
             return True

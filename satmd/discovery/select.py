@@ -54,6 +54,16 @@ class Search:
     tried: set = field(default_factory=set)  # (parent names, added name) already fitted
     log: list = field(default_factory=list)
 
+    def options(self, model: Model):
+        """The candidates ``model`` can grow by: not in it, and leaving the data a residual degree of freedom
+        (a coarse FRF of a few lines cannot carry every effect's parameters; such a model is not fitted)."""
+        n_lines = self.data.freq_hz.size
+        for name in self.candidates:
+            if name in model.names:
+                continue
+            if n_lines > len(self.free_names(list(model.effects) + [at_rest(name, self.rig)])):
+                yield name
+
     def free_names(self, effects):
         return self.base_free + tuple(e.qualified(p) for e in effects for p in e.parameter_names if self.measured(p))
 
@@ -140,9 +150,7 @@ def select(search: Search, nominal: Model, still_significant, max_effects: int =
         for parent in layer:
             if not still_significant(parent.fit):
                 continue
-            for c in search.candidates:
-                if c in parent.names:
-                    continue
+            for c in search.options(parent):
                 child = search.add(parent, c)
                 if parent.bic - child.bic > MIN_DELTA_BIC:
                     key = frozenset(child.names)
@@ -180,7 +188,7 @@ def _swaps(search, model, nominal):
         improved = False
         for name in model.names:
             rest = search.remove(model, name, nominal)
-            for c in search.candidates:
+            for c in search.options(rest):
                 if c in model.names:
                     continue
                 alt = search.add(rest, c)
@@ -198,7 +206,7 @@ def equivalents(search, model, nominal, limit: int = 3) -> dict:
     for name in model.names:
         rest = search.remove(model, name, nominal)
         alts = []
-        for c in search.candidates:
+        for c in search.options(rest):
             if c in model.names:
                 continue
             alt = search.add(rest, c)
