@@ -59,13 +59,13 @@ class _Timeout(BaseException):
     pass
 
 
-
 def portable(text: str, root=ROOT) -> str:
     """A case's output with this machine's paths named for what they are (a traceback quotes its files): the
     results file is read on other machines."""
     for path, name in ((str(root), "{repo}"), (sys.base_prefix, "{python}"), (str(Path.home()), "~")):
         text = text.replace(path, name)
     return text
+
 
 def _alarm(signum, frame):  # noqa: ARG001
     raise _Timeout()
