@@ -15,6 +15,8 @@ and then models it and predicts levels that were not measured:
 
 - `linear`: `LinearStructure`, the lowest level as a stable pole-residue model of every channel
   (`satmd.modal.rational.vector_fit`), in time;
+- `startup`: the modes above the force's band that a record's start from rest rings (its step is the only
+  force there), found in time;
 - `kernel`: the joint's force sample by sample (an implicit step, compiled with numba when it is there);
 - `model`: `StructureModel` (the linear part and its `Joint`), `simulate`, `predict`, JSON `save`/`load`;
 - `starts`: where the fit starts, the joint's law and path from the levels' spectra (the lowest level as the

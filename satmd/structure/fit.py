@@ -17,6 +17,7 @@ from .model import Drive, Joint, StructureModel, nrmse, warmup_of
 from .outside import above_band
 from .spectra import periodic_spectra
 from .starts import measured_start, underlying_start
+from .startup import with_start_up_modes
 
 FIT_PERIODS = 3  # steady periods of a periodic test in the output-error fit
 #: named laws (the best by the levels' spectra) each fitted when three or more levels are given, the one that
@@ -103,7 +104,7 @@ def fit_structure(recordings, between=None, law: str | None = None, channels=Non
             raise DataError(f"the joint's sensor {c!r} is not a channel ({', '.join(names)})")
     ref = min(spectra, key=lambda s: s.level)
     say(f"linear part from the lowest level ({ref.source}) ...")
-    linear = fit_linear(ref, names, between, n_pairs)
+    linear = with_start_up_modes(fit_linear(ref, names, between, n_pairs), recordings, spectra, between)
     levels = (min(s.level for s in spectra), max(s.level for s in spectra))
     files = list(files or [s.source for s in spectra])
     if between is None:
@@ -251,7 +252,6 @@ def _cost(model, drives) -> float:
 
 
 def _with_joint(model, c, kappa) -> StructureModel:
-
     return replace(model, joint=replace(model.joint, coefficients=np.asarray(c, float), coupling=np.asarray(kappa)))
 
 

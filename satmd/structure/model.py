@@ -6,7 +6,8 @@ Fitted by `fit_structure` on recordings at several levels (SPEC §11):
 2. **Linear part** from the lowest level (`linear.fit_linear`): a stable pole-residue model of every
    channel. The pair's relative motion is a small difference of two large accelerations, so the model
    is fitted on the channels with the pair's first sensor replaced by the difference: a few per cent of
-   error on each sensor would otherwise be all of the joint's stroke.
+   error on each sensor would otherwise be all of the joint's stroke. With the modes above the force's
+   band that a start from rest rings (`startup.start_up_modes`).
 3. **Start** in the frequency domain, every level at once: the change ``E_o = A_o − H_o F`` is the
    joint's force ``G = Σ c_j t_j(d, v)`` (from the measured relative motion) through the joint's column,
    ``A_or κ_r / (iω − λ_r)`` with a coupling ``κ_r`` per mode (reciprocity: the column of a force at
