@@ -70,3 +70,21 @@ def test_a_structure_with_no_mode_above_the_band_is_left_as_it_was():
     spectra = [periodic_spectra(r) for r in fitted]
     linear = fit_linear(spectra[0], ("acc1", "acc2", "acc3"))
     assert start_up_modes(linear, fitted, band_top_hz(spectra)) is linear
+
+
+def test_a_record_begun_in_motion_is_no_start_from_rest(chain):
+    """A record cut from a longer test, its first periods drifting as the F-16's do (read as a transient), starts
+    in steady state (`warmup_of`: one period of warm-up) and shows no mode above the band; the same test from
+    rest starts from rest."""
+    from satmd.signal.excitation import excitation_of, received
+    from satmd.structure.model import warmup_of
+
+    fitted, _, spectra, linear = chain
+    n = 1024
+    cut = {c: np.asarray(fitted[0][c], float)[n:] for c in fitted[0].channels}
+    drift = 1.0 + 0.05 * np.exp(-np.arange(cut["force"].size) / n)  # a gain settling over the first periods
+    moving = Recording(fitted[0].fs_hz, {c: x * drift if c != "force" else x for c, x in cut.items()},
+                       meta=fitted[0].meta)
+    assert excitation_of(received(moving)).transient_periods  # the drift reads as a transient
+    assert warmup_of(moving) == n and warmup_of(fitted[0]) == 0
+    assert start_up_modes(linear, [moving], band_top_hz(spectra)) is linear
