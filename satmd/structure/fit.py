@@ -78,7 +78,7 @@ def fit_structure(recordings, between=None, law: str | None = None, channels=Non
         missing = [c for c in names if c not in s.responses]
         if missing:
             raise DataError(f"{s.source}: no channel {', '.join(missing)} (the other levels have it)")
-    shape = None
+    shape, form = None, ()
     if between is None or law is None:
         if location is None:
             say("locating the joint among every pair of sensors ...")
@@ -87,7 +87,7 @@ def fit_structure(recordings, between=None, law: str | None = None, channels=Non
             between = law = None
         else:
             if between is None or tuple(between) == loc.between:
-                shape = loc.shape if law is None or law == loc.law else None
+                shape, form = (loc.shape, loc.form) if law is None or law == loc.law else (None, ())
             law_given = law is not None
             between, law = tuple(between or loc.between), law or loc.law
             if not law_given and len(recordings) >= 3 and tuple(between) == loc.between:
@@ -112,13 +112,12 @@ def fit_structure(recordings, between=None, law: str | None = None, channels=Non
         return _with_table(model, recordings, files)
     between = tuple(between)
     assert law is not None  # set with the place
-    lw = law_named(law)
     d0, v0 = ref.scales(*between)
-    aux = shape if shape is not None else shape_of(spectra, between, law, names)
+    lw, aux = (law_named(law).form(form), shape) if shape is not None else shape_of(spectra, between, law, names)
     reference = linear
     span = [_fit_span(r) for r in recordings]
     measured = [np.array([np.asarray(r[ch], float)[:n] for ch in names]) for r, n in zip(recordings, span)]
-    aux = _simulated_shape(reference, spectra, between, lw, d0, v0, aux, recordings, measured, span, levels)
+    lw, aux = _simulated_shape(reference, spectra, between, lw, d0, v0, aux, recordings, measured, span, levels)
     fitted = []
     for start in starts:  # the lowest level as the linear part, or the structure under the joint: the better kept
         if start == "underlying":
@@ -132,8 +131,9 @@ def fit_structure(recordings, between=None, law: str | None = None, channels=Non
         if not (np.all(np.isfinite(c)) and np.all(np.isfinite(kappa)) and np.all(np.isfinite(linear.residues))):
             say(f"the {start} start has no finite joint: left out")
             continue
-        model, drives = _with_modes_above(StructureModel(linear, Joint(between, law, c, aux, kappa), levels,
-                                                         reference=reference), spectra, recordings, measured, span)
+        joint = Joint(between, law, c, aux, kappa, form=lw.term_names)
+        model, drives = _with_modes_above(StructureModel(linear, joint, levels, reference=reference), spectra,
+                                          recordings, measured, span)
         say(f"output-error fit of the {law} joint between {between[0]} and {between[1]} on {len(recordings)} "
             f"recordings (from the {start} linear part) ...")
         model = _output_error(_stable(model, drives), drives, ref, max_nfev, fixed_path=not free_path)
@@ -149,25 +149,26 @@ def fit_structure(recordings, between=None, law: str | None = None, channels=Non
 
 
 def _simulated_shape(linear, spectra, between, lw, d0, v0, aux, recordings, measured, span, levels):
-    """The shape constants (a gap, a slip's smoothing) the output-error fit starts from: of the spectra's choice
-    and the law's grid (`JointLaw.shapes`), the one whose frequency-domain start simulates the recordings best.
-    The spectra weigh each level's change at the excited lines; the simulation weighs what the fit will, and a
-    fit of a sharp law stays near the shape it starts from (on the F-16 a friction started at 3 RMS velocities
-    of slip ended at worst NRMSE 0.30-0.45 per level, started at the best simulated one at 0.22-0.44)."""
-    tried = [aux, *lw.shapes(d0, v0)] if any(t in SHAPE_GRID for t in lw.all_terms) else [aux]
+    """(the law in its form, its shape constants) the output-error fit starts from: of the spectra's choice and
+    every form's grid (`JointLaw.variants`, `JointLaw.shapes`), the one whose frequency-domain start simulates the
+    recordings best. The spectra weigh each level's change at the excited lines; the simulation weighs what the
+    fit will, and a fit of a sharp law stays near the shape it starts from (on the F-16 a friction started at 3 RMS
+    velocities of slip ended at worst NRMSE 0.30-0.45 per level, started at the best simulated one at 0.22-0.44)."""
+    tried = [(lw, aux)] + [(form, a) for form in law_named(lw.name).variants() for a in form.shapes(d0, v0)
+                           if any(t in SHAPE_GRID for t in form.all_terms)]
     if len(tried) == 1:
-        return aux
-    best, best_cost = aux, np.inf
-    for a in tried:
-        c, kappa = measured_start(linear, spectra, between, lw, d0, v0, a)
+        return lw, aux
+    best, best_cost = (lw, aux), np.inf
+    for form, a in tried:
+        c, kappa = measured_start(linear, spectra, between, form, d0, v0, a)
         if not (np.all(np.isfinite(c)) and np.all(np.isfinite(kappa))):
             continue
-        model = StructureModel(linear, Joint(between, lw.name, c, a, kappa), levels, reference=linear,
-                               oversample=oversampling(linear, spectra[0].fs_hz))
+        model = StructureModel(linear, Joint(between, form.name, c, a, kappa, form=form.term_names), levels,
+                               reference=linear, oversample=oversampling(linear, spectra[0].fs_hz))
         drives = _drives(model, recordings, measured, span)
         cost = _cost(_stable(model, drives), drives)
         if cost < best_cost:
-            best, best_cost = a, cost
+            best, best_cost = (form, a), cost
     return best
 
 

@@ -7,13 +7,17 @@ the pair's relative motion (``d_F``, ``v_F``) is linear and known over the recor
 comes from its force ``g`` through the same modes. At every sample the joint's force is the law at the
 motion it makes, ``g_k = law(d_k(g_k), v_k(g_k))`` (the hold's ``G1`` term puts ``g_k`` in its own motion),
 solved by Newton steps on the scalar ``g_k`` from a linear extrapolation: an implicit step that stays
-stable on a stiff friction law. The outputs are then the linear responses to ``g`` (`linear`).
+stable on a stiff friction law. A term with a memory (a stick-slip contact, `laws.slide`) is stepped from its
+state at the previous sample over the stroke since; its state moves on once the sample's force is found.
+The outputs are then the linear responses to ``g`` (`linear`).
 """
 from __future__ import annotations
 
 import numpy as np
 
-from .laws import term
+from .laws import slide, term
+
+SLIP = 10  # `laws.TERM_CODES["slip(d)"]`: the one term with a memory (`laws.HYSTERETIC`)
 
 NEWTON_STEPS = 20
 NEWTON_TOL = 1e-10
@@ -39,12 +43,17 @@ def joint_force(psi, G0, G1, rd, rv, dF, vF, codes, coefs, aux):
     return _pass(psi, G0, G1, rd, rv, dF, vF, codes, coefs, aux)
 
 
-def _law(codes, coefs, aux, d, v):
+def _law(codes, coefs, aux, d, v, state, d_last):
+    """(force, ∂/∂d, ∂/∂v) at (d, v), a term with a memory stepped from its ``state`` at the stroke ``d_last``."""
     f = 0.0
     fd = 0.0
     fv = 0.0
     for j in range(codes.size):
-        t, td, tv = term(codes[j], d, v, aux[j])
+        if codes[j] == SLIP:
+            r, slope = slide(state[j], (d - d_last) / aux[j])
+            t, td, tv = aux[j] * r, slope, 0.0
+        else:
+            t, td, tv = term(codes[j], d, v, aux[j])
         f += coefs[j] * t
         fd += coefs[j] * td
         fv += coefs[j] * tv
@@ -62,6 +71,8 @@ def _pass(psi, G0, G1, rd, rv, dF, vF, codes, coefs, aux):
         sv += (rv[r] * G1[r]).real
     g1 = 0.0
     g2 = 0.0
+    state = np.zeros(codes.size)  # each memory term's state (from rest: zero)
+    d_last = 0.0
     for k in range(n_samples):
         zp = psi * z + G0 * g1 if k > 0 else z
         d_known = dF[k]
@@ -71,7 +82,7 @@ def _pass(psi, G0, G1, rd, rv, dF, vF, codes, coefs, aux):
             v_known += (rv[r] * zp[r]).real
         x = 2.0 * g1 - g2
         for _ in range(NEWTON_STEPS):
-            f, fd, fv = _law(codes, coefs, aux, d_known + sd * x, v_known + sv * x)
+            f, fd, fv = _law(codes, coefs, aux, d_known + sd * x, v_known + sv * x, state, d_last)
             slope = 1.0 - fd * sd - fv * sv
             step = (x - f) / slope if slope != 0.0 else 0.0
             x -= step
@@ -81,6 +92,11 @@ def _pass(psi, G0, G1, rd, rv, dF, vF, codes, coefs, aux):
             g[k:] = np.nan
             return g
         g[k] = x
+        d_now = d_known + sd * x
+        for j in range(codes.size):
+            if codes[j] == SLIP:
+                state[j] = slide(state[j], (d_now - d_last) / aux[j])[0]
+        d_last = d_now
         z = zp + G1 * x
         g2 = g1
         g1 = x
@@ -101,9 +117,11 @@ def _compiled():
             from .. import _compiled
             from . import laws
 
-            global term, _law
+            global term, slide, _law
             sources = [__file__, laws.__file__]  # the law's text is compiled into the pass
             term = numba.njit(cache=True, fastmath=False)(term)  # _law calls it by this name
+            laws.compile_slide(numba)
+            slide = laws.slide
             _law = _compiled.njit_cached(numba, _law, sources)  # _pass calls it by this name
             _STATE["pass"] = _compiled.njit_cached(numba, _pass, sources)
     return _STATE["pass"]

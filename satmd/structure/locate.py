@@ -63,6 +63,7 @@ class JointLocation:
     reference : the source of the level taken as linear; levels: force RMS of every recording
     poles_hz : the structure's modes used (f in Hz, ζ)
     shape : the chosen law's shape constants at the best place (`JointLaw.all_terms` order: a gap, a smoothing)
+    form : the chosen law's own terms in the form that explained the levels best (`JointLaw.forms`)
     """
 
     between: tuple
@@ -76,6 +77,7 @@ class JointLocation:
     poles_hz: list = field(default_factory=list)
     evidence: float = 0.0
     shape: np.ndarray | None = field(default=None, repr=False)
+    form: tuple = ()
 
     @property
     def detected(self) -> bool:
@@ -148,22 +150,28 @@ def locate_joint(recordings, laws=None, band_hz=None, channels=None) -> JointLoc
     return _verdict(bic, places, chosen, ref, items, modal, named)
 
 
-def shape_of(recordings, between, law_name: str, channels=None) -> np.ndarray:
-    """The shape constants of ``law_name`` at ``between`` that explain the level changes best (`best_shape`)."""
+def shape_of(recordings, between, law_name: str, channels=None):
+    """(the law in its form, its shape constants): ``law_name`` at ``between`` as it explains the level changes best
+    (`best_shape`)."""
     ref, others, names, rows, H, transfer, _ = prepare(recordings, None, channels)
-    return best_shape(tuple(between), LAWS[law_name], others, ref, H, names, rows, real_inputs(transfer), refine=True)[1]
+    _, aux, form = best_shape(tuple(between), LAWS[law_name], others, ref, H, names, rows, real_inputs(transfer),
+                              refine=True)
+    return form, aux
 
 
 def best_shape(place, law_, others, ref, H, names, rows, transfer, refine=False):
-    """(BIC, shape constants) of a law at a place at its best shape (a gap, a friction's smoothing, a saturating
-    spring's stroke) of `JointLaw.shapes`; with ``refine``, the best of the grid is refined between its
-    neighbours (a joint's gap is seldom on the grid, and a law off its shape loses to the sparse library); one
-    more parameter counted when there was a choice."""
+    """(BIC, shape constants, the law in its form) of a law at a place at its best form (`JointLaw.variants`) and
+    shape (a gap, a friction's smoothing or stick stroke, a saturating spring's stroke) of `JointLaw.shapes`; with
+    ``refine``, the best of the grid is refined between its neighbours (a joint's gap is seldom on the grid, and a
+    law off its shape loses to the sparse library); one more parameter counted when there was a choice."""
     d0, v0 = ref.scales(*place)
-    tried = law_.shapes(d0, v0)
-    found = [(_evidence(place, law_, others, ref, H, names, rows, transfer, aux), i) for i, aux in enumerate(tried)]
+    tried = [(form, aux) for form in law_.variants() for aux in form.shapes(d0, v0)]
+    found = [(_evidence(place, form, others, ref, H, names, rows, transfer, aux), i)
+             for i, (form, aux) in enumerate(tried)]
     value, i = min(found)
-    best = tried[i]
+    law_, best = tried[i]
+    tried = [aux for form, aux in tried if form is law_]
+    i = next(j for j, aux in enumerate(tried) if aux is best)
     if refine and len(tried) > 1:
         from scipy.optimize import minimize_scalar
 
@@ -181,7 +189,7 @@ def best_shape(place, law_, others, ref, H, names, rows, transfer, refine=False)
         if res.fun < value:
             value, best = float(res.fun), scaled(res.x)
     n = sum(2 * k.size for k in rows.values() if k is not rows[id(ref)]) * len(names)
-    return value + (np.log(n) if len(tried) > 1 else 0.0), best
+    return value + (np.log(n) if len(found) > 1 else 0.0), best, law_
 
 
 def prepare(recordings, band_hz=None, channels=None):
@@ -302,5 +310,6 @@ def _verdict(bic, places, laws, ref, items, modal, named) -> JointLocation:
         equivalent_places=[e for e in location[1:] if e["delta_bic"] <= EQUIVALENT],
         equivalent_laws=[e for e in laws_out if e["law"] != chosen and e["delta_bic"] <= EQUIVALENT],
         reference=ref.source, levels=[round(float(s.level), 6) for s in items], shape=named[chosen][1],
+        form=named[chosen][2].term_names,
         poles_hz=[(round(float(m.f_hz), 4), round(float(m.zeta), 5)) for m in modal.modes],
         evidence=float(bic[None] - best_bic))

@@ -49,7 +49,7 @@ class Joint:
     ----------
     between : (a, b); the joint's stroke is ``d = x_a − x_b``
     law : the law's name (`satmd.structure.laws.LAWS`)
-    coefficients : (J,) of the law's terms (`JointLaw.all_terms`): force in N per term unit
+    coefficients : (J,) of the law's terms (`JointLaw.all_terms` of its form): force in N per term unit
     aux : (J,) each term's shape constant (a gap in m, a friction's smoothing in m/s)
     coupling : (n,) complex κ_r: the joint's column of residues is the force's times κ
     units : ``"N"`` when the coefficients are forces (the path scaled by reciprocity through a driving
@@ -57,6 +57,8 @@ class Joint:
     ci95 : 95 % interval [lo, hi] of each fitted parameter, by the names of `parameters` (from the output-error
         fit's Jacobian, its residuals' correlation in time counted; in newtons the scale's error from the path's
         misfit to the modes' shapes too); empty when not estimated
+    form : the law's own terms in the form it takes (`JointLaw.forms`; a friction's stick-slip contact or its
+        memoryless Coulomb force); empty: the law's first form
     """
 
     between: tuple
@@ -66,14 +68,21 @@ class Joint:
     coupling: np.ndarray
     units: str = "relative"
     ci95: dict = field(default_factory=dict)
+    form: tuple = ()
+
+    @property
+    def law_form(self):
+        """The `JointLaw` in this joint's form."""
+        return law_named(self.law).form(self.form)
 
     @property
     def terms(self) -> tuple:
-        return law_named(self.law).all_terms
+        return self.law_form.all_terms
 
     def parameters(self) -> dict:
-        """Each term's coefficient by its name (``k3`` of d³, ``k_contact``, ``f_slip`` ...; ``k`` and ``c`` the
-        change of the joint's linear stiffness and damping) and the shape constants (``gap``, ``v_slip``)."""
+        """Each term's coefficient by its name (``k3`` of d³, ``k_contact``, ``k_stick``, ``f_slip`` ...; ``k`` and ``c``
+        the change of the joint's linear stiffness and damping) and the shape constants (``gap``, ``d_slip``,
+        ``v_slip``)."""
         from .laws import SHAPE_PARAMETERS, TERM_PARAMETERS
 
         out = {TERM_PARAMETERS[t]: float(c) for t, c in zip(self.terms, self.coefficients)}
@@ -81,7 +90,7 @@ class Joint:
         return out
 
     def formula(self) -> str:
-        return law_named(self.law).formula(self.coefficients, self.aux)
+        return self.law_form.formula(self.coefficients, self.aux)
 
     def to_dict(self) -> dict:
         return {"between": list(self.between), "law": self.law, "terms": list(self.terms),
@@ -92,9 +101,21 @@ class Joint:
     @classmethod
     def from_dict(cls, d: dict) -> "Joint":
         k = np.asarray(d["coupling"], float).reshape(-1, 2)
-        return cls(tuple(d["between"]), str(d["law"]), np.asarray(d["coefficients"], float),
-                   np.asarray(d["aux"], float), k[:, 0] + 1j * k[:, 1], str(d.get("units", "relative")),
-                   {str(n): [float(x) for x in v] for n, v in (d.get("ci95") or {}).items()})
+        named = law_named(str(d["law"]))
+        terms = tuple(d.get("terms") or named.all_terms)
+        if terms[-2:] != ("d", "v"):
+            raise ValueError(f"its {d['law']} joint's terms {', '.join(terms)} do not end in the linear d, v")
+        try:
+            form = named.form(terms[:-2]).term_names
+        except DataError as exc:  # a model saved by a version whose law had other terms
+            raise DataError(f"{exc}: fit the model again") from None
+        joint = cls(tuple(d["between"]), str(d["law"]), np.asarray(d["coefficients"], float),
+                    np.asarray(d["aux"], float), k[:, 0] + 1j * k[:, 1], str(d.get("units", "relative")),
+                    {str(n): [float(x) for x in v] for n, v in (d.get("ci95") or {}).items()}, form)
+        if not joint.coefficients.size == joint.aux.size == len(joint.terms):
+            raise ValueError(f"{joint.coefficients.size} coefficients and {joint.aux.size} shape constants for the "
+                             f"terms {', '.join(joint.terms)}")
+        return joint
 
 
 @dataclass(frozen=True)
@@ -223,6 +244,8 @@ class StructureModel:
             raise DataError(f"{path}: not JSON ({exc.msg} at line {exc.lineno})") from None
         try:
             return cls.from_dict(d)
+        except DataError as exc:  # e.g. a law or form this version does not know
+            raise DataError(f"{path}: {exc}") from None
         except (KeyError, TypeError, ValueError) as exc:
             raise DataError(f"{path}: a structure model with a missing or malformed field ({exc})") from None
 
@@ -336,7 +359,7 @@ class Drive:
         k = joint.coupling
         pair = self.pair * k
         g = joint_force(self.psi, self.G0, self.G1, 2 * pair / lin.poles ** 2, 2 * pair / lin.poles, self.dF, self.vF,
-                        law_named(joint.law).codes, np.asarray(joint.coefficients, float), np.asarray(joint.aux, float))
+                        joint.law_form.codes, np.asarray(joint.coefficients, float), np.asarray(joint.aux, float))
         if not np.all(np.isfinite(g)):
             return np.full_like(self.linear[:, keep], np.nan)
         z = modal_states(g, lin.poles, self.fs * self.r)[:, ::self.r][:, keep]  # at the record's samples

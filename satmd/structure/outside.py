@@ -18,7 +18,6 @@ from dataclasses import replace
 import numpy as np
 
 from ..conventions import TINY
-from .laws import law as law_named
 from .linear import LinearStructure
 
 MAX_PAIRS = 4          # poles tried above the band
@@ -87,7 +86,7 @@ def _block(model, s):
         return None
     f = lines * s.fs_hz / n
     d, v = s.relative(*joint.between, whole=True)
-    g = law_named(joint.law).force(joint.coefficients, d, v, joint.aux)
+    g = joint.law_form.force(joint.coefficients, d, v, joint.aux)
     G = np.fft.rfft(g, n)[lines]
     column = _column(lin.poles, lin.residues * np.asarray(joint.coupling)[None, :], f)
     A = np.array([s.whole[c][lines] for c in lin.channels])

@@ -69,12 +69,12 @@ def test_the_compiled_joint_pass_is_the_numpy_pass():
     psi, G0, G1 = discretise(poles, 400.0)
     rd, rv = 1e-3 * (rng.standard_normal(2) + 1j), 1e-2 * (rng.standard_normal(2) + 1j)
     dF, vF = 1e-3 * rng.standard_normal(2000), 1e-2 * rng.standard_normal(2000)
-    law_ = LAWS["friction"]
-    args = (psi, G0, G1, rd, rv, dF, vF, law_.codes, np.array([0.5, 20.0, 1.0]), np.array([1e-3, 1.0, 1.0]))
-    slow = _pass(*args)
-    if _compiled() is None:
-        pytest.skip("numba is not installed")
-    assert np.allclose(joint_force(*args), slow, rtol=1e-10, atol=1e-12)
+    for law_ in LAWS["friction"].variants():  # a stick-slip contact with a memory, a memoryless Coulomb force
+        args = (psi, G0, G1, rd, rv, dF, vF, law_.codes, np.array([0.5, 20.0, 1.0]), np.array([1e-3, 1.0, 1.0]))
+        slow = _pass(*args)
+        if _compiled() is None:
+            pytest.skip("numba is not installed")
+        assert np.allclose(joint_force(*args), slow, rtol=1e-10, atol=1e-12)
 
 
 def test_the_linear_part_in_time_has_its_frf():
@@ -167,6 +167,14 @@ def test_bad_models_and_recordings_are_refused(cubic_levels, cubic_model, tmp_pa
     broken.write_text("{")
     with pytest.raises(DataError, match="not JSON"):
         StructureModel.load(broken)
+    doc = cubic_model.to_dict()  # a friction joint in its memoryless form loads; in terms no form has, refused
+    doc["joint"] |= {"law": "friction", "terms": ["sign(v)", "d", "v"], "aux": [1e-3, 1.0, 1.0]}
+    (tmp_path / "coulomb.json").write_text(json.dumps(doc))
+    assert StructureModel.load(tmp_path / "coulomb.json").joint.terms == ("sign(v)", "d", "v")
+    doc["joint"]["terms"] = ["v³", "d", "v"]
+    (tmp_path / "old.json").write_text(json.dumps(doc))
+    with pytest.raises(DataError, match=r"old\.json: the friction law has no form with the terms v³.*fit the model again"):
+        StructureModel.load(tmp_path / "old.json")
     rec = cubic_levels[1]
     fewer = Recording(rec.fs_hz, {c: rec[c] for c in ("force", "acc1", "acc2")}, meta={"source": "three.csv"})
     with pytest.raises(DataError, match=r"three\.csv: no channel acc3, acc4, acc5"):
@@ -195,12 +203,16 @@ def test_the_stages_of_a_fit_are_told_to_a_listener_only():
     assert told == ["one", "two"]
 
 
-@pytest.mark.parametrize("law, coefficients, aux", [("clearance", [3e4, 0.0, 0.0], [2e-4, 1.0, 1.0]),
-                                                    ("friction", [0.5, 0.0, 0.0], [2e-3, 1.0, 1.0])])
-def test_the_joint_pass_is_the_ode_of_the_same_model(law, coefficients, aux):
+@pytest.mark.parametrize("law, form, coefficients, aux", [
+    ("clearance", (), [3e4, 0.0, 0.0], [2e-4, 1.0, 1.0]),
+    ("friction", ("sign(v)",), [0.5, 0.0, 0.0], [2e-3, 1.0, 1.0]),
+    ("friction", ("slip(d)",), [2e4, 0.0, 0.0], [2e-5, 1.0, 1.0])])
+def test_the_joint_pass_is_the_ode_of_the_same_model(law, form, coefficients, aux):
     """The joint's force of the implicit step (first-order hold, Newton) against a fine adaptive integration
-    (scipy's RK45, steps a tenth of the joint's) of the same modal model, for the two laws with a kink or a
-    steep slope: 1 %. The model's states are z' = λz + g with g = law(d, v) and d, v linear in z (SPEC §11)."""
+    (scipy's RK45, steps a tenth of the joint's) of the same modal model, for the laws with a kink, a steep slope
+    or a memory: 1 %. The model's states are z' = λz + g with g = law(d, v) and d, v linear in z (SPEC §11); a
+    stick-slip contact's state r adds r' = (1 − (½ sign(d' r) + ½) r²) d' / d_slip (a Bouc–Wen element in the stroke
+    d, whose rate d' the integrator's steps follow)."""
     from scipy.integrate import solve_ivp
 
     from satmd.physics.nonlinear.integrate import band_limited
@@ -209,30 +221,44 @@ def test_the_joint_pass_is_the_ode_of_the_same_model(law, coefficients, aux):
     lam = np.array([-0.6 + 2j * np.pi * 9.0, -1.5 + 2j * np.pi * 23.0])
     residues = np.array([[0.4 + 0.05j, 1.2 - 0.1j], [0.7 - 0.02j, -0.9 + 0.1j]])
     linear = LinearStructure(names, lam, residues, np.zeros(2))
-    joint = Joint(names, law, np.array(coefficients), np.array(aux), np.array([0.8 + 0.0j, 0.5 + 0.0j]))
+    joint = Joint(names, law, np.array(coefficients), np.array(aux), np.array([0.8 + 0.0j, 0.5 + 0.0j]), form=form)
     model = StructureModel(linear, joint, (1.0, 1.0), oversample=4)
     rng = np.random.default_rng(3)
     force = band_limited(rng.standard_normal(512), fs) * 60.0
     drive = Drive(model, force, fs, 0)
     pair = drive.pair * joint.coupling
     rd, rv = 2 * pair / lam ** 2, 2 * pair / lam
-    g = joint_force(drive.psi, drive.G0, drive.G1, rd, rv, drive.dF, drive.vF, LAWS[law].codes,
+    g = joint_force(drive.psi, drive.G0, drive.G1, rd, rv, drive.dF, drive.vF, joint.law_form.codes,
                     joint.coefficients, joint.aux)
     fine = drive.r * fs
     t = np.arange(drive.dF.size) / fine
-    force_law = LAWS[law].force
+    memory = form == ("slip(d)",)
+    c, a = joint.coefficients, joint.aux
+
+    def force_law(d, v, r):
+        if memory:
+            return c[0] * a[0] * r + c[1] * d + c[2] * v
+        return joint.law_form.force(c, d, v, a)
+
+    slope = np.diff(drive.dF) * fine  # the stroke's rate where the force's part is a straight line between samples
 
     def rhs(tt, y):
-        z = y[:2] + 1j * y[2:]
+        z = y[:2] + 1j * y[2:4]
         d = np.interp(tt, t, drive.dF) + (rd @ z).real
         v = np.interp(tt, t, drive.vF) + (rv @ z).real
-        dz = lam * z + force_law(joint.coefficients, d, v, joint.aux)
-        return np.concatenate([dz.real, dz.imag])
+        g_now = force_law(d, v, y[4])
+        dz = lam * z + g_now
+        # the state follows the stroke d itself: its rate, the joint's part Re(rd z') included
+        rate = slope[min(int(tt * fine), slope.size - 1)] + (rd @ dz).real
+        dr = (1 - (0.5 * np.sign(rate * y[4]) + 0.5) * y[4] ** 2) * rate / a[0]
+        return np.concatenate([dz.real, dz.imag, [dr]])
 
-    sol = solve_ivp(rhs, (0.0, t[-1]), np.zeros(4), t_eval=t, max_step=0.1 / fine, rtol=1e-8, atol=1e-14)
-    z = sol.y[:2] + 1j * sol.y[2:]
-    exact = force_law(joint.coefficients, drive.dF + (rd @ z).real, drive.vF + (rv @ z).real, joint.aux)
+    sol = solve_ivp(rhs, (0.0, t[-1]), np.zeros(5), t_eval=t, max_step=0.1 / fine, rtol=1e-8, atol=1e-14)
+    z = sol.y[:2] + 1j * sol.y[2:4]
+    exact = force_law(drive.dF + (rd @ z).real, drive.vF + (rv @ z).real, sol.y[4])
     assert np.std(exact) > 0.05 * np.max(np.abs(exact)) > 0  # the joint works: its law's kink is crossed
+    if memory:  # and a stick-slip contact slides: its state comes near ±1 and turns back
+        assert np.max(np.abs(sol.y[4])) > 0.9 and np.sum(np.diff(np.sign(np.diff(sol.y[4]))) != 0) > 4
     assert nrmse(g, exact) < 0.01, nrmse(g, exact)
 
 
