@@ -66,7 +66,7 @@ def run(args):
     if args.save_model:
         model = rep.model if rep.model is not None else _linear_structure(args, items if args.more else None, told)
         if args.driving_point:
-            from ..structure.fit import in_newtons
+            from ..structure.newtons import in_newtons
 
             model = in_newtons(model, args.driving_point)
         model.save(args.save_model)

@@ -22,7 +22,10 @@ and then models it and predicts levels that were not measured:
 - `starts`: where the fit starts, the joint's law and path from the levels' spectra (the lowest level as the
   structure, or the structure under the joint from every level at once);
 - `fit`: `fit_structure`, the model fitted on every level at once (from those starts, output error in time,
-  the parameters' intervals, the scale in newtons by reciprocity).
+  the parameters' intervals; of the laws each fitted, the one that simulates best and whose sign agrees with
+  its name);
+- `newtons`: the joint's coefficients in newtons (its path scaled by reciprocity through the driving point),
+  and the sign the modes' shapes give a path whose scale they do not fix.
 
 How (`locate`): the nonlinear force of a joint is a feedback input to the linear structure (nonlinear
 subspace identification, FNSI: Noël & Kerschen 2013). With the structure's poles from its lowest level,

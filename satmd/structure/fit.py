@@ -9,11 +9,12 @@ from ..conventions import TINY
 from ..errors import DataError
 from ..numerics import jacobian_covariance
 from ..validation import NAMES, Interval, Options, Whole, validate_params
-from .laws import LAWS, SHAPE_GRID, SHAPE_PARAMETERS
+from .laws import LAWS, SHAPE_GRID
 from .laws import law as law_named
 from .linear import fit_linear
 from .locate import shape_of
 from .model import Drive, Joint, StructureModel, nrmse, warmup_of
+from .newtons import in_newtons, path_sign
 from .outside import above_band
 from .spectra import periodic_spectra
 from .starts import measured_start, underlying_start
@@ -192,7 +193,7 @@ def best_fitting(models) -> StructureModel:
     def score(m):
         return float(np.mean(m.fit["nonlinear"])) if m.joint is not None else np.inf
 
-    named = [m for m in models if m.joint is not None and m.joint.law != "sparse" and not _contradicts(m.joint)]
+    named = [m for m in models if m.joint is not None and m.joint.law != "sparse" and not _contradicts(m)]
     sparse = [m for m in models if m.joint is not None and m.joint.law == "sparse"]
     best = min(named, key=score) if named else None
     if sparse and (best is None or score(sparse[0]) < (1 - SPARSE_MARGIN) * score(best)):
@@ -200,17 +201,26 @@ def best_fitting(models) -> StructureModel:
     return best if best is not None else models[0]
 
 
-#: law -> its coefficient whose sign the name fixes: a saturating spring with k_sat < 0 stiffens with the stroke,
-#: a clearance with k_contact < 0 gives way beyond its gap (on an independent chain with a saturating joint, the
-#: latter simulated the levels best and was named a clearance)
-NAMED_SIGN = {"softening": "k_sat", "clearance": "k_contact"}
+#: law -> its coefficients whose sign the name fixes (positive, as a force that restores or resists): a saturating
+#: spring with k_sat < 0 stiffens with the stroke, a clearance with k_contact < 0 gives way beyond its gap, a
+#: friction or a quadratic damping of negative sign feeds the structure energy (on an independent chain with a
+#: saturating joint, a giving clearance simulated the levels best and was named a clearance; on frames and beams
+#: with cubic joints, a stiffening saturating spring in relative units was named softening)
+NAMED_SIGN = {"softening": ("k_sat",), "clearance": ("k_contact",), "friction": ("k_stick", "f_slip"),
+              "quadratic_damping": ("c2",)}
 
 
-def _contradicts(joint) -> bool:
-    """A law fitted in newtons with the sign its name excludes (`NAMED_SIGN`): not that law, whatever it fits (in
-    relative units the path's sign leaves the coefficient's open, and it is kept)."""
-    key = NAMED_SIGN.get(joint.law)
-    return key is not None and joint.units == "N" and joint.parameters().get(key, 0.0) < 0
+def _contradicts(model) -> bool:
+    """A law fitted with the sign its name excludes (`NAMED_SIGN`): not that law, whatever it fits. In newtons the
+    coefficient's own sign; in relative units its sign times the path's where the modes' shapes give that
+    (`newtons.path_sign`); otherwise open, and the law is kept."""
+    joint = model.joint
+    values = joint.parameters() if joint.law in NAMED_SIGN else {}
+    signed = [values[k] for k in NAMED_SIGN.get(joint.law, ()) if k in values]
+    if not signed:
+        return False
+    sign = 1 if joint.units == "N" else path_sign(model)
+    return any(sign * v < 0 for v in signed)
 
 
 def _fit_span(recording) -> int:
@@ -342,45 +352,6 @@ def _half_widths(jac, residuals, sizes):
     if not np.all(np.isfinite(var)):
         return None
     return np.where(var >= 0, 1.96 * np.sqrt(np.abs(var)), np.nan)
-
-
-def in_newtons(model, driving_point=None) -> StructureModel:
-    """The joint with its path scaled as reciprocity says (κ_r = −(A_ar − A_br)/A_dr for a driving point d),
-    so that its coefficients are forces; the simulation is unchanged (c s, κ / s). As it was when there is no
-    driving point or the fitted path does not follow the modes' shapes (a misfit over 30 %)."""
-
-    from .linear import driving_point as found
-
-    lin, j = model.linear, model.joint
-    if driving_point is not None and driving_point not in lin.channels:
-        raise DataError(f"driving point {driving_point}: no such channel (channels: {', '.join(lin.channels)})")
-    # found on the lowest level's model first: the structure under the joint has more poles than modes, whose
-    # fitted constants can take any sign (on the F-16 it named the payload, the lowest level the shaker's point)
-    d = driving_point or (found(model.reference) if model.reference is not None else None) or found(lin)
-    if d is None or j is None:
-        return model if d is None else replace(model, driving_point=d)
-    phys = -lin.coupling(*j.between, d)
-    w = np.abs(lin.residues[lin.index(d)] / lin.poles ** 2)  # each mode's weight at the driving point
-    w = np.where(w > 0.05 * w.max(), w, 0.0)  # the structure's modes, not the poles that only shape the fit
-    s = float(np.sum(w * (j.coupling * phys.conj()).real) / max(np.sum(w * np.abs(phys) ** 2), TINY))
-    misfit = np.sqrt(np.sum(w * np.abs(j.coupling - s * phys) ** 2) / max(np.sum(w * np.abs(j.coupling) ** 2), TINY))
-    if not np.isfinite(s) or s == 0 or misfit > 0.3:  # the point is known, the scale is not: said so
-        return replace(model, driving_point=d)
-    # a force coefficient scales by s, whose relative standard error is the path's misfit to the modes' shapes
-    # over the modes that set it (a weighted mean's): its interval holds both, in quadrature; a gap or a slip
-    # velocity keeps its unit and its interval
-    shapes = set(SHAPE_PARAMETERS.values())
-    values = j.parameters()
-    rel = float(misfit) / np.sqrt(float(max(int(np.count_nonzero(w)), 1)))
-    ci = {}
-    for n, (lo, hi) in j.ci95.items():
-        if n in shapes:
-            ci[n] = [lo, hi]
-            continue
-        h = abs(s) * float(np.hypot(0.5 * (hi - lo), 1.96 * rel * abs(values[n])))
-        ci[n] = [values[n] * s - h, values[n] * s + h]
-    return replace(model, joint=replace(j, coefficients=j.coefficients * s, coupling=j.coupling / s, units="N",
-                                        ci95=ci), driving_point=d)
 
 
 def _with_table(model, recordings, files, drives=None) -> StructureModel:

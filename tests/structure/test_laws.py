@@ -43,7 +43,8 @@ def test_the_best_fitting_law_is_kept_and_the_sparse_library_only_by_a_margin():
     from satmd.structure.fit import SPARSE_MARGIN, best_fitting
 
     def model(law, nrmse):
-        return SimpleNamespace(joint=SimpleNamespace(law=law, units="relative"), fit={"nonlinear": [[nrmse, nrmse], [nrmse, nrmse]]})
+        return SimpleNamespace(joint=SimpleNamespace(law=law, units="relative", parameters=dict),
+                               fit={"nonlinear": [[nrmse, nrmse], [nrmse, nrmse]]})
 
     clearance, friction = model("clearance", 0.32), model("friction", 0.26)
     assert best_fitting([clearance, friction]) is friction
@@ -55,22 +56,84 @@ def test_the_best_fitting_law_is_kept_and_the_sparse_library_only_by_a_margin():
     assert best_fitting([none, clearance]) is clearance and best_fitting([none]) is none
 
 
+def _two_modes(kappa_scale):
+    """A mass-normalised two-mode structure (channels a, b; the force at a) with a joint from b to the ground whose
+    path is ``kappa_scale`` times reciprocity's, and that path's law fitted in relative units."""
+    from types import SimpleNamespace
+
+    from satmd.structure.linear import LinearStructure
+
+    w, zeta = 2 * np.pi * np.array([5.0, 12.0]), 0.02
+    phi = np.array([[1.0, 0.6], [0.8, -1.1]])  # rows: channels a, b; columns: modes
+    wd = w * np.sqrt(1 - zeta ** 2)
+    lam = -zeta * w + 1j * wd
+    residues = lam ** 2 * phi * phi[0] / (2j * wd)  # accelerance residues of a force at a
+    lin = LinearStructure(("a", "b"), lam, residues, np.zeros(2))
+    kappa = kappa_scale * -lin.coupling("b", "ground", "a")
+    return SimpleNamespace(linear=lin, reference=lin, driving_point=None,
+                           joint=SimpleNamespace(between=("b", "ground"), coupling=kappa))
+
+
+def test_the_path_gives_a_relative_coefficient_its_sign_where_the_modes_shapes_agree():
+    """`path_sign`: the sign of the path's scale onto reciprocity's where they point the same way mode by mode (a
+    path off in size, as fitted paths are, keeps its sign); none where they are unrelated or the point unknown."""
+    from satmd.structure import Joint, LinearStructure, StructureModel
+    from satmd.structure.newtons import in_newtons, path_scale, path_sign
+
+    for scale in (3.0, -0.4):
+        m = _two_modes(scale)
+        d, s, misfit, agreement = path_scale(m)
+        assert d == "a" and abs(s - scale) < 1e-9 * abs(scale) and misfit < 1e-9 and abs(agreement) > 1 - 1e-9
+        assert path_sign(m) == (1 if scale > 0 else -1)
+    m = _two_modes(1.0)
+    m.joint.coupling = m.joint.coupling * np.array([2.5, 0.4])  # each mode off in size by a factor: the sign holds
+    assert path_scale(m)[2] > 0.3 and path_sign(m) == 1
+    lin, phys = m.linear, -m.linear.coupling("b", "ground", "a")
+    w = np.abs(lin.residues[0] / lin.poles ** 2) * np.abs(phys) ** 2
+    m.joint.coupling = phys * np.array([1.0, -w[0] / w[1]])  # one mode against the shapes as much as the other for
+    assert abs(path_scale(m)[3]) < 1e-9 and path_sign(m) == 0  # them: unrelated, no sign
+    lin = m.linear
+    m.reference = m.linear = LinearStructure(lin.channels, lin.poles, -lin.residues, lin.feedthrough)
+    assert path_scale(m) is None and path_sign(m) == 0  # no channel has a driving point's signs
+    two = _two_modes(2.0)  # in newtons: the same simulation, the scale moved into the coefficients
+    joint = Joint(("b", "ground"), "cubic", np.array([1.0, -3.0, 0.1]), np.ones(3), two.joint.coupling)
+    n = in_newtons(StructureModel(two.linear, joint, (1.0, 2.0), reference=two.linear))
+    assert n.joint.units == "N" and n.driving_point == "a" and np.allclose(n.joint.coefficients, [2.0, -6.0, 0.2])
+    assert np.allclose(n.joint.coupling * n.joint.coefficients[0], joint.coupling * joint.coefficients[0])
+
+
 def test_a_saturating_spring_that_stiffens_is_no_softening():
-    """In newtons a negative k_sat is a spring that stiffens with the stroke: not the law its name says."""
+    """In newtons, or in relative units with the path's sign known, a negative k_sat is a spring that stiffens with
+    the stroke: not the law its name says; a friction or a quadratic damping of negative sign feeds energy in."""
     from types import SimpleNamespace
 
     from satmd.structure.fit import best_fitting
 
-    def model(law, nrmse, k_sat=None, units="N"):
-        joint = SimpleNamespace(law=law, units=units, parameters=lambda: {} if k_sat is None else {"k_sat": k_sat})
-        return SimpleNamespace(joint=joint, fit={"nonlinear": [[nrmse]]})
+    def model(law, nrmse, units="N", sign=None, **par):
+        joint = SimpleNamespace(law=law, units=units, parameters=lambda: par)
+        if sign is None:
+            return SimpleNamespace(joint=joint, fit={"nonlinear": [[nrmse]]}, driving_point=None, reference=None,
+                                   linear=None)
+        out = _two_modes(sign)
+        vars(out.joint).update(vars(joint))
+        out.fit = {"nonlinear": [[nrmse]]}
+        return out
 
     cubic = model("cubic", 0.020)
     assert best_fitting([model("softening", 0.019, k_sat=-2e4), cubic]) is cubic
     soft = model("softening", 0.019, k_sat=2e4)
     assert best_fitting([soft, cubic]) is soft
-    relative = model("softening", 0.019, k_sat=-2e4, units="relative")  # the path's sign leaves k_sat's open
-    assert best_fitting([relative, cubic]) is relative
+    stiffening = model("softening", 0.019, units="relative", sign=2.0, k_sat=-3.0)
+    assert best_fitting([stiffening, cubic]) is cubic
+    flipped = model("softening", 0.019, units="relative", sign=-2.0, k_sat=-3.0)  # in newtons +6: it softens
+    assert best_fitting([flipped, cubic]) is flipped
+    unknown = model("softening", 0.019, units="relative", sign=1.0, k_sat=-3.0)
+    w = np.abs(unknown.linear.residues[0] / unknown.linear.poles ** 2) * np.abs(unknown.joint.coupling) ** 2
+    unknown.joint.coupling = unknown.joint.coupling * np.array([1.0, -w[0] / w[1]])  # the path's sign unknown: kept
+    assert best_fitting([unknown, cubic]) is unknown
+    for law, key in (("friction", "k_stick"), ("friction", "f_slip"), ("quadratic_damping", "c2")):
+        assert best_fitting([model(law, 0.019, **{key: -1.0}), cubic]) is cubic
+        assert best_fitting([model(law, 0.019, **{key: 1.0}), cubic]).joint.law == law
 
 
 def test_a_clearance_whose_contact_gives_way_is_no_clearance():
