@@ -348,7 +348,8 @@ def measured() -> str:
         f"{st['median_cpu_s']['import_satmd']:.2f} s / {st['median_cpu_s']['satmd_help']:.2f} s of CPU "
         f"(heavy modules loaded at import: {heavy}); wall {st['median_s']['import_satmd']:.2f} s / "
         f"{st['median_s']['satmd_help']:.2f} s on a {st['cpu_count']}-core machine at load average "
-        f"{st['load_average'][0]:.1f} | `benchmarks/startup.py` |",
+        f"{st['load_average'][0]:.1f} (a bare `python -c pass`: {st['median_s']['python_bare']:.2f} s; `--help` "
+        f"{st['median_s']['satmd_help'] / max(st['median_s']['python_bare'], 1e-9):.0f}x it) | `benchmarks/startup.py` |",
         f"| identification memory and time, {at['points']:,}-point FRF (no std; fresh process, peak RSS) | "
         f"peak {at['peak_mb']:.0f} MB, fit {at['identify_s']:.1f} s"
         + (f"; `satmd identify --json` with std columns: peak {cli['peak_mb']:.0f} MB, {cli['wall_s']:.1f} s wall "
