@@ -177,6 +177,11 @@ def draw_prediction(prediction, title: str = ""):
         axes[0, j].set_xlabel("time [s]")
         axes[1, j].set_xlabel("frequency [Hz]")
         axes[1, j].set_xlim(0, min(fs / 2, 4 * _band_top(sig[0], fs)))
+        if prediction.band_top_hz and prediction.above_band:  # where the force's band ends: beyond, the joint's
+            axes[1, j].axvline(prediction.band_top_hz, color="0.5", lw=0.8, ls=":")
+            axes[1, j].set_title(f"above {prediction.band_top_hz:.3g} Hz: measured "
+                                 f"{prediction.above_band['measured'][j]:.3f}, missed "
+                                 f"{prediction.above_band['nrmse'][j]:.3f}", fontsize=8)
     axes[0, 0].set_ylabel("acceleration")
     axes[1, 0].set_ylabel("|spectrum|")
     axes[0, 0].legend(fontsize=8)

@@ -79,21 +79,54 @@ def _block(model, s):
     """(freq, G, E, W, rows) at the lines above the band of one level: the joint's force spectrum, what the
     model's modes leave of each channel's response there, and the channels' weights; None without such lines."""
     lin, joint = model.linear, model.joint
+    block = _lines_above(s, joint.between, lambda d, v: joint.law_form.force(joint.coefficients, d, v, joint.aux),
+                         lin.channels)
+    if block is None:
+        return None
+    f, G, A, W, lines = block
+    column = _column(lin.poles, lin.residues * np.asarray(joint.coupling)[None, :], f)
+    return f, G, A - column * G[None, :], W, lines
+
+
+def _lines_above(s, between, force, channels):
+    """(freq, G, A, W, lines): the force ``force(d, v)`` of the measured stroke between ``between`` and each
+    channel's response at the lines above the band of one level, with the channels' weights; None without any."""
     n = s.period_samples
     top = int(TOP_SHARE * (n // 2))
     lines = np.arange(int(s.lines.max()) + 1, top + 1)
     if lines.size < 4 or s.whole is None:
         return None
     f = lines * s.fs_hz / n
-    d, v = s.relative(*joint.between, whole=True)
-    g = joint.law_form.force(joint.coefficients, d, v, joint.aux)
-    G = np.fft.rfft(g, n)[lines]
-    column = _column(lin.poles, lin.residues * np.asarray(joint.coupling)[None, :], f)
-    A = np.array([s.whole[c][lines] for c in lin.channels])
-    E = A - column * G[None, :]
-    W = np.repeat(np.array([[1.0 / max(float(np.mean(np.abs(s.responses[c]))), TINY)] for c in lin.channels]),
+    d, v = s.relative(*between, whole=True)
+    G = np.fft.rfft(force(d, v), n)[lines]
+    A = np.array([s.whole[c][lines] for c in channels])
+    W = np.repeat(np.array([[1.0 / max(float(np.mean(np.abs(s.responses[c]))), TINY)] for c in channels]),
                   lines.size, axis=1)
-    return f, G, E, W, lines
+    return f, G, A, W, lines
+
+
+def harmonics_explained(spectra, between, force, channels, pairs: int = MAX_PAIRS) -> float:
+    """The share of the response above the force's band (its power, weighted per channel, over every level but
+    the lowest) that a joint's force ``force(d, v)`` on the measured stroke between ``between`` (``b`` may be
+    ``"ground"``) explains through ``pairs`` modes above the band: FNSI's question (the joint's force as an input)
+    of where the harmonics come from. 0 where no mode above the band is found."""
+    from ..modal.rational import vector_fit_inputs
+
+    ref = min(spectra, key=lambda s: s.level)
+    blocks = [b for b in (_lines_above(s, between, force, channels) for s in spectra if s is not ref)
+              if b is not None]
+    if not blocks:
+        return 0.0
+    before = sum(float(np.sum(np.abs(A * W) ** 2)) for _, _, A, W, _ in blocks)
+    band_top = max(int(s.lines.max()) for s in spectra) * spectra[0].fs_hz / spectra[0].period_samples
+    try:
+        poles, _, _ = vector_fit_inputs([(f, G[None, :], A, W) for f, G, A, W, _ in blocks], pairs)
+    except np.linalg.LinAlgError:
+        return 0.0
+    poles = poles[(poles.imag / (2 * np.pi) > band_top) & (poles.real < 0)]
+    if poles.size == 0 or before <= 0:
+        return 0.0
+    return max(0.0, 1.0 - _residues(poles, blocks)[1] / before)
 
 
 def _column(poles, T, f):
