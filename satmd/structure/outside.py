@@ -9,7 +9,7 @@ band, each channel's response is the joint's column there times the spectrum of 
 the measured stroke. What the modes in the model leave of it is fitted by a few more poles (vector fitting),
 whose residues T are the joint's column alone: the force reaches them only through their tails, which the
 lowest level's fit already holds in its flat terms, so they join the model with ``T = A κ`` at a large κ (the
-shaker's path through them 1e-6 of the joint's).
+shaker's path through them 1e-6 of the joint's, at the scale of the joint's path to the other modes).
 """
 from __future__ import annotations
 
@@ -22,7 +22,7 @@ from .linear import LinearStructure
 
 MAX_PAIRS = 4          # poles tried above the band
 TOP_SHARE = 0.8        # of the Nyquist frequency: beyond it an acquisition's anti-alias filter takes the response
-GAIN = 1e6             # κ of a mode the joint alone drives (its shaker residue is T/κ)
+GAIN = 1e6             # κ of a mode the joint alone drives over the largest of the others' (its shaker residue is T/κ)
 MIN_GAIN = 0.3         # the fit must explain this share of what the model leaves above the band
 
 
@@ -68,10 +68,13 @@ def above_band(model, spectra):
         return model
     poles, T = best
     lin = model.linear
+    kappa = np.asarray(model.joint.coupling, complex)
+    # in relative units the path's size is the joint force's unit (on a chain 1e9-1e11): a gain of 1e6 alone let
+    # the shaker drive the added modes 1e4 times harder than the joint does, and the linear part ran away
+    gain = GAIN * (float(np.max(np.abs(kappa), initial=0.0)) or 1.0)
     extra = LinearStructure(lin.channels, np.concatenate([lin.poles, poles]),
-                            np.hstack([lin.residues, T / GAIN]), lin.feedthrough)
-    joint = replace(model.joint, coupling=np.concatenate([np.asarray(model.joint.coupling, complex),
-                                                          np.full(poles.size, GAIN, complex)]))
+                            np.hstack([lin.residues, T / gain]), lin.feedthrough)
+    joint = replace(model.joint, coupling=np.concatenate([kappa, np.full(poles.size, gain, complex)]))
     return replace(model, linear=extra, joint=joint)
 
 

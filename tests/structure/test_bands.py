@@ -6,10 +6,10 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from satmd.structure import StructureModel
+from satmd.structure import Joint, StructureModel
 from satmd.structure.bands import above_band_shares, force_band_top
 from satmd.structure.linear import fit_linear
-from satmd.structure.outside import harmonics_explained
+from satmd.structure.outside import above_band, harmonics_explained
 from satmd.structure.spectra import periodic_spectra
 from tests.structure.chain import simulate_chain
 
@@ -67,3 +67,22 @@ def test_the_harmonics_come_from_the_joint_s_own_pair_and_law(cubic):
     assert harmonics_explained(spectra, ("acc1", "acc2"), lambda d, v: d ** 3, CHANNELS) < 0.2 * share
     assert harmonics_explained(spectra, ("acc3", "acc4"), lambda d, v: np.tanh(v / (0.1 * np.std(v))),
                                CHANNELS) < 0.1
+
+
+def test_modes_added_above_the_band_do_not_depend_on_the_joint_force_s_unit(cubic):
+    """In relative units only the product of the law's coefficients and the path is known (on chains the path
+    comes out 1e9-1e11): the same joint written at another scale gets the same modes above the band, and the
+    shaker's path through them stays negligible (a fixed gain of 1e6 let the shaker drive them harder than the
+    joint, and the linear part ran away)."""
+    spectra = [periodic_spectra(r) for r in cubic]
+    linear = fit_linear(spectra[0], CHANNELS)
+    kappa = linear.coupling("acc3", "acc4", "acc1")
+    models = [StructureModel(linear, Joint(("acc3", "acc4"), "cubic", np.array([3e9 / s, 0.0, 0.0]), np.ones(3),
+                                           kappa * s), (1.0, 8.0)) for s in (1.0, 1e10)]
+    wider = [above_band(m, spectra) for m in models]
+    n = linear.poles.size
+    assert all(w.linear.poles.size > n for w in wider)  # the cubic's harmonics reach the modes above the band
+    assert np.allclose(wider[0].linear.poles, wider[1].linear.poles, rtol=1e-9)
+    shaker = [np.abs(w.linear.residues[:, n:]).max() for w in wider]
+    assert shaker[1] == pytest.approx(shaker[0], rel=1e-6)
+    assert shaker[0] < 1e-4 * np.abs(linear.residues).max()
