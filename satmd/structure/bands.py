@@ -13,15 +13,15 @@ import numpy as np
 FORCE_SHARE = 0.999  # of the force's power (about its mean) below the top of its band
 
 
-def force_band_top(force, fs_hz: float) -> float:
-    """The frequency below which the force puts `FORCE_SHARE` of its power: the top of its band (near the Nyquist
-    frequency for a broadband force, whose response then has nothing above it)."""
-    f = np.asarray(force, float)
+def band_top(signal, fs_hz: float, share: float = FORCE_SHARE) -> float:
+    """The frequency below which a signal puts ``share`` of its power (about its mean): for a force, the top of its
+    band (near the Nyquist frequency for a broadband force, whose response then has nothing above it)."""
+    f = np.asarray(signal, float)
     power = np.abs(np.fft.rfft(f - f.mean())) ** 2
     total = float(power.sum())
     if f.size < 2 or total <= 0:
         return fs_hz / 2
-    k = min(int(np.searchsorted(np.cumsum(power), FORCE_SHARE * total)), power.size - 1)
+    k = min(int(np.searchsorted(np.cumsum(power), share * total)), power.size - 1)
     return float(k * fs_hz / f.size)
 
 

@@ -5,6 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..conventions import TINY
+from .bands import band_top
 
 
 def joint_figure(location, path, title: str = ""):
@@ -193,6 +194,4 @@ def draw_prediction(prediction, title: str = ""):
 
 def _band_top(x, fs) -> float:
     """The frequency below which 99 % of a signal's power lies (to frame the spectrum with its harmonics)."""
-    p = np.abs(np.fft.rfft(x - np.mean(x))) ** 2
-    cum = np.cumsum(p) / max(p.sum(), TINY)
-    return float(np.fft.rfftfreq(x.size, 1.0 / fs)[min(int(np.searchsorted(cum, 0.99)), p.size - 1)]) or fs / 8
+    return band_top(x, fs, 0.99) if np.ptp(x) > 0 else fs / 8

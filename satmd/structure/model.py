@@ -33,7 +33,7 @@ import numpy as np
 from ..conventions import TINY
 from ..errors import DataError
 from ..numerics import force_level
-from .bands import above_band_shares, force_band_top
+from .bands import above_band_shares, band_top
 from .kernel import joint_force
 from .laws import law as law_named
 from .linear import LinearStructure, discretise, modal_states, response
@@ -225,7 +225,7 @@ class StructureModel:
         level = force_level(force)
         lo, hi = self.levels
         fs = float(recording.fs_hz)
-        top = force_band_top(force, fs)
+        top = band_top(force, fs)
         split = [above_band_shares(s, m, fs, top) for s, m in zip(nl, measured)]
         return Prediction(name, level, bool(level < lo * 0.98 or level > hi * 1.02), self.channels,
                           [_finite_nrmse(s, m) for s, m in zip(nl, measured)],

@@ -19,6 +19,7 @@ import numpy as np
 
 from ..conventions import TINY
 from .linear import LinearStructure
+from .startup import band_top_hz
 
 MAX_PAIRS = 4          # poles tried above the band
 TOP_SHARE = 0.8        # of the Nyquist frequency: beyond it an acquisition's anti-alias filter takes the response
@@ -47,8 +48,7 @@ def above_band(model, spectra):
         return model
     before = sum(float(np.sum(np.abs(E * W) ** 2)) for _, _, E, W, _ in blocks)
     best, best_rss = None, before
-    fs, top_line = spectra[0].fs_hz, max(int(s.lines.max()) for s in spectra)
-    band_top = top_line * fs / spectra[0].period_samples
+    band_top = band_top_hz(spectra)
     for pairs in range(1, MAX_PAIRS + 1):
         try:
             poles, _, _ = vector_fit_inputs([(f, G[None, :], E, W) for f, G, E, W, _ in blocks], pairs)
@@ -121,7 +121,7 @@ def harmonics_explained(spectra, between, force, channels, pairs: int = MAX_PAIR
     if not blocks:
         return 0.0
     before = sum(float(np.sum(np.abs(A * W) ** 2)) for _, _, A, W, _ in blocks)
-    band_top = max(int(s.lines.max()) for s in spectra) * spectra[0].fs_hz / spectra[0].period_samples
+    band_top = band_top_hz(spectra)
     try:
         poles, _, _ = vector_fit_inputs([(f, G[None, :], A, W) for f, G, A, W, _ in blocks], pairs)
     except np.linalg.LinAlgError:

@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from satmd.structure import Joint, StructureModel
-from satmd.structure.bands import above_band_shares, force_band_top
+from satmd.structure.bands import above_band_shares, band_top
 from satmd.structure.linear import fit_linear
 from satmd.structure.outside import above_band, harmonics_explained
 from satmd.structure.spectra import periodic_spectra
@@ -23,10 +23,10 @@ def cubic():
 
 
 def test_the_force_band_is_where_the_force_puts_its_power(cubic):
-    assert 35.0 <= force_band_top(cubic[0]["force"], cubic[0].fs_hz) <= 37.5
+    assert 35.0 <= band_top(cubic[0]["force"], cubic[0].fs_hz) <= 37.5
     white = np.random.default_rng(0).standard_normal(4096)
-    assert force_band_top(white, 256.0) > 0.45 * 256.0
-    assert force_band_top(np.ones(64), 256.0) == 128.0  # no power at all: the whole range is the band
+    assert band_top(white, 256.0) > 0.45 * 256.0
+    assert band_top(np.ones(64), 256.0) == 128.0  # no power at all: the whole range is the band
 
 
 def test_the_miss_above_the_band_is_what_the_model_leaves_there():
