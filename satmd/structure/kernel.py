@@ -9,7 +9,8 @@ motion it makes, ``g_k = law(d_k(g_k), v_k(g_k))`` (the hold's ``G1`` term puts 
 solved by Newton steps on the scalar ``g_k`` from a linear extrapolation: an implicit step that stays
 stable on a stiff friction law. A term with a memory (a stick-slip contact, `laws.slide`) is stepped from its
 state at the previous sample over the stroke since; its state moves on once the sample's force is found.
-The outputs are then the linear responses to ``g`` (`linear`).
+The same pass keeps the modes' states driven by ``g`` at the samples asked for (`joint_states`): the outputs
+are linear in them, and filtering ``g`` through every mode again cost as much as the pass.
 """
 from __future__ import annotations
 
@@ -38,9 +39,22 @@ def joint_force(psi, G0, G1, rd, rv, dF, vF, codes, coefs, aux):
     -------
     (N,) float: the joint's force; NaN from the first sample where it ran away (no finite solution).
     """
+    return joint_states(psi, G0, G1, rd, rv, dF, vF, codes, coefs, aux, 0, 0)[0]
+
+
+def joint_states(psi, G0, G1, rd, rv, dF, vF, codes, coefs, aux, first, stride):
+    """`joint_force` and the modes' states the joint's force drives (``z_k = ψ z_{k-1} + G0 g_{k-1} + G1 g_k``
+    from rest, as `satmd.structure.linear.modal_states` of ``g``) at samples ``first, first + stride, …``.
+
+    Returns
+    -------
+    g : (N,) float, as `joint_force`
+    states : (n, M) complex at the samples asked for; none (M = 0) when ``stride`` is 0
+    """
+    args = (psi, G0, G1, rd, rv, dF, vF, codes, coefs, aux, int(first), int(stride))
     if _compiled() is not None:
-        return _compiled()(psi, G0, G1, rd, rv, dF, vF, codes, coefs, aux)
-    return _pass(psi, G0, G1, rd, rv, dF, vF, codes, coefs, aux)
+        return _compiled()(*args)
+    return _pass(*args)
 
 
 def _law(codes, coefs, aux, d, v, state, d_last):
@@ -60,13 +74,17 @@ def _law(codes, coefs, aux, d, v, state, d_last):
     return f, fd, fv
 
 
-def _pass(psi, G0, G1, rd, rv, dF, vF, codes, coefs, aux):
+def _pass(psi, G0, G1, rd, rv, dF, vF, codes, coefs, aux, first, stride):
     n_samples = dF.size
+    n_modes = psi.size
+    n_kept = (n_samples - first + stride - 1) // stride if stride > 0 and n_samples > first else 0
+    states = np.zeros((n_modes, n_kept), np.complex128)
     g = np.zeros(n_samples)
-    z = np.zeros(psi.size, np.complex128)
+    z = np.zeros(n_modes, np.complex128)
+    zp = np.zeros(n_modes, np.complex128)  # the states before the sample's force (no array made per sample)
     sd = 0.0
     sv = 0.0
-    for r in range(psi.size):
+    for r in range(n_modes):
         sd += (rd[r] * G1[r]).real
         sv += (rv[r] * G1[r]).real
     g1 = 0.0
@@ -74,10 +92,10 @@ def _pass(psi, G0, G1, rd, rv, dF, vF, codes, coefs, aux):
     state = np.zeros(codes.size)  # each memory term's state (from rest: zero)
     d_last = 0.0
     for k in range(n_samples):
-        zp = psi * z + G0 * g1 if k > 0 else z
         d_known = dF[k]
         v_known = vF[k]
-        for r in range(psi.size):
+        for r in range(n_modes):
+            zp[r] = psi[r] * z[r] + G0[r] * g1  # from rest z = 0 and g1 = 0
             d_known += (rd[r] * zp[r]).real
             v_known += (rv[r] * zp[r]).real
         x = 2.0 * g1 - g2
@@ -90,17 +108,22 @@ def _pass(psi, G0, G1, rd, rv, dF, vF, codes, coefs, aux):
                 break
         if not np.isfinite(x):
             g[k:] = np.nan
-            return g
+            return g, states
         g[k] = x
         d_now = d_known + sd * x
         for j in range(codes.size):
             if codes[j] == SLIP:
                 state[j] = slide(state[j], (d_now - d_last) / aux[j])[0]
         d_last = d_now
-        z = zp + G1 * x
+        for r in range(n_modes):
+            z[r] = zp[r] + G1[r] * x
+        if stride > 0 and k >= first and (k - first) % stride == 0:
+            kept = (k - first) // stride
+            for r in range(n_modes):
+                states[r, kept] = z[r]
         g2 = g1
         g1 = x
-    return g
+    return g, states
 
 
 _STATE: dict = {}

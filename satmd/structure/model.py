@@ -34,7 +34,7 @@ from ..conventions import TINY
 from ..errors import DataError
 from ..numerics import force_level
 from .bands import above_band_shares, band_top
-from .kernel import joint_force
+from .kernel import joint_states
 from .laws import law as law_named
 from .linear import LinearStructure, discretise, modal_states, response
 
@@ -381,12 +381,13 @@ class Drive:
         lin = self.model.linear
         k = joint.coupling
         pair = self.pair * k
-        g = joint_force(self.psi, self.G0, self.G1, 2 * pair / lin.poles ** 2, 2 * pair / lin.poles, self.dF, self.vF,
-                        joint.law_form.codes, np.asarray(joint.coefficients, float), np.asarray(joint.aux, float))
+        first, stride = self.r * self.skip, self.r * step  # the record's kept samples on the joint's finer steps
+        g, z = joint_states(self.psi, self.G0, self.G1, 2 * pair / lin.poles ** 2, 2 * pair / lin.poles, self.dF,
+                            self.vF, joint.law_form.codes, np.asarray(joint.coefficients, float),
+                            np.asarray(joint.aux, float), first, stride)
         if not np.all(np.isfinite(g)):
             return np.full_like(self.linear[:, keep], np.nan)
-        z = modal_states(g, lin.poles, self.fs * self.r)[:, ::self.r][:, keep]  # at the record's samples
         column = lin.residues * k[None, :]
         # a force at the joint's sensors moves them at once: the column's flat part Σ 2 Re(A/λ) (receptance ~ 1/s²)
         direct = response(1.0 / lin.poles[:, None], column)[:, 0]
-        return self.linear[:, keep] + response(z, column) + direct[:, None] * g[::self.r][keep]
+        return self.linear[:, keep] + response(z, column) + direct[:, None] * g[first::stride]

@@ -11,7 +11,7 @@ from satmd.errors import DataError
 from satmd.io import Recording
 from satmd.modal.rational import vector_fit, vector_fit_inputs
 from satmd.structure import Joint, LinearStructure, StructureModel, fit_structure
-from satmd.structure.kernel import _compiled, _pass, joint_force
+from satmd.structure.kernel import _compiled, _pass, joint_force, joint_states
 from satmd.structure.laws import LAWS
 from satmd.structure.linear import discretise, driving_point, fit_linear, modal_states, response
 from satmd.structure.model import Drive, nrmse
@@ -71,10 +71,29 @@ def test_the_compiled_joint_pass_is_the_numpy_pass():
     dF, vF = 1e-3 * rng.standard_normal(2000), 1e-2 * rng.standard_normal(2000)
     for law_ in LAWS["friction"].variants():  # a stick-slip contact with a memory, a memoryless Coulomb force
         args = (psi, G0, G1, rd, rv, dF, vF, law_.codes, np.array([0.5, 20.0, 1.0]), np.array([1e-3, 1.0, 1.0]))
-        slow = _pass(*args)
+        slow, states = _pass(*args, 7, 3)
         if _compiled() is None:
             pytest.skip("numba is not installed")
-        assert np.allclose(joint_force(*args), slow, rtol=1e-10, atol=1e-12)
+        g, fast = joint_states(*args, 7, 3)
+        assert np.allclose(g, slow, rtol=1e-10, atol=1e-12) and np.allclose(fast, states, rtol=1e-10, atol=1e-15)
+        assert np.array_equal(joint_force(*args), g)
+
+
+def test_the_pass_keeps_the_states_the_joint_s_force_drives():
+    """The states kept by the pass are the modes' response to its force (`modal_states`) at the samples asked
+    for: the outputs need no second filtering of the force."""
+    rng = np.random.default_rng(2)
+    poles = np.array([-1.0 + 30j, -2.0 + 70j, -0.5 + 150j])
+    psi, G0, G1 = discretise(poles, 400.0)
+    rd, rv = 1e-3 * (rng.standard_normal(3) + 1j), 1e-2 * (rng.standard_normal(3) + 1j)
+    dF, vF = 1e-3 * rng.standard_normal(1001), 1e-2 * rng.standard_normal(1001)
+    law_ = LAWS["cubic"].variants()[0]
+    args = (psi, G0, G1, rd, rv, dF, vF, law_.codes, np.array([2e5, 30.0]), np.array([1.0, 1.0]))
+    for first, stride in ((0, 1), (5, 4), (999, 7), (1001, 2)):
+        g, states = joint_states(*args, first, stride)
+        expected = modal_states(g, poles, 400.0)[:, first::stride]
+        assert states.shape == expected.shape and np.allclose(states, expected, rtol=1e-9, atol=1e-15)
+    assert joint_states(*args, 0, 0)[1].shape == (3, 0)
 
 
 def test_the_linear_part_in_time_has_its_frf():
