@@ -13,10 +13,10 @@ from satmd.modal.rational import vector_fit, vector_fit_inputs
 from satmd.structure import Joint, LinearStructure, StructureModel, fit_structure
 from satmd.structure.kernel import _compiled, _pass, joint_force, joint_states
 from satmd.structure.laws import LAWS
-from satmd.structure.linear import discretise, driving_point, fit_linear, modal_states, response
+from satmd.structure.linear import discretise, driving_point, fit_linear, modal_states, response, sufficient_pairs
 from satmd.structure.model import Drive, nrmse
 from satmd.structure.spectra import periodic_spectra
-from tests.structure.chain import simulate_chain
+from tests.structure.chain import chain_matrices, simulate_chain
 
 CUBIC = 3e9  # N/m³ between masses 3 and 4
 
@@ -109,6 +109,26 @@ def test_the_linear_part_in_time_has_its_frf():
     H = lin.frf([f0])[0, 0]
     late = (t > 40) & (t < 55)  # the transient gone, the record's end (where the interpolation stops) not reached
     assert np.allclose(y[late], (H * np.exp(2j * np.pi * f0 * t[late])).real, atol=5e-4 * abs(H))
+
+
+def test_the_linear_part_keeps_the_modes_not_the_distortion():
+    """The chain's five modes (9-61 Hz, band 3-60 Hz) and no more, with the cubic joint's distortion at levels 1
+    and 3 on top of 1 % noise: more pairs would fit the distortion, each a path the joint's force then drives."""
+    names = tuple(f"acc{i}" for i in range(1, 6))
+    M, K, _ = chain_matrices(5)
+    modes = np.sort(np.sqrt(np.linalg.eigvals(np.linalg.solve(np.diag(M), K)).real)) / (2 * np.pi)
+    for rec in simulate_chain(joint=(2, 3), law=lambda d, v: CUBIC * d ** 3, levels=(1.0, 3.0), seed=1):
+        lin = fit_linear(periodic_spectra(rec), names, ("acc3", "acc4"))
+        assert np.allclose(np.sort(np.abs(lin.poles)) / (2 * np.pi), modes, rtol=0.01)
+
+
+def test_sufficient_pairs_is_the_last_count_that_takes_a_mode():
+    """Errors of nearby counts scatter (vector fits): a count must beat the best of the fewer ones by 30 %."""
+    assert sufficient_pairs([1.0, 0.9, 0.05, 0.045, 0.06, 0.035, 0.04]) == 2  # 0.035 is 0.78 of 0.045: no mode
+    assert sufficient_pairs([1.0, 0.9, 0.05, 0.045, 0.06, 0.02]) == 5       # 0.02 is 0.44 of it: a mode
+    assert sufficient_pairs([1.0, 0.95, 0.9]) == 0 and sufficient_pairs([0.5]) == 0
+    errors = [1.48, 1.39, 1.26, 1.10, 1.04, 0.94, 0.52, 0.51, 0.45, 0.52, 0.42, 0.41, 0.38, 0.54]  # the F-16's
+    assert sufficient_pairs(errors) == 6
 
 
 def test_the_model_with_the_true_structure_reproduces_the_chain():
