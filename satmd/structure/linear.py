@@ -137,7 +137,7 @@ def sufficient_pairs(errors) -> int:
     """Index of the pole-pair count that last takes more than `MODE_GAIN` off the best error of the fewer counts
     (``errors`` for counts in order). A mode left out takes most of the error with it when added; pairs beyond
     the modes fit the lowest level's noise and distortion a little each (and vector fits of nearby counts
-    scatter: the best error so far is what a count must beat). On 40 independent ground vibration tests
+    scatter: the best error so far is what a count must beat). On the 36 joints of 40 independent ground vibration tests
     (`benchmarks/structures_gvt.py`) this keeps the modes in the band and one for those above it, where the
     fewest pairs within 1.5 times the best error took up to 16 pairs for 3 modes: spurious poles beside a
     resonance, each a path the joint's force then drives (on a chain with a cubic joint, level 2 predicted at
