@@ -5,9 +5,7 @@ from dataclasses import replace
 
 import numpy as np
 
-from ..conventions import TINY
 from ..errors import DataError
-from ..numerics import jacobian_covariance
 from ..validation import NAMES, Interval, Options, Whole, validate_params
 from .laws import LAWS, SHAPE_GRID
 from .laws import law as law_named
@@ -16,6 +14,7 @@ from .locate import shape_of
 from .model import Drive, Joint, StructureModel, nrmse, warmup_of
 from .newtons import in_newtons, path_sign
 from .outside import above_band
+from .output_error import output_error
 from .spectra import periodic_spectra
 from .starts import measured_start, underlying_start
 from .startup import with_start_up_modes
@@ -36,7 +35,7 @@ SHRINK = (1.0, 0.5, 0.25, 0.1, 0.03, 0.01, 0.0)  # scales of the start's joint t
                   "driving_point": [None, str], "starts": [NAMES], "free_path": [bool]})
 def fit_structure(recordings, between=None, law: str | None = None, channels=None, n_pairs: int | None = None,
                   max_nfev: int = 40, files=None, driving_point: str | None = None, starts=STARTS,
-                  free_path: bool = False, location=None, progress=None) -> StructureModel:
+                  free_path: bool = True, location=None, progress=None) -> StructureModel:
     """The structure's linear part and its joint, fitted on every recording at once (SPEC §11).
 
     Parameters
@@ -46,16 +45,19 @@ def fit_structure(recordings, between=None, law: str | None = None, channels=Non
     law : the law's name; default: `locate_joint`'s law
     channels : the response channels (default every channel but the force)
     n_pairs : pole pairs of the linear part (default: chosen on the lowest level, `fit_linear`)
-    max_nfev : evaluations of the output-error fit (each simulates every recording)
+    max_nfev : evaluations of each output-error fit (each simulates every recording)
     files : names of the recordings for the fit table (default their ``source``)
     driving_point : the channel at the force's point (default: found, `linear.driving_point`); with one the
         joint's coefficients are in newtons (reciprocity fixes the scale of its path), without one relative
     starts : the linear parts the fit starts from, each fitted to the end and the best kept: ``"measured"``
         (the lowest level's best linear approximation) and ``"underlying"`` (the structure under the joint,
         from every level at once)
-    free_path : the output-error fit moves the joint's path κ too (default: the law's coefficients and shape
-        constants alone, the path as the frequency-domain start found it: on the F-16, freeing its 16-20 numbers
-        fitted the fitted levels closer and predicted the level left out worse, 0.32-0.47 against 0.28-0.40)
+    free_path : the fit's last stage moves the joint's path κ (its force's input to each mode) with the law's
+        coefficients (default): the frequency-domain start finds the path from the in-band change alone, and a
+        payload or a support that the joint alone moves is then off at every level (on independent ground
+        vibration tests, the place and law given, it cut the worst held-out NRMSE by more than 10 % on 16 of 26
+        joints and raised it on one; on the F-16 it changed level 5's by under 0.01). False: the law's
+        coefficients and shape constants alone (laws are weighed so, the chosen one is then freed)
     location : a `JointLocation` of these recordings already made (default: `locate_joint` runs when the place
         or the law is not given). With three or more levels and no law given, the named laws (and the ``sparse``
         library when the spectra name it) are each fitted on every level and the model that simulates them best
@@ -79,74 +81,99 @@ def fit_structure(recordings, between=None, law: str | None = None, channels=Non
         missing = [c for c in names if c not in s.responses]
         if missing:
             raise DataError(f"{s.source}: no channel {', '.join(missing)} (the other levels have it)")
-    shape, form = None, ()
+    files = list(files or [s.source for s in spectra])
+    fit = _Fit(recordings, spectra, names, n_pairs, max_nfev, starts, driving_point, say)
     if between is None or law is None:
         if location is None:
             say("locating the joint among every pair of sensors ...")
         loc = location or locate_joint(spectra, channels=names)
         if not loc.detected:
-            between = law = None
-        else:
-            if between is None or tuple(between) == loc.between:
-                shape, form = (loc.shape, loc.form) if law is None or law == loc.law else (None, ())
-            law_given = law is not None
-            between, law = tuple(between or loc.between), law or loc.law
-            if not law_given and len(recordings) >= 3 and tuple(between) == loc.between:
-                weighed = [e["law"] for e in loc.laws if e["law"] != "sparse"][:WEIGHED]
-                weighed = ["sparse", *weighed] if law == "sparse" else weighed
-                if len(weighed) > 1:
-                    say(f"{', '.join(weighed)}: each fitted on every level, the best kept ...")
-                    return best_fitting([fit_structure(recordings, between=between, law=w, channels=names,
-                                                       n_pairs=n_pairs, max_nfev=max_nfev, files=files,
-                                                       driving_point=driving_point, starts=starts,
-                                                       free_path=free_path, progress=progress) for w in weighed])
-    for c in (between or ()):
-        if c != "ground" and c not in names:
-            raise DataError(f"the joint's sensor {c!r} is not a channel ({', '.join(names)})")
-    ref = min(spectra, key=lambda s: s.level)
-    say(f"linear part from the lowest level ({ref.source}) ...")
-    linear = with_start_up_modes(fit_linear(ref, names, between, n_pairs), recordings, spectra, between)
-    levels = (min(s.level for s in spectra), max(s.level for s in spectra))
-    files = list(files or [s.source for s in spectra])
-    if between is None:
-        model = StructureModel(linear, None, levels)
-        return _with_table(model, recordings, files)
-    between = tuple(between)
-    assert law is not None  # set with the place
-    d0, v0 = ref.scales(*between)
-    lw, aux = (law_named(law).form(form), shape) if shape is not None else shape_of(spectra, between, law, names)
-    reference = linear
-    span = [_fit_span(r) for r in recordings]
-    measured = [np.array([np.asarray(r[ch], float)[:n] for ch in names]) for r, n in zip(recordings, span)]
-    lw, aux = _simulated_shape(reference, spectra, between, lw, d0, v0, aux, recordings, measured, span, levels)
-    fitted = []
-    for start in starts:  # the lowest level as the linear part, or the structure under the joint: the better kept
-        if start == "underlying":
-            say("the structure under the joint and the joint's path, from every level at once ...")
-            try:
-                linear, c, kappa = underlying_start(reference, spectra, between, lw, d0, v0, aux)
-            except np.linalg.LinAlgError:  # a vector fit that did not converge: as a start without a joint
-                linear, c, kappa = reference, np.full(len(lw.all_terms), np.nan), np.zeros(reference.poles.size)
-        else:
-            linear, (c, kappa) = reference, measured_start(reference, spectra, between, lw, d0, v0, aux)
-        if not (np.all(np.isfinite(c)) and np.all(np.isfinite(kappa)) and np.all(np.isfinite(linear.residues))):
-            say(f"the {start} start has no finite joint: left out")
-            continue
-        joint = Joint(between, law, c, aux, kappa, form=lw.term_names)
-        model, drives = _with_modes_above(StructureModel(linear, joint, levels, reference=reference), spectra,
-                                          recordings, measured, span)
-        say(f"output-error fit of the {law} joint between {between[0]} and {between[1]} on {len(recordings)} "
-            f"recordings (from the {start} linear part) ...")
-        model = _output_error(_stable(model, drives), drives, ref, max_nfev, fixed_path=not free_path)
-        fitted.append(model)
-    if not fitted:  # no start gave a joint to fit: the linear model of the lowest level, said by its table
-        return _with_table(StructureModel(reference, None, levels), recordings, files)
-    # judged on the whole records: a model that slowly gathers energy shows it only over many periods
-    whole = [(Drive(fitted[0], np.asarray(r["force"], float), float(r.fs_hz), warmup_of(r)),
-              np.array([np.asarray(r[ch], float) for ch in names])) for r in recordings]
-    model = min(fitted, key=lambda m: _cost(m, [(_redrive(d, m), y) for d, y in whole]))
-    model = in_newtons(model, driving_point)
-    return _with_table(model, recordings, files)
+            return fit.law(None, None, files)
+        law_given = law is not None
+        shape, form = None, ()
+        if between is None or tuple(between) == loc.between:
+            shape, form = (loc.shape, loc.form) if law is None or law == loc.law else (None, ())
+        between, law = tuple(between or loc.between), law or loc.law
+        if not law_given and len(recordings) >= 3 and tuple(between) == loc.between:
+            weighed = [e["law"] for e in loc.laws if e["law"] != "sparse"][:WEIGHED]
+            weighed = ["sparse", *weighed] if law == "sparse" else weighed
+            if len(weighed) > 1:
+                say(f"{', '.join(weighed)}: each fitted on every level, the best kept ...")
+                model = best_fitting([fit.law(between, w, files) for w in weighed])
+                return fit.finished(model, free_path, files)
+        model = fit.law(between, law, files, shape, form)
+    else:
+        model = fit.law(tuple(between), law, files)
+    return fit.finished(model, free_path, files)
+
+
+class _Fit:
+    """One `fit_structure` call's recordings and settings: a law fitted at a place (`law`), the chosen model
+    finished (`finished`)."""
+
+    def __init__(self, recordings, spectra, names, n_pairs, max_nfev, starts, driving_point, say):
+        self.recordings, self.spectra, self.names, self.driving_point = recordings, spectra, names, driving_point
+        self.n_pairs, self.max_nfev, self.starts, self.say = n_pairs, max_nfev, starts, say
+        self.ref = min(spectra, key=lambda s: s.level)
+        self.levels = (min(s.level for s in spectra), max(s.level for s in spectra))
+        self.span = [_fit_span(r) for r in recordings]
+        self.measured = [np.array([np.asarray(r[ch], float)[:n] for ch in names]) for r, n in zip(recordings, self.span)]
+
+    def law(self, between, law, files, shape=None, form=()) -> StructureModel:
+        """The linear part and (``between`` not None) the joint of ``law`` between ``between``, its path as the
+        frequency-domain start found it, with its fit table; the joint's coefficients relative."""
+        recordings, spectra, names, ref, say = self.recordings, self.spectra, self.names, self.ref, self.say
+        for c in (between or ()):
+            if c != "ground" and c not in names:
+                raise DataError(f"the joint's sensor {c!r} is not a channel ({', '.join(names)})")
+        say(f"linear part from the lowest level ({ref.source}) ...")
+        reference = with_start_up_modes(fit_linear(ref, names, between, self.n_pairs), recordings, spectra, between)
+        if between is None:
+            return _with_table(StructureModel(reference, None, self.levels), recordings, files)
+        d0, v0 = ref.scales(*between)
+        lw, aux = ((law_named(law).form(form), shape) if shape is not None
+                   else shape_of(spectra, between, law, names))
+        lw, aux = _simulated_shape(reference, spectra, between, lw, d0, v0, aux, recordings, self.measured,
+                                   self.span, self.levels)
+        fitted = []
+        for start in self.starts:  # the lowest level as the linear part, or the structure under the joint
+            if start == "underlying":
+                say("the structure under the joint and the joint's path, from every level at once ...")
+                try:
+                    linear, c, kappa = underlying_start(reference, spectra, between, lw, d0, v0, aux)
+                except np.linalg.LinAlgError:  # a vector fit that did not converge: as a start without a joint
+                    linear, c = reference, np.full(len(lw.all_terms), np.nan)
+                    kappa = np.zeros(reference.poles.size)
+            else:
+                linear, (c, kappa) = reference, measured_start(reference, spectra, between, lw, d0, v0, aux)
+            if not (np.all(np.isfinite(c)) and np.all(np.isfinite(kappa))
+                    and np.all(np.isfinite(linear.residues))):
+                say(f"the {start} start has no finite joint: left out")
+                continue
+            joint = Joint(between, law, c, aux, kappa, form=lw.term_names)
+            model, drives = _with_modes_above(StructureModel(linear, joint, self.levels, reference=reference),
+                                              spectra, recordings, self.measured, self.span)
+            say(f"output-error fit of the {law} joint between {between[0]} and {between[1]} on "
+                f"{len(recordings)} recordings (from the {start} linear part) ...")
+            fitted.append(output_error(_stable(model, drives), drives, ref, self.max_nfev, fixed_path=True))
+        if not fitted:  # no start gave a joint to fit: the linear model of the lowest level, said by its table
+            return _with_table(StructureModel(reference, None, self.levels), recordings, files)
+        # judged on the whole records: a model that slowly gathers energy shows it only over many periods
+        whole = [(Drive(fitted[0], np.asarray(r["force"], float), float(r.fs_hz), warmup_of(r)),
+                  np.array([np.asarray(r[ch], float) for ch in names])) for r in recordings]
+        model = min(fitted, key=lambda m: _cost(m, [(_redrive(d, m), y) for d, y in whole]))
+        return _with_table(replace(model, driving_point=self.driving_point), recordings, files)
+
+    def finished(self, model, free_path, files) -> StructureModel:
+        """``model`` with its path fitted too (``free_path``), in newtons where a driving point fixes the scale."""
+        if model.joint is None:
+            return model
+        if free_path:
+            a, b = model.joint.between
+            self.say(f"output-error fit of the {model.joint.law} joint between {a} and {b} with its path free ...")
+            model = output_error(model, _drives(model, self.recordings, self.measured, self.span), self.ref,
+                                  self.max_nfev, fixed_path=False)
+        return _with_table(in_newtons(model, self.driving_point), self.recordings, files)
 
 
 def _simulated_shape(linear, spectra, between, lw, d0, v0, aux, recordings, measured, span, levels):
@@ -274,84 +301,6 @@ def _stable(model, drives) -> StructureModel:
         if all(np.all(np.isfinite(d.outputs(trial.joint))) for d, _ in drives):
             return trial
     return model  # pragma: no cover - the scale 0 is the linear model
-
-
-def _output_error(model, drives, ref, max_nfev, fixed_path=False) -> StructureModel:
-    """Least squares of the simulated responses on every recording: the law's coefficients, its shape constants
-    (in log: a gap, a friction's smoothing) and, unless ``fixed_path``, the path κ (then the law's first
-    coefficient is held: it fixes the scale the path shares)."""
-
-    from scipy.optimize import least_squares
-
-    j = model.joint
-    n_c = j.coefficients.size
-    shaped = [i for i, t in enumerate(j.terms) if t in SHAPE_GRID]
-    step = max(1, int(ref.fs_hz / (8 * ref.freq_hz[-1])))  # the responses are band-limited well below Nyquist
-    scales = [m.std(axis=1, keepdims=True) for _, m in drives]
-
-    n_free = n_c if fixed_path else n_c - 1  # with the path free, the law's first term's size fixes the scale
-
-    def unpack(theta):
-        c = theta[:n_c] if fixed_path else np.concatenate([j.coefficients[:1], theta[:n_c - 1]])
-        aux = j.aux.copy()
-        aux[shaped] = np.exp(theta[n_free:n_free + len(shaped)])
-        if fixed_path:
-            return replace(j, coefficients=c, aux=aux)
-        k = theta[n_free + len(shaped):]
-        return replace(j, coefficients=c, aux=aux, coupling=k[0::2] + 1j * k[1::2])
-
-    def residual(theta):
-        trial = unpack(theta)
-        out = []
-        for (drive, measured), sd in zip(drives, scales):
-            e = (drive.outputs(trial, step) - measured[:, ::step]) / sd
-            e = np.clip(np.nan_to_num(e, nan=1e3), -1e3, 1e3)  # a run-away: large, finite, smooth enough to step
-            out.append(e.ravel() / np.sqrt(e.size))
-        return np.concatenate(out)
-
-    k0 = np.zeros(0) if fixed_path else np.column_stack([j.coupling.real, j.coupling.imag]).ravel()
-    log_aux = np.log(j.aux[shaped])
-    theta0 = np.concatenate([j.coefficients if fixed_path else j.coefficients[1:], log_aux, k0])
-    scale = np.maximum(np.abs(theta0), 1e-3 * (np.abs(theta0).max() or 1.0))
-    scale[scale == 0] = 1.0
-    scale[n_free:n_free + len(shaped)] = 1.0  # a log: steps of order one
-    sol = least_squares(residual, theta0, x_scale=scale, diff_step=1e-4, max_nfev=max_nfev)
-    start = residual(theta0)
-    if sol.cost > 0.5 * float(start @ start):  # never worse than where it started
-        return replace(model, joint=unpack(theta0))
-    joint = unpack(sol.x)
-    half = _half_widths(sol.jac, sol.fun, [len(np.ravel(m[:, ::step])) for _, m in drives])
-    if half is None:
-        return replace(model, joint=joint)
-    names = list(joint.parameters())
-    ci = {}
-    for i, c in enumerate(joint.coefficients):  # (with the path free, the first is held: no interval)
-        if fixed_path or i > 0:
-            h = float(half[i if fixed_path else i - 1])
-            ci[names[i]] = [float(c) - h, float(c) + h]
-    for k, i in enumerate(shaped):  # a shape constant was fitted in log: its interval is a factor either side
-        h = float(half[n_free + k])
-        ci[names[n_c + k]] = [float(joint.aux[i] * np.exp(-h)), float(joint.aux[i] * np.exp(h))]
-    return replace(model, joint=replace(joint, ci95=ci))
-
-
-def _half_widths(jac, residuals, sizes):
-    """95 % half-widths of the fitted parameters: (JᵀJ)⁻¹ scaled by the residuals' variance, inflated by
-    (1 + ρ)/(1 − ρ) for their lag-one correlation ρ in time (a simulation's misfit is smooth, not white: without it
-    the intervals would count every sample as news). None when JᵀJ is singular (`numerics.jacobian_covariance`)."""
-    jac = np.asarray(jac, float)
-    n, p = jac.shape
-    if n <= p:
-        return None
-    edges = np.cumsum([0, *sizes])
-    pairs = [(residuals[a:b - 1], residuals[a + 1:b]) for a, b in zip(edges[:-1], edges[1:]) if b - a > 2]
-    rho = float(sum(x @ y for x, y in pairs) / max(sum(x @ x for x, _ in pairs), TINY)) if pairs else 0.0
-    rho = min(max(rho, 0.0), 0.999)
-    cov = jacobian_covariance(jac, float(residuals @ residuals) / (n - p) * (1 + rho) / (1 - rho))
-    var = np.diag(cov)
-    if not np.all(np.isfinite(var)):
-        return None
-    return np.where(var >= 0, 1.96 * np.sqrt(np.abs(var)), np.nan)
 
 
 def _with_table(model, recordings, files, drives=None) -> StructureModel:

@@ -378,16 +378,21 @@ class Drive:
         keep = slice(self.skip, None, step)
         if joint is None:
             return self.base[:, keep]
+        g, z = self.driven(joint, step)
+        if not np.all(np.isfinite(g)):
+            return np.full_like(self.linear[:, keep], np.nan)
+        column = self.model.linear.residues * joint.coupling[None, :]
+        return self.linear[:, keep] + response(z, column)
+
+    def driven(self, joint: Joint, step: int = 1):
+        """(g, w) at the kept samples: the joint's force (NaN from where it ran away) and each mode's state it
+        drives with its direct part, ``w_r = z_r + g / λ_r``: a force at the joint's sensors moves them at once,
+        the column's flat part (receptance ~ 1/s²). The joint's share of the outputs is ``Re Σ 2 A_r κ_r w_r``."""
         lin = self.model.linear
-        k = joint.coupling
-        pair = self.pair * k
+        pair = self.pair * joint.coupling
         first, stride = self.r * self.skip, self.r * step  # the record's kept samples on the joint's finer steps
         g, z = joint_states(self.psi, self.G0, self.G1, 2 * pair / lin.poles ** 2, 2 * pair / lin.poles, self.dF,
                             self.vF, joint.law_form.codes, np.asarray(joint.coefficients, float),
                             np.asarray(joint.aux, float), first, stride)
-        if not np.all(np.isfinite(g)):
-            return np.full_like(self.linear[:, keep], np.nan)
-        column = lin.residues * k[None, :]
-        # a force at the joint's sensors moves them at once: the column's flat part Σ 2 Re(A/λ) (receptance ~ 1/s²)
-        direct = response(1.0 / lin.poles[:, None], column)[:, 0]
-        return self.linear[:, keep] + response(z, column) + direct[:, None] * g[first::stride]
+        g = g[first::stride]
+        return g, z + g[None, :] / lin.poles[:, None]

@@ -77,11 +77,13 @@ def in_newtons(model, driving_point=None):
     values = j.parameters()
     rel = float(misfit) / np.sqrt(float(max(int(np.count_nonzero(w > 0.05 * w.max())), 1)))
     ci = {}
-    for n, (lo, hi) in j.ci95.items():
+    for n, v in values.items() if j.ci95 else ():
+        lo, hi = j.ci95.get(n, (v, v))  # none for a coefficient held to fix the path's scale: the scale's alone
         if n in shapes:
-            ci[n] = [lo, hi]
+            if n in j.ci95:
+                ci[n] = [lo, hi]
             continue
-        h = abs(s) * float(np.hypot(0.5 * (hi - lo), 1.96 * rel * abs(values[n])))
-        ci[n] = [values[n] * s - h, values[n] * s + h]
+        h = abs(s) * float(np.hypot(0.5 * (hi - lo), 1.96 * rel * abs(v)))
+        ci[n] = [v * s - h, v * s + h]
     return replace(model, joint=replace(j, coefficients=j.coefficients * s, coupling=j.coupling / s, units="N",
                                         ci95=ci), driving_point=d)
