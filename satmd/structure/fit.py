@@ -171,8 +171,12 @@ class _Fit:
         if free_path:
             a, b = model.joint.between
             self.say(f"output-error fit of the {model.joint.law} joint between {a} and {b} with its path free ...")
-            model = output_error(model, _drives(model, self.recordings, self.measured, self.span), self.ref,
-                                  self.max_nfev, fixed_path=False)
+            freed = output_error(model, _drives(model, self.recordings, self.measured, self.span), self.ref,
+                                 self.max_nfev, fixed_path=False)
+            # fitted on the first periods, kept where the whole records say so too (as the starts are judged)
+            whole = [(Drive(model, np.asarray(r["force"], float), float(r.fs_hz), warmup_of(r)),
+                      np.array([np.asarray(r[ch], float) for ch in self.names])) for r in self.recordings]
+            model = freed if _cost(freed, whole) <= _cost(model, whole) else model
         return _with_table(in_newtons(model, self.driving_point), self.recordings, files)
 
 
