@@ -11,10 +11,15 @@ levels √2 apart. Written to plain CSV files and run through the command line a
 Scored as the issue asks: the joint between the right two sensors (or sensor and ground), its law, the
 held-out levels' worst-channel NRMSE within 3× the noise floor (the accelerometers' noise, as an NRMSE) and
 below a quarter of the level-1 linear model's (judged at the held-out levels where a quarter of the linear
-model's miss is above 3× the noise); nulls with no joint.
+model's miss is above 3× the noise); nulls with no joint. Each test also says whether its held-out levels can
+be predicted that well at all (``truth_1pct``): the simulator run again with the joint's first parameter 1 %
+off, the worst channel's NRMSE between the two runs at each held-out level. Where that alone is beyond 3× the
+noise, the response hangs on the joint more finely than any identification from noisy records fixes it (a
+saturating joint near a jump, a contact at an internal resonance), and the summary counts those tests apart.
 
     python benchmarks/structures_gvt.py [--count 120] [--seed0 0] [--out PATH]
     python benchmarks/structures_gvt.py --merge part1.json part2.json [--out PATH]
+    python benchmarks/structures_gvt.py --add-truth-sensitivity PATH   (to a result written before the field)
 
 The issue's protocol is 100 structures with a joint (``--count 120``: a null every sixth), about 4 h on one
 core; parts (``--seed0``, ``--count``) run apart and merge.
@@ -24,6 +29,7 @@ Writes benchmarks/results/structures_gvt.json and prints one line of figures.
 from __future__ import annotations
 
 import argparse
+import copy
 import json
 import os
 import subprocess
@@ -40,6 +46,7 @@ import _indep_gvt as sim  # noqa: E402
 from _machine import describe, load_after, machine  # noqa: E402
 
 FITTED, HELD = (1, 3, 5, 7), (2, 4, 6)
+SENSITIVITY = 0.01  # the truth's joint parameter moved by this share to see how finely the response hangs on it
 OUT = ROOT / "benchmarks" / "results" / "structures_gvt.json"
 
 
@@ -62,7 +69,8 @@ def case(structure: str, law: str | None, seed: int) -> dict:
     t0 = time.perf_counter()
     recs = sim.simulate(test)
     row = {**test.describe(), "simulate_s": round(time.perf_counter() - t0, 1),
-           "outside_band": {str(lv): outside_band(recs[lv - 1], test.sensors) for lv in HELD}}
+           "outside_band": {str(lv): outside_band(recs[lv - 1], test.sensors) for lv in HELD},
+           "truth_1pct": truth_sensitivity(test, recs)}
     with tempfile.TemporaryDirectory() as tmp:
         for lv, rec in enumerate(recs, 1):
             sim.write_csv(rec, Path(tmp) / f"L{lv}.csv")
@@ -86,6 +94,35 @@ def case(structure: str, law: str | None, seed: int) -> dict:
                                 **by_period(Path(tmp) / "model.json", Path(tmp) / f"L{lv}.csv")}
                                for lv, r in zip(HELD, pred["recordings"])]
     return _score(row)
+
+
+def truth_sensitivity(test, recs=None) -> dict | None:
+    """Per held-out level, the worst channel's NRMSE of the simulator's own response with the joint's first
+    parameter `SENSITIVITY` off (the same force and noise): what a model 1 % off in its joint's strength would
+    miss at best. None for a null."""
+    if test.law is None:
+        return None
+    recs = recs if recs is not None else sim.simulate(test)
+    moved = copy.deepcopy(test)
+    first = next(iter(moved.par))
+    moved.par[first] *= 1 + SENSITIVITY
+    other = sim.simulate(moved)
+    return {str(lv): round(max(float(np.std(recs[lv - 1][c] - other[lv - 1][c]) / np.std(recs[lv - 1][c]))
+                               for c in test.sensors), 4) for lv in HELD}
+
+
+def add_truth_sensitivity(path: Path) -> dict:
+    """``truth_1pct`` for every row of a result written before the field, and its summary again."""
+    result = json.loads(path.read_text())
+    for row in result["rows"]:
+        if "truth_1pct" not in row:
+            row["truth_1pct"] = truth_sensitivity(sim.make_test(row["seed"], row["structure"], row["law"]))
+            print(f"{row['structure']} {row['law']} seed {row['seed']}: {row['truth_1pct']}", file=sys.stderr,
+                  flush=True)
+        _score(row)
+    result["summary"] = summarise(result["rows"])
+    path.write_text(json.dumps(result, indent=1))
+    return result
 
 
 def by_period(model_path: Path, csv: Path) -> dict:
@@ -135,6 +172,9 @@ def _score(row: dict) -> dict:
     if held:
         worst = [max(_finite(h["nrmse"])) for h in held]
         row["right"]["within_3x_noise"] = all(w <= 3 * floor for w in worst)
+        moved = row.get("truth_1pct")
+        if moved:  # the truth itself, 1 % off, within 3x the noise at every held-out level
+            row["right"]["predictable"] = all(moved[str(h["level"])] <= 3 * floor for h in held)
         # a quarter of the linear model's miss, where that is above the 3x-noise allowance (below it, the noise)
         judged = [h for h in held if 0.25 * max(_finite(h["linear_nrmse"])) > 3 * floor]
         if judged and row["law"] is not None:
@@ -174,6 +214,9 @@ def summarise(rows: list) -> dict:
     out = {"structures": len(rows), "joints": len(joints), "nulls": len(nulls),
            "placed": share(joints, "placed"), "named": share(joints, "named"),
            "within_3x_noise": share(rows, "within_3x_noise"),
+           "within_3x_noise_where_predictable": share([r for r in rows if r.get("right", {}).get("predictable", True)
+                                                       and "truth_1pct" in r], "within_3x_noise"),
+           "unpredictable": sum(r.get("right", {}).get("predictable") is False for r in rows),
            "below_quarter_linear": share(joints, "below_quarter_linear"), "null_clean": share(nulls, "null"),
            "errors": sum("error" in r or "predict_error" in r for r in rows), "by": {},
            "misses_outside_band": sum(_outside_band_miss(r) for r in rows if not r.get("right", {}).get("within_3x_noise", True)),
@@ -192,8 +235,11 @@ def line(result: dict) -> str:
     def f(k):
         return f"{s[k]['right']}/{s[k]['n']}"
 
+    where = s.get("within_3x_noise_where_predictable") or {}
     return (f"structures_gvt: {s['structures']} tests ({s['nulls']} nulls): placed {f('placed')}, law {f('named')}, "
-            f"held-out levels within 3x noise {f('within_3x_noise')}, below a quarter of linear "
+            f"held-out levels within 3x noise {f('within_3x_noise')}"
+            + (f" ({where['right']}/{where['n']} where the truth 1 % off is)" if where.get("n") else "")
+            + ", below a quarter of linear "
             f"{f('below_quarter_linear')}, nulls clean {f('null_clean')}, errors {s['errors']}")
 
 
@@ -214,7 +260,11 @@ def main(argv=None) -> int:
     ap.add_argument("--seed0", type=int, default=0)
     ap.add_argument("--out", type=Path, default=OUT)
     ap.add_argument("--merge", nargs="+", default=None)
+    ap.add_argument("--add-truth-sensitivity", type=Path, default=None, metavar="PATH")
     args = ap.parse_args(argv)
+    if args.add_truth_sensitivity:
+        print(line(add_truth_sensitivity(args.add_truth_sensitivity)))
+        return 0
     if args.merge:
         print(line(merge(args.merge, args.out)))
         return 0
@@ -266,8 +316,14 @@ def readme_markdown(result: dict) -> str:
               + (f"models that ran away at a held-out level {s['ran_away']}; " if s.get("ran_away") else "") +
               f"`discover` median "
               f"{secs[len(secs) // 2] if secs else float('nan'):.0f} s (longest {secs[-1] if secs else float('nan'):.0f} s) "
-              f"on one core. The issue's targets: placed ≥ 95 %, law ≥ 90 %, within 3× noise ≥ 90 % over ≥ 100 "
-              f"structures, nulls ≥ 99 %."]
+              f"on one core. "
+              + (f"The simulator itself, run again with the joint's first parameter 1 % off, misses a held-out level "
+                 f"by more than 3× the noise in {s['unpredictable']} tests (`truth_1pct`: no identification from noisy "
+                 f"records pins a joint that finely); within 3× noise on the others "
+                 f"{f(s['within_3x_noise_where_predictable'])}. "
+                 if (s.get("within_3x_noise_where_predictable") or {}).get("n") else "") +
+              "The issue's targets: placed ≥ 95 %, law ≥ 90 %, within 3× noise ≥ 90 % over ≥ 100 "
+              "structures, nulls ≥ 99 %."]
     return "\n".join(lines)
 
 
