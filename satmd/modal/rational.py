@@ -85,14 +85,24 @@ def vector_fit(freq_hz, frf, weight=None, n_pairs: int = 10, iterations: int = 1
             rhs.append(R[n_own:-1, -1])
         sigma = np.linalg.lstsq(np.vstack(rows), np.concatenate(rhs), rcond=None)[0]
         poles = _relocate(poles, sigma)
-    P = np.hstack([_columns(s, poles), np.ones((s.size, 1))])
+    return (poles, *residues_at(f, H, W, poles))
+
+
+def residues_at(freq_hz, frf, weight, poles):
+    """(residues (C, K) complex, feedthrough (C,) float) of ``frf`` (C, M) on fixed ``poles``: weighted linear
+    least squares per channel (`vector_fit`'s last step)."""
+    f = np.asarray(freq_hz, float)
+    H = np.atleast_2d(np.asarray(frf, complex))
+    W = np.broadcast_to(weight, H.shape)
+    s = 2j * np.pi * f
+    P = np.hstack([_columns(s, np.asarray(poles, complex)), np.ones((s.size, 1))])
     residues, feed = [], []
     for h, w in zip(H, W):
         A, b = _stack(P * w[:, None], h * w)
         c = np.linalg.lstsq(A, b, rcond=None)[0]
         residues.append(c[0:-1:2] + 1j * c[1:-1:2])
         feed.append(float(c[-1]))
-    return poles, np.array(residues), np.array(feed)
+    return np.array(residues), np.array(feed)
 
 
 def vector_fit_inputs(blocks, n_pairs: int, iterations: int = 12, poles=None):
