@@ -12,10 +12,12 @@ Scored as the issue asks: the joint between the right two sensors (or sensor and
 held-out levels' worst-channel NRMSE within 3× the noise floor (the accelerometers' noise, as an NRMSE) and
 below a quarter of the level-1 linear model's (judged at the held-out levels where a quarter of the linear
 model's miss is above 3× the noise); nulls with no joint. Each test also says whether its held-out levels can
-be predicted that well at all (``truth_1pct``): the simulator run again with the joint's first parameter 1 %
+be predicted that well at all (``truth_moved``): the simulator run again with the joint's first parameter 0.1 %
 off, the worst channel's NRMSE between the two runs at each held-out level. Where that alone is beyond 3× the
-noise, the response hangs on the joint more finely than any identification from noisy records fixes it (a
-saturating joint near a jump, a contact at an internal resonance), and the summary counts those tests apart.
+noise, the response hangs on the joint more finely than noisy records pin it (a saturating joint that jumps
+between responses at the top levels: at 1 % off, chain softening 4 moved 0.78 at level 6, frame softening 29
+0.62, while beam softening 6, 0.07 at 1 % and 0.007 at 0.1 %, was predicted at 0.05), and the summary counts
+those tests apart.
 
     python benchmarks/structures_gvt.py [--count 120] [--seed0 0] [--out PATH]
     python benchmarks/structures_gvt.py --merge part1.json part2.json [--out PATH]
@@ -46,7 +48,7 @@ import _indep_gvt as sim  # noqa: E402
 from _machine import describe, load_after, machine  # noqa: E402
 
 FITTED, HELD = (1, 3, 5, 7), (2, 4, 6)
-SENSITIVITY = 0.01  # the truth's joint parameter moved by this share to see how finely the response hangs on it
+SENSITIVITY = 1e-3  # the truth's joint parameter moved by this share to see how finely the response hangs on it
 OUT = ROOT / "benchmarks" / "results" / "structures_gvt.json"
 
 
@@ -70,7 +72,7 @@ def case(structure: str, law: str | None, seed: int) -> dict:
     recs = sim.simulate(test)
     row = {**test.describe(), "simulate_s": round(time.perf_counter() - t0, 1),
            "outside_band": {str(lv): outside_band(recs[lv - 1], test.sensors) for lv in HELD},
-           "truth_1pct": truth_sensitivity(test, recs)}
+           "truth_moved": truth_sensitivity(test, recs)}
     with tempfile.TemporaryDirectory() as tmp:
         for lv, rec in enumerate(recs, 1):
             sim.write_csv(rec, Path(tmp) / f"L{lv}.csv")
@@ -98,7 +100,7 @@ def case(structure: str, law: str | None, seed: int) -> dict:
 
 def truth_sensitivity(test, recs=None) -> dict | None:
     """Per held-out level, the worst channel's NRMSE of the simulator's own response with the joint's first
-    parameter `SENSITIVITY` off (the same force and noise): what a model 1 % off in its joint's strength would
+    parameter `SENSITIVITY` off (the same force and noise): what a model 0.1 % off in its joint's strength would
     miss at best. None for a null."""
     if test.law is None:
         return None
@@ -112,12 +114,12 @@ def truth_sensitivity(test, recs=None) -> dict | None:
 
 
 def add_truth_sensitivity(path: Path) -> dict:
-    """``truth_1pct`` for every row of a result written before the field, and its summary again."""
+    """``truth_moved`` for every row of a result written before the field, and its summary again."""
     result = json.loads(path.read_text())
     for row in result["rows"]:
-        if "truth_1pct" not in row:
-            row["truth_1pct"] = truth_sensitivity(sim.make_test(row["seed"], row["structure"], row["law"]))
-            print(f"{row['structure']} {row['law']} seed {row['seed']}: {row['truth_1pct']}", file=sys.stderr,
+        if "truth_moved" not in row:
+            row["truth_moved"] = truth_sensitivity(sim.make_test(row["seed"], row["structure"], row["law"]))
+            print(f"{row['structure']} {row['law']} seed {row['seed']}: {row['truth_moved']}", file=sys.stderr,
                   flush=True)
         _score(row)
     result["summary"] = summarise(result["rows"])
@@ -172,8 +174,8 @@ def _score(row: dict) -> dict:
     if held:
         worst = [max(_finite(h["nrmse"])) for h in held]
         row["right"]["within_3x_noise"] = all(w <= 3 * floor for w in worst)
-        moved = row.get("truth_1pct")
-        if moved:  # the truth itself, 1 % off, within 3x the noise at every held-out level
+        moved = row.get("truth_moved")
+        if moved:  # the truth itself, 0.1 % off, within 3x the noise at every held-out level
             row["right"]["predictable"] = all(moved[str(h["level"])] <= 3 * floor for h in held)
         # a quarter of the linear model's miss, where that is above the 3x-noise allowance (below it, the noise)
         judged = [h for h in held if 0.25 * max(_finite(h["linear_nrmse"])) > 3 * floor]
@@ -215,7 +217,7 @@ def summarise(rows: list) -> dict:
            "placed": share(joints, "placed"), "named": share(joints, "named"),
            "within_3x_noise": share(rows, "within_3x_noise"),
            "within_3x_noise_where_predictable": share([r for r in rows if r.get("right", {}).get("predictable", True)
-                                                       and "truth_1pct" in r], "within_3x_noise"),
+                                                       and "truth_moved" in r], "within_3x_noise"),
            "unpredictable": sum(r.get("right", {}).get("predictable") is False for r in rows),
            "below_quarter_linear": share(joints, "below_quarter_linear"), "null_clean": share(nulls, "null"),
            "errors": sum("error" in r or "predict_error" in r for r in rows), "by": {},
@@ -238,7 +240,7 @@ def line(result: dict) -> str:
     where = s.get("within_3x_noise_where_predictable") or {}
     return (f"structures_gvt: {s['structures']} tests ({s['nulls']} nulls): placed {f('placed')}, law {f('named')}, "
             f"held-out levels within 3x noise {f('within_3x_noise')}"
-            + (f" ({where['right']}/{where['n']} where the truth 1 % off is)" if where.get("n") else "")
+            + (f" ({where['right']}/{where['n']} where the truth 0.1 % off is)" if where.get("n") else "")
             + ", below a quarter of linear "
             f"{f('below_quarter_linear')}, nulls clean {f('null_clean')}, errors {s['errors']}")
 
@@ -317,9 +319,9 @@ def readme_markdown(result: dict) -> str:
               f"`discover` median "
               f"{secs[len(secs) // 2] if secs else float('nan'):.0f} s (longest {secs[-1] if secs else float('nan'):.0f} s) "
               f"on one core. "
-              + (f"The simulator itself, run again with the joint's first parameter 1 % off, misses a held-out level "
-                 f"by more than 3× the noise in {s['unpredictable']} tests (`truth_1pct`: no identification from noisy "
-                 f"records pins a joint that finely); within 3× noise on the others "
+              + (f"The simulator itself, run again with the joint's first parameter 0.1 % off, misses a held-out level "
+                 f"by more than 3× the noise in {s['unpredictable']} tests (`truth_moved`: the response jumps with the "
+                 f"joint's strength, more finely than noisy records pin it); within 3× noise on the others "
                  f"{f(s['within_3x_noise_where_predictable'])}. "
                  if (s.get("within_3x_noise_where_predictable") or {}).get("n") else "") +
               "The issue's targets: placed ≥ 95 %, law ≥ 90 %, within 3× noise ≥ 90 % over ≥ 100 "
