@@ -15,7 +15,7 @@ from .model import Drive, Joint, StructureModel, nrmse, warmup_of
 from .newtons import in_newtons, path_sign
 from .outside import above_band
 from .output_error import output_error
-from .spectra import periodic_spectra
+from .spectra import drive_force, periodic_spectra
 from .starts import measured_start, underlying_start
 from .startup import with_start_up_modes
 
@@ -159,7 +159,7 @@ class _Fit:
         if not fitted:  # no start gave a joint to fit: the linear model of the lowest level, said by its table
             return _with_table(StructureModel(reference, None, self.levels), recordings, files)
         # judged on the whole records: a model that slowly gathers energy shows it only over many periods
-        whole = [(Drive(fitted[0], np.asarray(r["force"], float), float(r.fs_hz), warmup_of(r)),
+        whole = [(Drive(fitted[0], drive_force(r), float(r.fs_hz), warmup_of(r)),
                   np.array([np.asarray(r[ch], float) for ch in names])) for r in recordings]
         model = min(fitted, key=lambda m: _cost(m, [(_redrive(d, m), y) for d, y in whole]))
         return _with_table(replace(model, driving_point=self.driving_point), recordings, files)
@@ -174,7 +174,7 @@ class _Fit:
             freed = output_error(model, _drives(model, self.recordings, self.measured, self.span), self.ref,
                                  self.max_nfev, fixed_path=False)
             # fitted on the first periods, kept where the whole records say so too (as the starts are judged)
-            whole = [(Drive(model, np.asarray(r["force"], float), float(r.fs_hz), warmup_of(r)),
+            whole = [(Drive(model, drive_force(r), float(r.fs_hz), warmup_of(r)),
                       np.array([np.asarray(r[ch], float) for ch in self.names])) for r in self.recordings]
             model = freed if _cost(freed, whole) <= _cost(model, whole) else model
         return _with_table(in_newtons(model, self.driving_point), self.recordings, files)
@@ -278,7 +278,7 @@ def oversampling(linear, fs_hz: float) -> int:
 
 def _drives(model, recordings, measured, span) -> list:
     """(Drive, measured responses) of each recording's first ``span`` samples through ``model``."""
-    return [(Drive(model, np.asarray(r["force"], float)[:n], float(r.fs_hz), warmup_of(r)), m)
+    return [(Drive(model, drive_force(r)[:n], float(r.fs_hz), warmup_of(r)), m)
             for r, m, n in zip(recordings, measured, span)]
 
 
@@ -312,7 +312,7 @@ def _with_table(model, recordings, files, drives=None) -> StructureModel:
     lin, nl = [], []
     for i, r in enumerate(recordings):
         if drives is None:
-            drive = Drive(model, np.asarray(r["force"], float), float(r.fs_hz), warmup_of(r))
+            drive = Drive(model, drive_force(r), float(r.fs_hz), warmup_of(r))
             measured = np.array([np.asarray(r[c], float) for c in model.channels])
         else:
             drive, measured = drives[i]

@@ -37,6 +37,7 @@ from .bands import above_band_shares, band_top
 from .kernel import joint_states
 from .laws import law as law_named
 from .linear import LinearStructure, discretise, modal_states, response
+from .spectra import drive_force
 
 SCHEMA = "satmd-structure-model/1"
 PREDICTION_SCHEMA = "satmd-prediction/1"
@@ -219,7 +220,7 @@ class StructureModel:
         if not (np.all(np.isfinite(force)) and np.all(np.isfinite(measured))):
             raise DataError(f"{name}: NaN or inf in the force or a response")
         warm = warmup_of(recording)
-        drive = Drive(self, force, float(recording.fs_hz), warm)
+        drive = Drive(self, drive_force(recording), float(recording.fs_hz), warm)
         lin = drive.outputs(None)
         nl = drive.outputs(self.joint) if self.joint is not None else lin
         level = force_level(force)

@@ -134,3 +134,37 @@ def periodic_spectra(recording) -> PeriodicSpectra:
         raise DataError(f"{source}: no response channel beside the force")
     return PeriodicSpectra(source, force_level(rec["force"]), float(rec.fs_hz), int(n), lines, force, responses, std,
                            whole)
+
+
+SIGNIFICANT = 3.0   # standard errors of a line's mean over the steady periods beyond which the line is the force's
+MIN_STEADY = 3      # steady periods needed to tell a line's mean from its noise
+
+
+def drive_force(recording) -> np.ndarray:
+    """The force a model of the structure is driven by: as measured, except over the steady periods of a periodic
+    force, where it is the mean period at the lines whose mean stands above its noise (`SIGNIFICANT` standard
+    errors), nothing at the others. A simulation driven by the measured force answers the load cell's noise too,
+    most where the structure is most mobile: above the band, at the driving point (on an independent frame the
+    driving point's held-out NRMSE over the steady periods went from 0.037 to 0.014, its noise 0.010). Lines
+    the shaker puts there by itself (harmonics of a structure's nonlinear feedback) stand above the noise and
+    stay. The periods before the steady ones are kept as measured: a start from rest carries what a period cannot.
+    """
+    force = np.asarray(recording["force"], float)
+    try:
+        exc = excitation_of(received(recording))
+    except DataError:
+        return force
+    steady = list(exc.steady)
+    if exc.kind != "periodic" or len(steady) < MIN_STEADY:
+        return force
+    n = int(exc.period_samples)
+    X = np.fft.rfft(force[: exc.periods * n].reshape(exc.periods, n)[steady], axis=1)
+    mean = X.mean(axis=0)
+    standard_error = np.sqrt(np.mean(np.abs(X - mean) ** 2, axis=0) * len(steady) / (len(steady) - 1) / len(steady))
+    keep = np.abs(mean) > SIGNIFICANT * standard_error
+    keep[0] = True  # the load cell's offset as it was
+    period = np.fft.irfft(np.where(keep, mean, 0.0), n)
+    out = force.copy()
+    for p in steady:
+        out[p * n:(p + 1) * n] = period
+    return out
