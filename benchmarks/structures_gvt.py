@@ -245,12 +245,14 @@ def line(result: dict) -> str:
             f"{f('below_quarter_linear')}, nulls clean {f('null_clean')}, errors {s['errors']}")
 
 
-def merge(paths, out: Path) -> dict:
+def merge(paths, out: Path, summary_of=None) -> dict:
+    """Parts of one run (``--seed0``, ``--count``) in one result, summarised again (``summary_of``, default
+    `summarise`)."""
     parts = [json.loads(Path(p).read_text()) for p in paths]
     rows = [r for p in parts for r in p["rows"]]
     result = {"machine": parts[-1]["machine"], "runs": [{"file": str(p), "machine": q["machine"]}
                                                         for p, q in zip(paths, parts)],
-              "rows": rows, "summary": summarise(rows),
+              "rows": rows, "summary": (summary_of or summarise)(rows),
               "benchmark_seconds": sum(q.get("benchmark_seconds", 0.0) for q in parts)}
     out.write_text(json.dumps(result, indent=1))
     return result
@@ -270,20 +272,28 @@ def main(argv=None) -> int:
     if args.merge:
         print(line(merge(args.merge, args.out)))
         return 0
-    t0 = time.perf_counter()
-    result = {"machine": machine(threads=1), "fitted_levels": list(FITTED), "held_levels": list(HELD), "rows": []}
-    for i, (structure, law, seed) in enumerate(plan(args.count, args.seed0)):
-        row = case(structure, law, seed)
-        result["rows"].append(row)
-        print(f"[{i + 1}/{args.count}] {structure} {law} seed {seed}: {row.get('found_between')} "
-              f"{row.get('found_law')} {row.get('right')} ({row.get('discover_s')} s)", file=sys.stderr, flush=True)
-        result["summary"] = summarise(result["rows"])
-        args.out.write_text(json.dumps(result, indent=1))
-    result["benchmark_seconds"] = time.perf_counter() - t0
-    result["machine"].update(load_after())
-    args.out.write_text(json.dumps(result, indent=1))
+    result = run_plan(case, summarise, args.count, args.seed0, args.out,
+                      {"fitted_levels": list(FITTED), "held_levels": list(HELD)},
+                      lambda r: f"{r.get('found_between')} {r.get('found_law')} {r.get('right')} ({r.get('discover_s')} s)")
     print(line(result) + " | " + describe(result["machine"]))
     return 0
+
+
+def run_plan(case_of, summary_of, count: int, seed0: int, out: Path, extra: dict, tell) -> dict:
+    """``case_of(structure, law, seed)`` over `plan`, the result (its rows and ``summary_of(rows)``) written to
+    ``out`` after every test (a long run interrupted keeps what it measured); ``tell(row)`` on stderr."""
+    t0 = time.perf_counter()
+    result = {"machine": machine(threads=1), **extra, "rows": []}
+    for i, (structure, law, seed) in enumerate(plan(count, seed0)):
+        row = case_of(structure, law, seed)
+        result["rows"].append(row)
+        print(f"[{i + 1}/{count}] {structure} {law} seed {seed}: {tell(row)}", file=sys.stderr, flush=True)
+        result["summary"] = summary_of(result["rows"])
+        out.write_text(json.dumps(result, indent=1))
+    result["benchmark_seconds"] = time.perf_counter() - t0
+    result["machine"].update(load_after())
+    out.write_text(json.dumps(result, indent=1))
+    return result
 
 
 def readme_markdown(result: dict) -> str:

@@ -19,7 +19,6 @@ Writes benchmarks/results/structures_gvt_locate.json and prints one line of figu
 from __future__ import annotations
 
 import argparse
-import json
 import sys
 import tempfile
 import time
@@ -32,8 +31,8 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 sys.path.insert(0, str(ROOT / "benchmarks"))
 import _indep_gvt as sim  # noqa: E402
-from _machine import describe, load_after, machine  # noqa: E402
-from structures_gvt import plan  # noqa: E402
+from _machine import describe  # noqa: E402
+from structures_gvt import merge, run_plan  # noqa: E402
 from satmd.io import load_recording  # noqa: E402
 from satmd.structure import locate_joint  # noqa: E402
 from satmd.structure.spectra import periodic_spectra  # noqa: E402
@@ -123,25 +122,10 @@ def main(argv=None) -> int:
     ap.add_argument("--merge", nargs="+", default=None)
     args = ap.parse_args(argv)
     if args.merge:
-        parts = [json.loads(Path(p).read_text()) for p in args.merge]
-        rows = sorted((r for p in parts for r in p["rows"]), key=lambda r: r["seed"])
-        result = {"machine": parts[0]["machine"], "rows": rows, "summary": summarise(rows),
-                  "benchmark_seconds": sum(p.get("benchmark_seconds", 0.0) for p in parts)}
-        args.out.write_text(json.dumps(result, indent=1))
-        print(line(result))
+        print(line(merge(args.merge, args.out, summarise)))
         return 0
-    t0 = time.perf_counter()
-    result = {"machine": machine(threads=1), "rows": []}
-    for i, (structure, law, seed) in enumerate(plan(args.count, args.seed0)):
-        row = case(structure, law, seed)
-        result["rows"].append(row)
-        print(f"[{i + 1}/{args.count}] {structure} {law} seed {seed}: {row['found_between']} {row['found_law']} "
-              f"(true rank {row.get('true_rank')}, {row['locate_s']} s)", file=sys.stderr, flush=True)
-        result["summary"] = summarise(result["rows"])
-        args.out.write_text(json.dumps(result, indent=1))
-    result["benchmark_seconds"] = time.perf_counter() - t0
-    result["machine"].update(load_after())
-    args.out.write_text(json.dumps(result, indent=1))
+    result = run_plan(case, summarise, args.count, args.seed0, args.out, {},
+                      lambda r: f"{r['found_between']} {r['found_law']} (true rank {r.get('true_rank')}, {r['locate_s']} s)")
     print(line(result) + " | " + describe(result["machine"]))
     return 0
 
