@@ -11,11 +11,12 @@ from .laws import LAWS, SHAPE_GRID
 from .laws import law as law_named
 from .linear import fit_linear
 from .locate import shape_of
-from .model import Drive, Joint, StructureModel, nrmse, warmup_of
+from .model import Drive, Joint, StructureModel, nrmse
 from .newtons import in_newtons, path_sign
 from .outside import above_band
 from .output_error import output_error
-from .spectra import drive_force, periodic_spectra
+from .outputs import resolved_outputs
+from .spectra import drive_force, periodic_spectra, warmup_of
 from .starts import measured_start, underlying_start
 from .startup import with_start_up_modes
 
@@ -177,7 +178,10 @@ class _Fit:
             whole = [(Drive(model, drive_force(r), float(r.fs_hz), warmup_of(r)),
                       np.array([np.asarray(r[ch], float) for ch in self.names])) for r in self.recordings]
             model = freed if _cost(freed, whole) <= _cost(model, whole) else model
-        return _with_table(in_newtons(model, self.driving_point), self.recordings, files)
+        model = in_newtons(model, self.driving_point)
+        whole = [(Drive(model, drive_force(r), float(r.fs_hz), warmup_of(r)),
+                  np.array([np.asarray(r[ch], float) for ch in self.names])) for r in self.recordings]
+        return _with_table(resolved_outputs(model, whole), self.recordings, files)
 
 
 def _simulated_shape(linear, spectra, between, lw, d0, v0, aux, recordings, measured, span, levels):

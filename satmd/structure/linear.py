@@ -71,12 +71,12 @@ class LinearStructure:
         return self.pair_residues(a, b) / self.residues[self.index(driving_point)]
 
     def to_dict(self) -> dict:
-        return {"channels": list(self.channels), "poles": _pairs(self.poles),
-                "residues": [_pairs(r) for r in self.residues], "feedthrough": self.feedthrough.tolist()}
+        return {"channels": list(self.channels), "poles": as_pairs(self.poles),
+                "residues": [as_pairs(r) for r in self.residues], "feedthrough": self.feedthrough.tolist()}
 
     @classmethod
     def from_dict(cls, d: dict) -> "LinearStructure":
-        return cls(tuple(d["channels"]), _complex(d["poles"]), np.array([_complex(r) for r in d["residues"]]),
+        return cls(tuple(d["channels"]), from_pairs(d["poles"]), np.array([from_pairs(r) for r in d["residues"]]),
                    np.asarray(d["feedthrough"], float))
 
 
@@ -226,10 +226,10 @@ def response(states, residues) -> np.ndarray:
     return 2.0 * (R.real @ states.real - R.imag @ states.imag)  # the real part alone: half the work
 
 
-def _pairs(z) -> list:
+def as_pairs(z) -> list:
     return [[float(x.real), float(x.imag)] for x in np.asarray(z, complex)]
 
 
-def _complex(pairs) -> np.ndarray:
+def from_pairs(pairs) -> np.ndarray:
     a = np.asarray(pairs, float).reshape(-1, 2)
     return a[:, 0] + 1j * a[:, 1]

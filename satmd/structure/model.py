@@ -30,14 +30,13 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..conventions import TINY
 from ..errors import DataError
 from ..numerics import force_level
 from .bands import above_band_shares, band_top
 from .kernel import joint_states
 from .laws import law as law_named
-from .linear import LinearStructure, discretise, modal_states, response
-from .spectra import drive_force
+from .linear import LinearStructure, as_pairs, discretise, from_pairs, modal_states, response
+from .spectra import drive_force, warmup_of
 
 SCHEMA = "satmd-structure-model/1"
 PREDICTION_SCHEMA = "satmd-prediction/1"
@@ -61,6 +60,8 @@ class Joint:
         misfit to the modes' shapes too); empty when not estimated
     form : the law's own terms in the form it takes (`JointLaw.forms`; a friction's stick-slip contact or its
         memoryless Coulomb force); empty: the law's first form
+    column : (C, n) complex residues of the joint's force at each channel off the pair, re-solved from the
+        recordings (`outputs.resolved_outputs`); None: the force's scaled per mode by κ, as at the pair (`column_of`)
     """
 
     between: tuple
@@ -71,6 +72,7 @@ class Joint:
     units: str = "relative"
     ci95: dict = field(default_factory=dict)
     form: tuple = ()
+    column: np.ndarray | None = None
 
     @property
     def law_form(self):
@@ -94,11 +96,21 @@ class Joint:
     def formula(self) -> str:
         return self.law_form.formula(self.coefficients, self.aux)
 
+    def column_of(self, linear: LinearStructure) -> np.ndarray:
+        """(C, n) the joint's force's residues at each channel of ``linear``: the force's times κ at the pair's
+        own channels (their residues are the stroke), ``column`` at the others where it was re-solved."""
+        scaled = linear.residues * self.coupling[None, :]
+        if self.column is None:
+            return scaled
+        own = np.isin(np.array(linear.channels), np.array(self.between))[:, None]
+        return np.where(own, scaled, self.column)
+
     def to_dict(self) -> dict:
         return {"between": list(self.between), "law": self.law, "terms": list(self.terms),
                 "coefficients": [float(c) for c in self.coefficients], "aux": [float(a) for a in self.aux],
                 "coupling": [[float(k.real), float(k.imag)] for k in self.coupling], "units": self.units,
-                "formula": self.formula(), "ci95": {k: [float(x) for x in v] for k, v in self.ci95.items()}}
+                "formula": self.formula(), "ci95": {k: [float(x) for x in v] for k, v in self.ci95.items()}} | (
+                    {} if self.column is None else {"column": [as_pairs(r) for r in self.column]})
 
     @classmethod
     def from_dict(cls, d: dict) -> "Joint":
@@ -113,7 +125,8 @@ class Joint:
             raise DataError(f"{exc}: fit the model again") from None
         joint = cls(tuple(d["between"]), str(d["law"]), np.asarray(d["coefficients"], float),
                     np.asarray(d["aux"], float), k[:, 0] + 1j * k[:, 1], str(d.get("units", "relative")),
-                    {str(n): [float(x) for x in v] for n, v in (d.get("ci95") or {}).items()}, form)
+                    {str(n): [float(x) for x in v] for n, v in (d.get("ci95") or {}).items()}, form,
+                    None if d.get("column") is None else np.array([from_pairs(r) for r in d["column"]]))
         if not joint.coefficients.size == joint.aux.size == len(joint.terms):
             raise ValueError(f"{joint.coefficients.size} coefficients and {joint.aux.size} shape constants for the "
                              f"terms {', '.join(joint.terms)}")
@@ -253,9 +266,13 @@ class StructureModel:
     def from_dict(cls, d: dict) -> "StructureModel":
         if d.get("schema") != SCHEMA:
             raise DataError(f"not a structure model (schema {d.get('schema')!r}, expected {SCHEMA!r})")
-        return cls(LinearStructure.from_dict(d["linear"]), None if d.get("joint") is None else Joint.from_dict(d["joint"]),
-                   tuple(d["levels"]), d.get("fit", {}), d.get("units", {"force": "N", "response": "m/s²"}),
-                   d.get("driving_point"), int(d.get("oversample", 4)),
+        linear = LinearStructure.from_dict(d["linear"])
+        joint = None if d.get("joint") is None else Joint.from_dict(d["joint"])
+        if joint is not None and joint.column is not None and joint.column.shape != linear.residues.shape:
+            raise ValueError(f"the joint's column is {joint.column.shape}, the residues {linear.residues.shape}")
+        return cls(linear, joint, tuple(d["levels"]), d.get("fit", {}),
+                   d.get("units", {"force": "N", "response": "m/s²"}), d.get("driving_point"),
+                   int(d.get("oversample", 4)),
                    None if d.get("reference") is None else LinearStructure.from_dict(d["reference"]))
 
     @classmethod
@@ -304,47 +321,6 @@ def _finite_nrmse(simulated, measured) -> float:
     return value if np.isfinite(value) else float("inf")
 
 
-START_SHARE = 1 / 32   # of a period: the start a start from rest shows, its response building up from nothing
-AT_REST = 0.25         # the start's departure from the steady periods' (median over channels) beyond which it was at rest
-
-
-def warmup_of(recording) -> int:
-    """Samples of warm-up before a recording: one period of a periodic force whose record starts in steady
-    state, else none (from rest, as the record did). A record starts in steady state where its first period
-    has no start-up transient, or where the first `START_SHARE` of it departs from the steady periods by less
-    than `AT_REST` of their RMS: a start from rest departs by all of it (on independent ground vibration tests
-    0.4 to 1.3), a record cut from a longer test only by its drift (on the F-16, whose slow drift over the
-    first periods reads as a transient, 0.13 to 0.16)."""
-    from ..signal.excitation import excitation_of, received
-
-    try:
-        rec = received(recording)
-        exc = excitation_of(rec)
-    except DataError:
-        return 0
-    if exc.kind != "periodic":
-        return 0
-    n = int(exc.period_samples)
-    if not exc.transient_periods or not _starts_from_rest(rec, exc):
-        return n
-    return 0
-
-
-def _starts_from_rest(rec, exc) -> bool:
-    n, steady = int(exc.period_samples), list(exc.steady)
-    m = max(int(START_SHARE * n), 1)
-    if not steady or exc.periods < 2:
-        return True
-    departures = []
-    for name in rec.channels:
-        if name == "force":
-            continue
-        y = np.asarray(rec[name], float)[: exc.periods * n].reshape(exc.periods, n)
-        mean = y[steady].mean(axis=0)[:m]
-        departures.append(np.sqrt(np.mean((y[0, :m] - mean) ** 2) / max(np.mean(mean ** 2), TINY)))
-    return bool(np.median(departures) > AT_REST) if departures else True
-
-
 class Drive:
     """One force through the model: the linear part's response and the pair's motion, computed once.
 
@@ -382,7 +358,7 @@ class Drive:
         g, z = self.driven(joint, step)
         if not np.all(np.isfinite(g)):
             return np.full_like(self.linear[:, keep], np.nan)
-        column = self.model.linear.residues * joint.coupling[None, :]
+        column = joint.column_of(self.model.linear)
         return self.linear[:, keep] + response(z, column)
 
     def driven(self, joint: Joint, step: int = 1):

@@ -85,5 +85,6 @@ def in_newtons(model, driving_point=None):
             continue
         h = abs(s) * float(np.hypot(0.5 * (hi - lo), 1.96 * rel * abs(v)))
         ci[n] = [v * s - h, v * s + h]
+    column = None if j.column is None else j.column / s
     return replace(model, joint=replace(j, coefficients=j.coefficients * s, coupling=j.coupling / s, units="N",
-                                        ci95=ci), driving_point=d)
+                                        ci95=ci, column=column), driving_point=d)

@@ -87,7 +87,7 @@ def _block(model, s):
     if block is None:
         return None
     f, G, A, W, lines = block
-    column = _column(lin.poles, lin.residues * np.asarray(joint.coupling)[None, :], f)
+    column = _column(lin.poles, joint.column_of(lin), f)
     return f, G, A - column * G[None, :], W, lines
 
 

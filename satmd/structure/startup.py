@@ -68,7 +68,7 @@ def start_up_modes(linear: LinearStructure, recordings, band_top: float, between
     -------
     LinearStructure
     """
-    from .model import warmup_of
+    from .spectra import warmup_of
 
     rest = [r for r in recordings if warmup_of(r) == 0]
     if not rest:

@@ -77,7 +77,7 @@ def test_a_record_begun_in_motion_is_no_start_from_rest(chain):
     in steady state (`warmup_of`: one period of warm-up) and shows no mode above the band; the same test from
     rest starts from rest."""
     from satmd.signal.excitation import excitation_of, received
-    from satmd.structure.model import warmup_of
+    from satmd.structure.spectra import warmup_of
 
     fitted, _, spectra, linear = chain
     n = 1024
