@@ -371,8 +371,8 @@ def test_the_modes_above_the_band_reach_into_it_as_a_flexibility():
 
 def test_the_channels_off_the_pair_are_re_solved_on_every_level(cubic_levels, cubic_model):
     """`resolved_outputs`: a channel off the joint's pair whose residues and joint's column are off (10 % and 20°,
-    the column 30 % low) misses the chain by several times its 1 % noise; re-solved on the fitted levels it comes
-    back to the noise at the level it did not see. The pair's own residues (the joint's stroke) are not touched."""
+    the column 30 % low) misses the chain's level 3 by 0.38 (1 % noise); re-solved on levels 1 and 8 it comes back
+    to the noise at level 3, which it did not see (0.011). The pair's own residues (the joint's stroke) are not touched."""
     from dataclasses import replace
 
     from satmd.structure.outputs import resolved_outputs
@@ -389,7 +389,7 @@ def test_the_channels_off_the_pair_are_re_solved_on_every_level(cubic_levels, cu
               for r in (cubic_levels[0], cubic_levels[2])]
     again = resolved_outputs(off, drives)
     before, after = off.predict(cubic_levels[1]).nrmse[i], again.predict(cubic_levels[1]).nrmse[i]
-    assert before > 0.04 and after < 0.013, (before, after)
+    assert before > 0.1 and after < 0.013, (before, after)
     pair = [lin.index(c) for c in m.joint.between]
     assert np.array_equal(again.linear.residues[pair], residues[pair])
     assert np.array_equal(again.joint.column_of(again.linear)[pair], again.linear.residues[pair] * m.joint.coupling)
