@@ -238,6 +238,11 @@ def test_bad_models_and_recordings_are_refused(cubic_levels, cubic_model, tmp_pa
     (tmp_path / "old.json").write_text(json.dumps(doc))
     with pytest.raises(DataError, match=r"old\.json: the friction law has no form with the terms v³.*fit the model again"):
         StructureModel.load(tmp_path / "old.json")
+    doc = cubic_model.to_dict()
+    doc["joint"]["column"] = doc["joint"]["column"][:-1]  # a channel's row of the joint's column lost
+    (tmp_path / "cut.json").write_text(json.dumps(doc))
+    with pytest.raises(DataError, match=r"cut\.json: a structure model with a missing or malformed field \(the joint's column"):
+        StructureModel.load(tmp_path / "cut.json")
     rec = cubic_levels[1]
     fewer = Recording(rec.fs_hz, {c: rec[c] for c in ("force", "acc1", "acc2")}, meta={"source": "three.csv"})
     with pytest.raises(DataError, match=r"three\.csv: no channel acc3, acc4, acc5"):
