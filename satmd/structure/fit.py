@@ -27,6 +27,9 @@ FIT_PERIODS = 3  # steady periods of a periodic test in the output-error fit
 #: ranked fifth at 0.26 and 0.28-0.40. A middle level held out instead (fitted on two) chose quadratic damping
 WEIGHED = 5
 SPARSE_MARGIN = 0.1
+PLACES = 3      # the spectra's best places simulated on every level (`_best_place`)
+PLACE_LAWS = 2  # laws fitted at each next place: the best place's best simulated
+RIVAL = 0.1     # a next place is simulated where its ΔBIC to the best is within this share of the joint's evidence
 STARTS = ("measured", "underlying")
 SHRINK = (1.0, 0.5, 0.25, 0.1, 0.03, 0.01, 0.0)  # scales of the start's joint tried until the loop is stable
 
@@ -90,22 +93,58 @@ def fit_structure(recordings, between=None, law: str | None = None, channels=Non
         loc = location or locate_joint(spectra, channels=names)
         if not loc.detected:
             return fit.law(None, None, files)
-        law_given = law is not None
+        place_given, law_given = between is not None, law is not None
         shape, form = None, ()
         if between is None or tuple(between) == loc.between:
             shape, form = (loc.shape, loc.form) if law is None or law == loc.law else (None, ())
         between, law = tuple(between or loc.between), law or loc.law
-        if not law_given and len(recordings) >= 3 and tuple(between) == loc.between:
-            weighed = [e["law"] for e in loc.laws if e["law"] != "sparse"][:WEIGHED]
-            weighed = ["sparse", *weighed] if law == "sparse" else weighed
-            if len(weighed) > 1:
-                say(f"{', '.join(weighed)}: each fitted on every level, the best kept ...")
-                model = best_fitting([fit.law(between, w, files) for w in weighed])
-                return fit.finished(model, free_path, files)
-        model = fit.law(between, law, files, shape, form)
+        weighed = [e["law"] for e in loc.laws if e["law"] != "sparse"][:WEIGHED]
+        weighed = ["sparse", *weighed] if law == "sparse" else weighed
+        if not law_given and len(recordings) >= 3 and tuple(between) == loc.between and len(weighed) > 1:
+            say(f"{', '.join(weighed)}: each fitted on every level, the best kept ...")
+            fitted = [fit.law(between, w, files) for w in weighed]
+        else:
+            fitted = [fit.law(between, law, files, shape, form)]
+        model = best_fitting(fitted)
+        if not place_given and len(recordings) >= 3:
+            laws = [law] if law_given else _ranked_laws(fitted)[:PLACE_LAWS]
+            model = _best_place(fit, loc, model, laws, [w for w in weighed if w not in laws] if not law_given else [],
+                                files)
     else:
         model = fit.law(tuple(between), law, files)
     return fit.finished(model, free_path, files)
+
+
+def _best_place(fit, loc, model, laws, others, files) -> StructureModel:
+    """``model`` (at the spectra's best place), or the model at one of the next places (`PLACES`, those within
+    `RIVAL` of the joint's evidence) where it simulates every level better (`best_fitting`): each next place is
+    fitted with ``laws`` (the best place's best simulated), and the place kept has ``others`` weighed there too.
+    The spectra weigh each level's change at the excited lines, through a frequency-domain model that misses
+    some of the top level's change; on independent ground vibration tests the true place was second or third in
+    5 of 6 misplaced joints (the spectra's ΔBIC 116 to 2366, against an evidence of 14000 to 59000), and fitted
+    with the true law it simulated the four levels better in all 5 (a beam's support: mean NRMSE 0.022 against
+    0.049, the held-out levels 0.047 against 0.17). The law the spectra name at a next place is often the sparse
+    library, which fitted worse there than a named law (0.11 against 0.022)."""
+    rivals = [tuple(e["between"]) for e in loc.location[1:PLACES] if e["delta_bic"] <= RIVAL * loc.evidence]
+    if not rivals or not laws or model.joint is None:
+        return model
+    fit.say(f"the next {len(rivals)} place(s) by the spectra ({', '.join(' and '.join(p) for p in rivals)}), "
+            f"{' and '.join(laws)} fitted at each on every level ...")
+    tried = [model, *[fit.law(p, w, files) for p in rivals for w in laws]]
+    fit.say("; ".join(f"{' and '.join(m.joint.between)} ({m.joint.law}): mean NRMSE {_score(m):.4f}"
+                      for m in tried if m.joint is not None))
+    best = best_fitting(tried)
+    if best.joint is None or best.joint.between == model.joint.between or not others:
+        return best
+    fit.say(f"{', '.join(others)} between {best.joint.between[0]} and {best.joint.between[1]}: each fitted ...")
+    here = [m for m in tried if m.joint is not None and m.joint.between == best.joint.between]
+    return best_fitting([*here, *[fit.law(best.joint.between, w, files) for w in others]])
+
+
+def _ranked_laws(models) -> list:
+    """The named laws of ``models`` (one place), best simulated first (`_score`); the sparse library last."""
+    ranked = sorted((m for m in models if m.joint is not None), key=lambda m: (m.joint.law == "sparse", _score(m)))
+    return [m.joint.law for m in ranked]
 
 
 class _Fit:
@@ -225,15 +264,17 @@ def best_fitting(models) -> StructureModel:
     over every recording and channel); the sparse library only where it beats every named law by more than
     `SPARSE_MARGIN` (its terms fit what a named law leaves, and predict the levels it did not see no better);
     a law whose fitted sign contradicts its name is not that law (`_contradicts`)."""
-    def score(m):
-        return float(np.mean(m.fit["nonlinear"])) if m.joint is not None else np.inf
-
     named = [m for m in models if m.joint is not None and m.joint.law != "sparse" and not _contradicts(m)]
     sparse = [m for m in models if m.joint is not None and m.joint.law == "sparse"]
-    best = min(named, key=score) if named else None
-    if sparse and (best is None or score(sparse[0]) < (1 - SPARSE_MARGIN) * score(best)):
+    best = min(named, key=_score) if named else None
+    if sparse and (best is None or _score(sparse[0]) < (1 - SPARSE_MARGIN) * _score(best)):
         best = sparse[0]
     return best if best is not None else models[0]
+
+
+def _score(model) -> float:
+    """Mean NRMSE of a model's fit table over every recording and channel (inf without a joint)."""
+    return float(np.mean(model.fit["nonlinear"])) if model.joint is not None else np.inf
 
 
 #: law -> its coefficients whose sign the name fixes (positive, as a force that restores or resists): a saturating

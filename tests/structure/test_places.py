@@ -1,0 +1,64 @@
+"""The joint's place when the levels' spectra and a simulation of the levels disagree (`fit._best_place`): the next
+places within reach of the best are fitted on every level, and the one that simulates them best is kept."""
+from __future__ import annotations
+
+import numpy as np
+
+from satmd.structure import Joint, JointLocation, LinearStructure, StructureModel
+from satmd.structure.fit import _best_place
+
+LINEAR = LinearStructure(("acc1", "acc2", "acc3"), np.array([-1.0 + 60j]), np.ones((3, 1), complex), np.zeros(3))
+
+
+class _Fits:
+    """`fit._Fit` as `_best_place` uses it: a model per (place, law) with a given mean NRMSE, each call noted."""
+
+    def __init__(self, scores):
+        self.scores, self.calls = scores, []
+
+    @staticmethod
+    def say(text):
+        pass
+
+    def law(self, between, law, files):
+        self.calls.append((tuple(between), law))
+        joint = Joint(tuple(between), law, np.array([1.0, 0.0, 0.0]), np.ones(3), np.ones(1, complex), "N")
+        return StructureModel(LINEAR, joint, (1.0, 8.0), fit={"nonlinear": [[self.scores[(tuple(between), law)]]]})
+
+
+def _located(next_gap):
+    places = [("acc1", "acc2"), ("acc2", "acc3"), ("acc1", "ground")]
+    return JointLocation(("acc1", "acc2"), [{"between": list(p), "delta_bic": d, "law": "cubic"}
+                                            for p, d in zip(places, (0.0, next_gap, 5000.0))],
+                         "cubic", [{"law": w, "delta_bic": 0.0} for w in ("cubic", "softening", "friction")],
+                         [], [], "L1", [1.0, 8.0], evidence=1000.0)
+
+
+def test_a_next_place_that_simulates_the_levels_better_is_kept_and_its_law_weighed():
+    fits = _Fits({(("acc1", "acc2"), "cubic"): 0.05, (("acc2", "acc3"), "cubic"): 0.03,
+                  (("acc2", "acc3"), "softening"): 0.02, (("acc2", "acc3"), "friction"): 0.04})
+    model = fits.law(("acc1", "acc2"), "cubic", None)
+    chosen = _best_place(fits, _located(50.0), model, ["cubic"], ["softening", "friction"], None)
+    assert chosen.joint.between == ("acc2", "acc3") and chosen.joint.law == "softening"
+    # the third place is 5000 behind (over a tenth of the evidence, 1000): not simulated
+    assert fits.calls[1:] == [(("acc2", "acc3"), "cubic"), (("acc2", "acc3"), "softening"), (("acc2", "acc3"), "friction")]
+
+
+def test_the_best_place_stays_where_no_next_place_simulates_better_or_none_is_near():
+    fits = _Fits({(("acc1", "acc2"), "cubic"): 0.02, (("acc2", "acc3"), "cubic"): 0.03})
+    model = fits.law(("acc1", "acc2"), "cubic", None)
+    assert _best_place(fits, _located(50.0), model, ["cubic"], ["softening"], None) is model
+    assert fits.calls[1:] == [(("acc2", "acc3"), "cubic")]  # no law weighed at a place not kept
+    far = _Fits({})
+    assert _best_place(far, _located(500.0), model, ["cubic"], ["softening"], None) is model and far.calls == []
+    given = _Fits({(("acc2", "acc3"), "friction"): 0.01})  # a law given: the next place fitted with it, none weighed
+    chosen = _best_place(given, _located(50.0), model, ["friction"], [], None)
+    assert chosen.joint.between == ("acc2", "acc3") and given.calls == [(("acc2", "acc3"), "friction")]
+
+
+def test_the_laws_tried_at_a_next_place_are_the_best_simulated_named_ones():
+    from satmd.structure.fit import _ranked_laws
+
+    fits = _Fits({(("acc1", "acc2"), w): x for w, x in (("sparse", 0.01), ("cubic", 0.04), ("friction", 0.02))})
+    models = [fits.law(("acc1", "acc2"), w, None) for w in ("sparse", "cubic", "friction")]
+    assert _ranked_laws(models) == ["friction", "cubic", "sparse"]
