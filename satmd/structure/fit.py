@@ -199,8 +199,7 @@ class _Fit:
         if not fitted:  # no start gave a joint to fit: the linear model of the lowest level, said by its table
             return _with_table(StructureModel(reference, None, self.levels), recordings, files)
         # judged on the whole records: a model that slowly gathers energy shows it only over many periods
-        whole = [(Drive(fitted[0], drive_force(r), float(r.fs_hz), warmup_of(r)),
-                  np.array([np.asarray(r[ch], float) for ch in names])) for r in recordings]
+        whole = self.whole(fitted[0])
         model = min(fitted, key=lambda m: _cost(m, [(_redrive(d, m), y) for d, y in whole]))
         return _with_table(replace(model, driving_point=self.driving_point), recordings, files)
 
@@ -214,13 +213,15 @@ class _Fit:
             freed = output_error(model, _drives(model, self.recordings, self.measured, self.span), self.ref,
                                  self.max_nfev, fixed_path=False)
             # fitted on the first periods, kept where the whole records say so too (as the starts are judged)
-            whole = [(Drive(model, drive_force(r), float(r.fs_hz), warmup_of(r)),
-                      np.array([np.asarray(r[ch], float) for ch in self.names])) for r in self.recordings]
+            whole = self.whole(model)
             model = freed if _cost(freed, whole) <= _cost(model, whole) else model
         model = in_newtons(model, self.driving_point)
-        whole = [(Drive(model, drive_force(r), float(r.fs_hz), warmup_of(r)),
-                  np.array([np.asarray(r[ch], float) for ch in self.names])) for r in self.recordings]
-        return _with_table(resolved_outputs(model, whole), self.recordings, files)
+        return _with_table(resolved_outputs(model, self.whole(model)), self.recordings, files)
+
+    def whole(self, model) -> list:
+        """(Drive, measured responses) of every recording, whole, through ``model``."""
+        return [(Drive(model, drive_force(r), float(r.fs_hz), warmup_of(r)),
+                 np.array([np.asarray(r[ch], float) for ch in self.names])) for r in self.recordings]
 
 
 def _simulated_shape(linear, spectra, between, lw, d0, v0, aux, recordings, measured, span, levels):
