@@ -335,7 +335,8 @@ class Drive:
         lin = model.linear
         u = np.concatenate([force[force.size - warmup:], force]) if warmup else force
         ub = band_limited(u, fs_hz)
-        self.linear = response(modal_states(ub, lin.poles, fs_hz), lin.residues) + lin.feedthrough[:, None] * u
+        self.u, self.states = u, modal_states(ub, lin.poles, fs_hz)  # the force with its warm-up; the modes it drives
+        self.linear = response(self.states, lin.residues) + lin.feedthrough[:, None] * u
         ref = model.reference
         self.base = self.linear if ref is None else (response(modal_states(ub, ref.poles, fs_hz), ref.residues)
                                                      + ref.feedthrough[:, None] * u)

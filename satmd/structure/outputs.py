@@ -17,15 +17,12 @@ from dataclasses import replace
 import numpy as np
 
 from ..conventions import TINY
-from .linear import modal_states
 
 
 def resolved_outputs(model, drives):
     """``model`` with the residues, joint's column and feed-through of every channel off the joint's pair
     re-solved by least squares on ``drives`` [(Drive, measured (C, N))]; ``model`` itself where it has no joint,
     every channel is the pair's, or the joint ran away on a recording."""
-    from ..physics.nonlinear.integrate import band_limited
-
     joint, lin = model.joint, model.linear
     free = [i for i, c in enumerate(lin.channels) if joint is not None and c not in joint.between]
     if not free:
@@ -33,13 +30,11 @@ def resolved_outputs(model, drives):
     n = lin.poles.size
     rows = {i: ([], []) for i in free}
     for drive, measured in drives:
-        force = np.asarray(drive.force, float)
-        u = np.concatenate([force[force.size - drive.skip:], force]) if drive.skip else force
-        x = modal_states(band_limited(u, drive.fs), lin.poles, drive.fs)[:, drive.skip:]
+        x, u = drive.states[:, drive.skip:], drive.u[drive.skip:]
         g, w = drive.driven(joint)
         if not np.all(np.isfinite(g)):
             return model
-        basis = np.vstack([2 * x.real, -2 * x.imag, 2 * w.real, -2 * w.imag, u[None, drive.skip:]]).T
+        basis = np.vstack([2 * x.real, -2 * x.imag, 2 * w.real, -2 * w.imag, u[None, :]]).T
         for i in free:
             scale = max(float(measured[i].std()), TINY)
             rows[i][0].append(basis / scale)
