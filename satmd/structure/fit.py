@@ -7,6 +7,7 @@ import numpy as np
 
 from ..errors import DataError
 from ..validation import NAMES, Interval, Options, Whole, validate_params
+from .acquisition import acquisition_of
 from .laws import LAWS, SHAPE_GRID
 from .laws import law as law_named
 from .linear import fit_linear
@@ -18,7 +19,7 @@ from .output_error import output_error
 from .outputs import resolved_outputs
 from .spectra import drive_force, periodic_spectra, warmup_of
 from .starts import measured_start, underlying_start
-from .startup import with_start_up_modes
+from .startup import band_top_hz, with_start_up_modes
 
 FIT_PERIODS = 3  # steady periods of a periodic test in the output-error fit
 #: named laws (the best by the levels' spectra) each fitted when three or more levels are given, the one that
@@ -217,7 +218,9 @@ class _Fit:
             whole = self.whole(model)
             model = freed if _cost(freed, whole) <= _cost(model, whole) else model
         model = in_newtons(model, self.driving_point)
-        return _with_table(resolved_outputs(model, self.whole(model)), self.recordings, files)
+        model = resolved_outputs(model, self.whole(model))
+        chain = acquisition_of(model, self.whole(model), band_top_hz(self.spectra))
+        return _with_table(replace(model, acquisition=chain), self.recordings, files)
 
     def widened(self, model) -> StructureModel:
         """``model`` with more modes above the band (`above_band`), found through its fitted law and its

@@ -32,6 +32,7 @@ import numpy as np
 
 from ..errors import DataError
 from ..numerics import force_level
+from .acquisition import Acquisition
 from .bands import above_band_shares, band_top
 from .kernel import joint_states
 from .laws import law as law_named
@@ -199,6 +200,7 @@ class StructureModel:
     units : {"force": "N", "response": "m/s²"}
     driving_point : the channel at the force's point, when there is one
     oversample : the joint's force is integrated at this many times the record's rate
+    acquisition : the acquisition's low-pass on the joint's share above the force's band (`acquisition`), or None
     """
 
     linear: LinearStructure
@@ -209,6 +211,7 @@ class StructureModel:
     driving_point: str | None = None
     oversample: int = 4
     reference: LinearStructure | None = None
+    acquisition: Acquisition | None = None
 
     @property
     def channels(self) -> tuple:
@@ -253,7 +256,8 @@ class StructureModel:
                 "oversample": int(self.oversample),
                 "linear": self.linear.to_dict(),
                 "reference": None if self.reference is None else self.reference.to_dict(),
-                "joint": None if self.joint is None else self.joint.to_dict(), "fit": self.fit}
+                "joint": None if self.joint is None else self.joint.to_dict(), "fit": self.fit,
+                "acquisition": None if self.acquisition is None else self.acquisition.to_dict()}
 
     def save(self, path) -> None:
         """Write the model as JSON (never pickle), atomically."""
@@ -273,7 +277,8 @@ class StructureModel:
         return cls(linear, joint, tuple(d["levels"]), d.get("fit", {}),
                    d.get("units", {"force": "N", "response": "m/s²"}), d.get("driving_point"),
                    int(d.get("oversample", 4)),
-                   None if d.get("reference") is None else LinearStructure.from_dict(d["reference"]))
+                   None if d.get("reference") is None else LinearStructure.from_dict(d["reference"]),
+                   None if d.get("acquisition") is None else Acquisition.from_dict(d["acquisition"]))
 
     @classmethod
     def load(cls, path) -> "StructureModel":
@@ -302,6 +307,8 @@ class StructureModel:
                     "so reciprocity does not fix its scale)" if self.driving_point else
                     " (relative: no driving point fixes its scale)")
             lines.append(f"joint between {a} and {b}: {self.joint.law}, force {self.joint.formula()}{unit}")
+            if self.acquisition is not None:
+                lines.append(self.acquisition.describe())
         if self.fit:
             lines.append("NRMSE (" + ", ".join(self.fit["channels"]) + "): linear → with the joint")
             for f, lin, nl in zip(self.fit["files"], self.fit["linear"], self.fit["nonlinear"]):
@@ -359,8 +366,9 @@ class Drive:
         g, z = self.driven(joint, step)
         if not np.all(np.isfinite(g)):
             return np.full_like(self.linear[:, keep], np.nan)
-        column = joint.column_of(self.model.linear)
-        return self.linear[:, keep] + response(z, column)
+        share = response(z, joint.column_of(self.model.linear))
+        chain = self.model.acquisition
+        return self.linear[:, keep] + (share if chain is None or step != 1 else chain.apply(share, self.fs))
 
     def driven(self, joint: Joint, step: int = 1):
         """(g, w) at the kept samples: the joint's force (NaN from where it ran away) and each mode's state it
