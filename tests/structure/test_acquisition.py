@@ -108,3 +108,24 @@ def test_a_saved_model_keeps_its_acquisition_and_a_cut_one_is_refused(tmp_path, 
     path.write_text(text)
     with pytest.raises(DataError, match="model.json"):
         StructureModel.load(path)
+
+
+def test_discover_says_the_chain_s_filter_apart_from_the_joint(monkeypatch, chain):
+    """`discover`'s joint finding names the acquisition's low-pass as the measurement chain's, after the joint's
+    model (fakes for the location and the fit: the sentence is what is tested)."""
+    from satmd.discovery.findings import NonlinearFinding
+    from satmd.discovery.nonlinear import modes
+    from satmd.discovery.nonlinear.distortion import NonlinearReport
+    from satmd.structure import JointLocation
+
+    gain = Acquisition(36.0, np.array([60.0, 90.0, 110.0]), np.array([0.99 - 0.3j, 0.8 - 1.2j, 0.3 + 0j]))
+    fitted = replace(chain[0], acquisition=gain, fit={"metric": "nrmse", "channels": list(CHANNELS),
+                                                      "linear": [[0.3] * 4], "nonlinear": [[0.02] * 4]})
+    located = JointLocation(("acc3", "acc4"), [{"between": ["acc3", "acc4"], "delta_bic": 0.0, "law": "cubic"}],
+                            "cubic", [{"law": "cubic", "delta_bic": 0.0}], [], [], "L1", [1.0, 8.0], evidence=1e3)
+    monkeypatch.setattr("satmd.structure.locate_joint", lambda recordings: located)
+    monkeypatch.setattr(modes, "_structure_model", lambda recordings, loc: fitted)
+    report = NonlinearReport(True, [], [NonlinearFinding("nonlinear_unexplained", explanation="")])
+    recordings = simulate_chain(n=4, joint=(2, 3), levels=(1.0, 8.0), period=256, periods=2, seed=1)
+    text = modes.with_joint(report, recordings).findings[0].explanation
+    assert "modelled" in text and "acquisition's low-pass" in text and "-3 dB at 110 Hz" in text, text

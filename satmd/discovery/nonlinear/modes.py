@@ -200,6 +200,8 @@ def with_joint(report, recordings):
             explanation += (f"; modelled ({model.joint.formula()}{unit}{'; 95 %: ' + bounds if bounds else ''}), "
                             f"simulated from each force the worst NRMSE goes from {worst_lin:.2f} (linear) to "
                             f"{worst_nl:.2f}")
+            if model.acquisition is not None:  # the measurement chain's, not the structure's: said apart
+                explanation += f"; {model.acquisition.describe()}"
         else:  # said, not hidden: the place or the law the levels point to does not make a better simulation
             explanation += (f"; its model ({model.joint.formula()}{unit}) does not simulate the recordings better than "
                             f"the linear one (worst NRMSE {worst_lin:.2f} linear, {worst_nl:.2f} with the joint): the "
