@@ -54,7 +54,8 @@ class Acquisition:
         return np.fft.irfft(np.fft.rfft(x, axis=-1) * self.at(np.fft.rfftfreq(n, 1.0 / fs_hz)), n, axis=-1)
 
     def cutoff_hz(self) -> float | None:
-        """Where the gain first falls below 1/√2 (the chain's -3 dB), None if it never does."""
+        """The first band's centre where the gain is below 1/√2 (the chain's -3 dB point lies in that band or the
+        one before), None if none is."""
         below = np.flatnonzero(np.abs(self.gain) < 2 ** -0.5)
         return float(self.freq_hz[below[0]]) if below.size else None
 
@@ -63,7 +64,7 @@ class Acquisition:
         passed = np.flatnonzero(np.abs(self.gain) >= 2 ** -0.5)
         lag = (f", phase {np.degrees(np.angle(self.gain[passed[-1]])):+.0f}° at {self.freq_hz[passed[-1]]:.4g} Hz"
                if passed.size else "")
-        at = f"-3 dB at {cut:.4g} Hz" if cut is not None else "no -3 dB point below Nyquist"
+        at = f"-3 dB by {cut:.4g} Hz" if cut is not None else "no -3 dB point below Nyquist"
         return (f"the joint's harmonics above {self.band_top_hz:.4g} Hz pass the acquisition's low-pass, estimated "
                 f"from them: {at}{lag}")
 
