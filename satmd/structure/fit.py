@@ -205,7 +205,10 @@ class _Fit:
         return _with_table(replace(model, driving_point=self.driving_point), recordings, files)
 
     def finished(self, model, free_path, files) -> StructureModel:
-        """``model`` with its path fitted too (``free_path``), in newtons where a driving point fixes the scale."""
+        """``model`` finished: more modes above the band where its fitted law's harmonics ask for them (`widened`),
+        its path fitted too (``free_path``), in newtons where a driving point fixes the scale, the channels off the
+        joint's pair re-solved (`resolved_outputs`), and the acquisition's low-pass on the joint's harmonics
+        (`acquisition_of`)."""
         if model.joint is None:
             return model
         model = self.widened(model)
