@@ -84,7 +84,8 @@ class Acquisition:
 def acquisition_of(model, drives, band_top_hz: float) -> Acquisition | None:
     """The chain's gain on the joint's share above ``band_top_hz`` from ``drives`` [(Drive, measured (C, N))] of
     a fitted ``model``, or None where the joint puts nothing above the band or the gain does not bring the
-    records closer there (by `MIN_GAIN`)."""
+    records closer there (by `MIN_GAIN`). The drives are of the model without a gain of its own: their outputs
+    are the joint's share as the model makes it."""
     from sklearn.isotonic import IsotonicRegression
 
     joint = model.joint
