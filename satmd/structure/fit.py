@@ -8,12 +8,13 @@ import numpy as np
 from ..errors import DataError
 from ..validation import NAMES, Interval, Options, Whole, validate_params
 from .acquisition import acquisition_of
+from .choice import PLACE_LAWS, best_fitting, best_place, ranked_laws
 from .laws import LAWS, SHAPE_GRID
 from .laws import law as law_named
 from .linear import fit_linear
 from .locate import shape_of
 from .model import Drive, Joint, StructureModel, nrmse
-from .newtons import in_newtons, path_sign
+from .newtons import in_newtons
 from .outside import above_band
 from .output_error import output_error
 from .outputs import resolved_outputs
@@ -27,10 +28,6 @@ FIT_PERIODS = 3  # steady periods of a periodic test in the output-error fit
 #: their best, a clearance, fitted them at mean NRMSE 0.32 and predicted level 5 at 0.37-0.62, a friction they
 #: ranked fifth at 0.26 and 0.28-0.40. A middle level held out instead (fitted on two) chose quadratic damping
 WEIGHED = 5
-SPARSE_MARGIN = 0.1
-PLACES = 3      # the spectra's best places simulated on every level (`_best_place`)
-PLACE_LAWS = 2  # laws fitted at each next place: the best place's best simulated
-RIVAL = 0.1     # a next place is simulated where its ΔBIC to the best is within this share of the joint's evidence
 STARTS = ("measured", "underlying")
 SHRINK = (1.0, 0.5, 0.25, 0.1, 0.03, 0.01, 0.0)  # scales of the start's joint tried until the loop is stable
 
@@ -108,44 +105,13 @@ def fit_structure(recordings, between=None, law: str | None = None, channels=Non
             fitted = [fit.law(between, law, files, shape, form)]
         model = best_fitting(fitted)
         if not place_given and len(recordings) >= 3:
-            laws = [law] if law_given else _ranked_laws(fitted)[:PLACE_LAWS]
-            model = _best_place(fit, loc, model, laws, [w for w in weighed if w not in laws] if not law_given else [],
-                                files)
+            laws = [law] if law_given else ranked_laws(fitted)[:PLACE_LAWS]
+            others = [] if law_given else [w for w in weighed if w not in laws]
+            return best_place(fit, loc, [model] if law_given else fitted, laws, others, files,
+                              lambda m: fit.finished(m, free_path, files))
     else:
         model = fit.law(tuple(between), law, files)
     return fit.finished(model, free_path, files)
-
-
-def _best_place(fit, loc, model, laws, others, files) -> StructureModel:
-    """``model`` (at the spectra's best place), or the model at one of the next places (`PLACES`, those within
-    `RIVAL` of the joint's evidence) where it simulates every level better (`best_fitting`): each next place is
-    fitted with ``laws`` (the best place's best simulated), and the place kept has ``others`` weighed there too.
-    The spectra weigh each level's change at the excited lines, through a frequency-domain model that misses
-    some of the top level's change; on independent ground vibration tests the true place was second or third in
-    5 of 6 misplaced joints (the spectra's ΔBIC 116 to 2366, against an evidence of 14000 to 59000), and fitted
-    with the true law it simulated the four levels better in all 5 (a beam's support: mean NRMSE 0.022 against
-    0.049, the held-out levels 0.047 against 0.17). The law the spectra name at a next place is often the sparse
-    library, which fitted worse there than a named law (0.11 against 0.022)."""
-    rivals = [tuple(e["between"]) for e in loc.location[1:PLACES] if e["delta_bic"] <= RIVAL * loc.evidence]
-    if not rivals or not laws or model.joint is None:
-        return model
-    fit.say(f"the next {len(rivals)} place(s) by the spectra ({', '.join(' and '.join(p) for p in rivals)}), "
-            f"{' and '.join(laws)} fitted at each on every level ...")
-    tried = [model, *[fit.law(p, w, files) for p in rivals for w in laws]]
-    fit.say("; ".join(f"{' and '.join(m.joint.between)} ({m.joint.law}): mean NRMSE {_score(m):.4f}"
-                      for m in tried if m.joint is not None))
-    best = best_fitting(tried)
-    if best.joint is None or best.joint.between == model.joint.between or not others:
-        return best
-    fit.say(f"{', '.join(others)} between {best.joint.between[0]} and {best.joint.between[1]}: each fitted ...")
-    here = [m for m in tried if m.joint is not None and m.joint.between == best.joint.between]
-    return best_fitting([*here, *[fit.law(best.joint.between, w, files) for w in others]])
-
-
-def _ranked_laws(models) -> list:
-    """The named laws of ``models`` (one place), best simulated first (`_score`); the sparse library last."""
-    ranked = sorted((m for m in models if m.joint is not None), key=lambda m: (m.joint.law == "sparse", _score(m)))
-    return [m.joint.law for m in ranked]
 
 
 class _Fit:
@@ -281,46 +247,6 @@ def _with_modes_above(model, spectra, recordings, measured, span):
         m = replace(m, oversample=oversampling(m.linear, spectra[0].fs_hz))
         runs.append((m, _drives(m, recordings, measured, span)))
     return min(runs, key=lambda run: _cost(_stable(*run), run[1]))
-
-
-def best_fitting(models) -> StructureModel:
-    """Of models of one structure with different laws, the one that simulates its recordings best (mean NRMSE
-    over every recording and channel); the sparse library only where it beats every named law by more than
-    `SPARSE_MARGIN` (its terms fit what a named law leaves, and predict the levels it did not see no better);
-    a law whose fitted sign contradicts its name is not that law (`_contradicts`)."""
-    named = [m for m in models if m.joint is not None and m.joint.law != "sparse" and not _contradicts(m)]
-    sparse = [m for m in models if m.joint is not None and m.joint.law == "sparse"]
-    best = min(named, key=_score) if named else None
-    if sparse and (best is None or _score(sparse[0]) < (1 - SPARSE_MARGIN) * _score(best)):
-        best = sparse[0]
-    return best if best is not None else models[0]
-
-
-def _score(model) -> float:
-    """Mean NRMSE of a model's fit table over every recording and channel (inf without a joint)."""
-    return float(np.mean(model.fit["nonlinear"])) if model.joint is not None else np.inf
-
-
-#: law -> its coefficients whose sign the name fixes (positive, as a force that restores or resists): a saturating
-#: spring with k_sat < 0 stiffens with the stroke, a clearance with k_contact < 0 gives way beyond its gap, a
-#: friction or a quadratic damping of negative sign feeds the structure energy (on an independent chain with a
-#: saturating joint, a giving clearance simulated the levels best and was named a clearance; on frames and beams
-#: with cubic joints, a stiffening saturating spring in relative units was named softening)
-NAMED_SIGN = {"softening": ("k_sat",), "clearance": ("k_contact",), "friction": ("k_stick", "f_slip"),
-              "quadratic_damping": ("c2",)}
-
-
-def _contradicts(model) -> bool:
-    """A law fitted with the sign its name excludes (`NAMED_SIGN`): not that law, whatever it fits. In newtons the
-    coefficient's own sign; in relative units its sign times the path's where the modes' shapes give that
-    (`newtons.path_sign`); otherwise open, and the law is kept."""
-    joint = model.joint
-    values = joint.parameters() if joint.law in NAMED_SIGN else {}
-    signed = [values[k] for k in NAMED_SIGN.get(joint.law, ()) if k in values]
-    if not signed:
-        return False
-    sign = 1 if joint.units == "N" else path_sign(model)
-    return any(sign * v < 0 for v in signed)
 
 
 def _fit_span(recording) -> int:

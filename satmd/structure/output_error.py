@@ -66,7 +66,8 @@ def output_error(model, drives, ref, max_nfev, fixed_path=False) -> StructureMod
             ci[names[i]] = [float(c) - h, float(c) + h]
     for k, i in enumerate(shaped):  # a shape constant was fitted in log: its interval is a factor either side
         h = float(half[n_free + k])
-        ci[names[n_c + k]] = [float(joint.aux[i] * np.exp(-h)), float(joint.aux[i] * np.exp(h))]
+        with np.errstate(over="ignore"):  # a shape the records leave open: its interval is unbounded, [0, inf]
+            ci[names[n_c + k]] = [float(joint.aux[i] * np.exp(-h)), float(joint.aux[i] * np.exp(h))]
     return replace(model, joint=replace(joint, ci95=ci))
 
 

@@ -40,7 +40,7 @@ def test_the_best_fitting_law_is_kept_and_the_sparse_library_only_by_a_margin():
     """`best_fitting`: the model that simulates the recordings best; a sparse law's extra terms must earn their keep."""
     from types import SimpleNamespace
 
-    from satmd.structure.fit import SPARSE_MARGIN, best_fitting
+    from satmd.structure.choice import SPARSE_MARGIN, best_fitting
 
     def model(law, nrmse):
         return SimpleNamespace(joint=SimpleNamespace(law=law, units="relative", parameters=dict),
@@ -107,7 +107,7 @@ def test_a_saturating_spring_that_stiffens_is_no_softening():
     the stroke: not the law its name says; a friction or a quadratic damping of negative sign feeds energy in."""
     from types import SimpleNamespace
 
-    from satmd.structure.fit import best_fitting
+    from satmd.structure.choice import best_fitting
 
     def model(law, nrmse, units="N", sign=None, **par):
         joint = SimpleNamespace(law=law, units=units, parameters=lambda: par)
@@ -140,7 +140,7 @@ def test_a_clearance_whose_contact_gives_way_is_no_clearance():
     """In newtons a negative contact stiffness softens beyond the gap: a clearance only closes (SPEC §11)."""
     from types import SimpleNamespace
 
-    from satmd.structure.fit import best_fitting
+    from satmd.structure.choice import best_fitting
 
     def model(law, nrmse, **par):
         joint = SimpleNamespace(law=law, units="N", parameters=lambda: par)
