@@ -107,8 +107,7 @@ def fit_structure(recordings, between=None, law: str | None = None, channels=Non
         if not place_given and len(recordings) >= 3:
             laws = [law] if law_given else ranked_laws(fitted)[:PLACE_LAWS]
             others = [] if law_given else [w for w in weighed if w not in laws]
-            return best_place(fit, loc, [model] if law_given else fitted, laws, others, files,
-                              lambda m: fit.finished(m, free_path, files))
+            model = best_place(fit, loc, model, laws, others, files)
     else:
         model = fit.law(tuple(between), law, files)
     return fit.finished(model, free_path, files)

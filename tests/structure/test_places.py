@@ -1,24 +1,20 @@
-"""The joint's place when the levels' spectra and a simulation of the levels disagree (`choice.best_place`): the
-next places within reach of the best are fitted on every level, each place's best is finished, and the place whose
-finished model simulates the levels best is kept."""
+"""The joint's place when the levels' spectra and a simulation of the levels disagree (`choice.best_place`): the next
+places within reach of the best are fitted on every level, and the one that simulates them best is kept."""
 from __future__ import annotations
-
-from dataclasses import replace
 
 import numpy as np
 
 from satmd.structure import Joint, JointLocation, LinearStructure, StructureModel
-from satmd.structure.choice import best_place, ranked_laws
+from satmd.structure.choice import best_place
 
 LINEAR = LinearStructure(("acc1", "acc2", "acc3"), np.array([-1.0 + 60j]), np.ones((3, 1), complex), np.zeros(3))
 
 
 class _Fits:
-    """`fit._Fit` as `best_place` uses it: a model per (place, law) with a given mean NRMSE, and that model
-    finished with another (``done``, default the same), each call noted."""
+    """`fit._Fit` as `best_place` uses it: a model per (place, law) with a given mean NRMSE, each call noted."""
 
-    def __init__(self, scores, done=None):
-        self.scores, self.done, self.calls, self.finished = scores, done or {}, [], []
+    def __init__(self, scores):
+        self.scores, self.calls = scores, []
 
     @staticmethod
     def say(text):
@@ -29,11 +25,6 @@ class _Fits:
         joint = Joint(tuple(between), law, np.array([1.0, 0.0, 0.0]), np.ones(3), np.ones(1, complex), "N")
         return StructureModel(LINEAR, joint, (1.0, 8.0), fit={"nonlinear": [[self.scores[(tuple(between), law)]]]})
 
-    def finish(self, model):
-        key = (model.joint.between, model.joint.law)
-        self.finished.append(key)
-        return replace(model, fit={"nonlinear": [[self.done.get(key, self.scores[key])]]})
-
 
 def _located(next_gap):
     places = [("acc1", "acc2"), ("acc2", "acc3"), ("acc1", "ground")]
@@ -43,61 +34,31 @@ def _located(next_gap):
                          [], [], "L1", [1.0, 8.0], evidence=1000.0)
 
 
-def _score(model):
-    return model.fit["nonlinear"][0][0]
-
-
 def test_a_next_place_that_simulates_the_levels_better_is_kept_and_its_law_weighed():
     fits = _Fits({(("acc1", "acc2"), "cubic"): 0.05, (("acc2", "acc3"), "cubic"): 0.03,
-                  (("acc2", "acc3"), "softening"): 0.02, (("acc2", "acc3"), "friction"): 0.04},
-                 done={(("acc2", "acc3"), "softening"): 0.015})
+                  (("acc2", "acc3"), "softening"): 0.02, (("acc2", "acc3"), "friction"): 0.04})
     model = fits.law(("acc1", "acc2"), "cubic", None)
-    chosen = best_place(fits, _located(50.0), [model], ["cubic"], ["softening", "friction"], None, fits.finish)
-    assert chosen.joint.between == ("acc2", "acc3") and chosen.joint.law == "softening" and _score(chosen) == 0.015
+    chosen = best_place(fits, _located(50.0), model, ["cubic"], ["softening", "friction"], None)
+    assert chosen.joint.between == ("acc2", "acc3") and chosen.joint.law == "softening"
     # the third place is 5000 behind (over a tenth of the evidence, 1000): not simulated
     assert fits.calls[1:] == [(("acc2", "acc3"), "cubic"), (("acc2", "acc3"), "softening"), (("acc2", "acc3"), "friction")]
-    # every place's laws finished, then the laws weighed at the place kept, finished too
-    assert fits.finished == [(("acc1", "acc2"), "cubic"), (("acc2", "acc3"), "cubic"), (("acc2", "acc3"), "softening"),
-                             (("acc2", "acc3"), "friction")]
 
 
-def test_places_are_compared_finished():
-    """A next place that simulates the levels worse on its first fit but better finished is kept (a chain's
-    clearance: the ground's place closer before the paths were freed, the true place after)."""
-    fits = _Fits({(("acc1", "acc2"), "cubic"): 0.05, (("acc2", "acc3"), "cubic"): 0.07},
-                 done={(("acc1", "acc2"), "cubic"): 0.045, (("acc2", "acc3"), "cubic"): 0.03})
-    model = fits.law(("acc1", "acc2"), "cubic", None)
-    chosen = best_place(fits, _located(50.0), [model], ["cubic"], [], None, fits.finish)
-    assert chosen.joint.between == ("acc2", "acc3") and _score(chosen) == 0.03
-    fits.done[(("acc2", "acc3"), "cubic")] = 0.06  # finished and still worse: the best place stays
-    fits.finished.clear()
-    chosen = best_place(fits, _located(50.0), [model], ["cubic"], [], None, fits.finish)
-    assert chosen.joint.between == ("acc1", "acc2") and _score(chosen) == 0.045 and len(fits.finished) == 2
-
-
-def test_the_best_place_stays_where_no_next_place_simulates_better_or_none_is_near():
+def test_thebest_place_stays_where_no_next_place_simulates_better_or_none_is_near():
     fits = _Fits({(("acc1", "acc2"), "cubic"): 0.02, (("acc2", "acc3"), "cubic"): 0.03})
     model = fits.law(("acc1", "acc2"), "cubic", None)
-    chosen = best_place(fits, _located(50.0), [model], ["cubic"], ["softening"], None, fits.finish)
-    assert chosen.joint.between == ("acc1", "acc2") and _score(chosen) == 0.02
+    assert best_place(fits, _located(50.0), model, ["cubic"], ["softening"], None) is model
     assert fits.calls[1:] == [(("acc2", "acc3"), "cubic")]  # no law weighed at a place not kept
-    far = _Fits({(("acc1", "acc2"), "cubic"): 0.02})
-    chosen = best_place(far, _located(500.0), [model], ["cubic"], ["softening"], None, far.finish)
-    assert far.calls == [] and far.finished == [(("acc1", "acc2"), "cubic")]  # no rival: the model finished alone
-    given = _Fits({**fits.scores, (("acc2", "acc3"), "friction"): 0.01})  # a law given: fitted there, none weighed
-    chosen = best_place(given, _located(50.0), [model], ["friction"], [], None, given.finish)
+    far = _Fits({})
+    assert best_place(far, _located(500.0), model, ["cubic"], ["softening"], None) is model and far.calls == []
+    given = _Fits({(("acc2", "acc3"), "friction"): 0.01})  # a law given: the next place fitted with it, none weighed
+    chosen = best_place(given, _located(50.0), model, ["friction"], [], None)
     assert chosen.joint.between == ("acc2", "acc3") and given.calls == [(("acc2", "acc3"), "friction")]
 
 
 def test_the_laws_tried_at_a_next_place_are_the_best_simulated_named_ones():
+    from satmd.structure.choice import ranked_laws
+
     fits = _Fits({(("acc1", "acc2"), w): x for w, x in (("sparse", 0.01), ("cubic", 0.04), ("friction", 0.02))})
     models = [fits.law(("acc1", "acc2"), w, None) for w in ("sparse", "cubic", "friction")]
     assert ranked_laws(models) == ["friction", "cubic", "sparse"]
-
-
-def test_the_best_place_laws_are_compared_finished_with_no_next_place_near():
-    fits = _Fits({(("acc1", "acc2"), "cubic"): 0.05, (("acc1", "acc2"), "softening"): 0.06},
-                 done={(("acc1", "acc2"), "softening"): 0.04})
-    fitted = [fits.law(("acc1", "acc2"), w, None) for w in ("cubic", "softening")]
-    chosen = best_place(fits, _located(500.0), fitted, ["cubic", "softening"], ["friction"], None, fits.finish)
-    assert chosen.joint.law == "softening" and _score(chosen) == 0.04 and len(fits.finished) == 2
