@@ -34,18 +34,14 @@ def best_place(fit, loc, model, laws, others, files):
     fit.say(f"the next {len(rivals)} place(s) by the spectra ({', '.join(' and '.join(p) for p in rivals)}), "
             f"{' and '.join(laws)} fitted at each on every level ...")
     tried = [model, *[fit.law(p, w, files) for p in rivals for w in laws]]
-    fit.say(_scores(tried))
+    fit.say("; ".join(f"{' and '.join(m.joint.between)} ({m.joint.law}): mean NRMSE {score(m):.4f}"
+                      for m in tried if m.joint is not None))
     best = best_fitting(tried)
     if best.joint is None or best.joint.between == model.joint.between or not others:
         return best
     fit.say(f"{', '.join(others)} between {best.joint.between[0]} and {best.joint.between[1]}: each fitted ...")
     here = [m for m in tried if m.joint is not None and m.joint.between == best.joint.between]
     return best_fitting([*here, *[fit.law(best.joint.between, w, files) for w in others]])
-
-
-def _scores(models) -> str:
-    return "; ".join(f"{' and '.join(m.joint.between)} ({m.joint.law}): mean NRMSE {score(m):.4f}"
-                     for m in models if m.joint is not None)
 
 
 def ranked_laws(models) -> list:
