@@ -61,8 +61,10 @@ class Joint:
         misfit to the modes' shapes too); empty when not estimated
     form : the law's own terms in the form it takes (`JointLaw.forms`; a friction's stick-slip contact or its
         memoryless Coulomb force); empty: the law's first form
-    column : (C, n) complex residues of the joint's force at each channel off the pair, re-solved from the
-        recordings (`outputs.resolved_outputs`); None: the force's scaled per mode by κ, as at the pair (`column_of`)
+    column : (C, n) complex residues of the joint's force at each channel, re-solved from the recordings
+        (`outputs.resolved_outputs`); None: the force's scaled per mode by κ (`column_of`)
+    stroke : (n,) complex accelerance residues of the stroke per unit force, kept when the channels' own were
+        re-solved (`outputs.resolved_outputs`); None: the pair's difference of the channels' (`stroke_of`)
     """
 
     between: tuple
@@ -74,6 +76,7 @@ class Joint:
     ci95: dict = field(default_factory=dict)
     form: tuple = ()
     column: np.ndarray | None = None
+    stroke: np.ndarray | None = None
 
     @property
     def law_form(self):
@@ -98,20 +101,22 @@ class Joint:
         return self.law_form.formula(self.coefficients, self.aux)
 
     def column_of(self, linear: LinearStructure) -> np.ndarray:
-        """(C, n) the joint's force's residues at each channel of ``linear``: the force's times κ at the pair's
-        own channels (their residues are the stroke), ``column`` at the others where it was re-solved."""
-        scaled = linear.residues * self.coupling[None, :]
-        if self.column is None:
-            return scaled
-        own = np.isin(np.array(linear.channels), np.array(self.between))[:, None]
-        return np.where(own, scaled, self.column)
+        """(C, n) the joint's force's residues at each channel of ``linear``: ``column`` where it was re-solved,
+        else the force's times κ."""
+        return linear.residues * self.coupling[None, :] if self.column is None else self.column
+
+    def stroke_of(self, linear: LinearStructure) -> np.ndarray:
+        """(n,) the stroke's residues per unit force: ``stroke`` where the channels were re-solved, else the
+        difference of the pair's."""
+        return linear.pair_residues(*self.between) if self.stroke is None else self.stroke
 
     def to_dict(self) -> dict:
         return {"between": list(self.between), "law": self.law, "terms": list(self.terms),
                 "coefficients": [float(c) for c in self.coefficients], "aux": [float(a) for a in self.aux],
                 "coupling": [[float(k.real), float(k.imag)] for k in self.coupling], "units": self.units,
                 "formula": self.formula(), "ci95": {k: [float(x) for x in v] for k, v in self.ci95.items()}} | (
-                    {} if self.column is None else {"column": [as_pairs(r) for r in self.column]})
+                    {} if self.column is None else {"column": [as_pairs(r) for r in self.column]}) | (
+                    {} if self.stroke is None else {"stroke": as_pairs(self.stroke)})
 
     @classmethod
     def from_dict(cls, d: dict) -> "Joint":
@@ -127,7 +132,8 @@ class Joint:
         joint = cls(tuple(d["between"]), str(d["law"]), np.asarray(d["coefficients"], float),
                     np.asarray(d["aux"], float), k[:, 0] + 1j * k[:, 1], str(d.get("units", "relative")),
                     {str(n): [float(x) for x in v] for n, v in (d.get("ci95") or {}).items()}, form,
-                    None if d.get("column") is None else np.array([from_pairs(r) for r in d["column"]]))
+                    None if d.get("column") is None else np.array([from_pairs(r) for r in d["column"]]),
+                    None if d.get("stroke") is None else from_pairs(d["stroke"]))
         if not joint.coefficients.size == joint.aux.size == len(joint.terms):
             raise ValueError(f"{joint.coefficients.size} coefficients and {joint.aux.size} shape constants for the "
                              f"terms {', '.join(joint.terms)}")
@@ -274,6 +280,8 @@ class StructureModel:
         joint = None if d.get("joint") is None else Joint.from_dict(d["joint"])
         if joint is not None and joint.column is not None and joint.column.shape != linear.residues.shape:
             raise ValueError(f"the joint's column is {joint.column.shape}, the residues {linear.residues.shape}")
+        if joint is not None and joint.stroke is not None and joint.stroke.shape != linear.poles.shape:
+            raise ValueError(f"the joint's stroke has {joint.stroke.size} residues for {linear.poles.size} poles")
         return cls(linear, joint, tuple(d["levels"]), d.get("fit", {}),
                    d.get("units", {"force": "N", "response": "m/s²"}), d.get("driving_point"),
                    int(d.get("oversample", 4)),
@@ -354,7 +362,7 @@ class Drive:
             uf = band_limited(upsample(u, r), fine) if r > 1 else band_limited(u, fs_hz)
             x = modal_states(uf, lin.poles, fine)
             self.psi, self.G0, self.G1 = discretise(lin.poles, fine)
-            self.pair = p = lin.pair_residues(*model.joint.between)
+            self.pair = p = model.joint.stroke_of(lin)
             self.dF, self.vF = response(x, p / lin.poles ** 2), response(x, p / lin.poles)
 
     def outputs(self, joint: Joint | None, step: int = 1) -> np.ndarray:

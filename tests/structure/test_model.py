@@ -165,7 +165,7 @@ def test_a_fitted_model_predicts_a_level_it_never_saw(cubic_levels, cubic_model)
     assert lo < CUBIC < hi < 2 * lo and lo < k3 < hi and set(m.joint.ci95) == {"k3", "k", "c"}
 
 
-def test_a_path_off_the_modes_is_fitted_back(cubic_levels, cubic_model):
+def test_a_path_off_the_modes_is_fitted_back(cubic_levels):
     """The output-error fit with the path free (`fit_structure`'s last stage) puts back a path that the start
     found 40 % off on every other mode; the law's coefficients alone cannot."""
     from dataclasses import replace
@@ -173,7 +173,12 @@ def test_a_path_off_the_modes_is_fitted_back(cubic_levels, cubic_model):
     from satmd.structure.fit import _cost, _drives, _fit_span
     from satmd.structure.output_error import output_error
 
-    m, recs = cubic_model, [cubic_levels[0], cubic_levels[2]]
+    # the model as it was before its channels were re-solved (the path then reaches every channel through κ)
+    with pytest.MonkeyPatch.context() as patch:
+        patch.setattr("satmd.structure.fit.resolved_outputs", lambda model, drives: model)
+        m = fit_structure([cubic_levels[0], cubic_levels[2]])
+    assert m.joint.column is None and m.joint.stroke is None
+    recs = [cubic_levels[0], cubic_levels[2]]
     span = [_fit_span(r) for r in recs]
     measured = [np.array([np.asarray(r[c], float)[:n] for c in m.channels]) for r, n in zip(recs, span)]
     k = m.joint.coupling.copy()
@@ -377,7 +382,7 @@ def test_the_modes_above_the_band_reach_into_it_as_a_flexibility():
 def test_the_channels_off_the_pair_are_re_solved_on_every_level(cubic_levels, cubic_model):
     """`resolved_outputs`: a channel off the joint's pair whose residues and joint's column are off (10 % and 20°,
     the column 30 % low) misses the chain's level 3 by 0.38 (1 % noise); re-solved on levels 1 and 8 it comes back
-    to the noise at level 3, which it did not see (0.011). The pair's own residues (the joint's stroke) are not touched."""
+    to the noise at level 3, which it did not see (0.011). The joint's stroke is kept."""
     from dataclasses import replace
 
     from satmd.structure.outputs import resolved_outputs
@@ -395,6 +400,31 @@ def test_the_channels_off_the_pair_are_re_solved_on_every_level(cubic_levels, cu
     again = resolved_outputs(off, drives)
     before, after = off.predict(cubic_levels[1]).nrmse[i], again.predict(cubic_levels[1]).nrmse[i]
     assert before > 0.1 and after < 0.013, (before, after)
-    pair = [lin.index(c) for c in m.joint.between]
-    assert np.array_equal(again.linear.residues[pair], residues[pair])
-    assert np.array_equal(again.joint.column_of(again.linear)[pair], again.linear.residues[pair] * m.joint.coupling)
+    assert np.array_equal(again.joint.stroke_of(again.linear), off.joint.stroke_of(off.linear))
+
+
+def test_the_pair_s_sensors_are_re_solved_their_stroke_kept(cubic_levels, cubic_model):
+    """`resolved_outputs` on the joint's own sensors: both off by the same residues and joint's column (15 % of the
+    second's, at 40°), the stroke and so the joint's force exact, they miss level 3 (which the re-solve does not
+    see); re-solved on levels 1 and 8 they come back to the noise (1 %), and the stroke is kept as it was."""
+    from dataclasses import replace
+
+    from satmd.structure.outputs import resolved_outputs
+    from satmd.structure.spectra import drive_force
+
+    m = cubic_model
+    lin, (a, b) = m.linear, m.joint.between
+    ia, ib = lin.index(a), lin.index(b)
+    residues, column = lin.residues.copy(), m.joint.column_of(lin).copy()
+    shift = 0.15 * np.exp(0.7j) * residues[ib]
+    residues[[ia, ib]] += shift
+    column[[ia, ib]] += 0.15 * np.exp(0.7j) * column[ib]
+    off = replace(m, linear=replace(lin, residues=residues), joint=replace(m.joint, column=column))
+    drives = [(Drive(off, drive_force(r), r.fs_hz, 0), np.array([np.asarray(r[c], float) for c in m.channels]))
+              for r in (cubic_levels[0], cubic_levels[2])]
+    again = resolved_outputs(off, drives)
+    before, after = off.predict(cubic_levels[1]).nrmse, again.predict(cubic_levels[1]).nrmse
+    assert before[ib] > 0.05 and max(after[ia], after[ib]) < 0.013, (before, after)
+    assert np.array_equal(again.joint.stroke_of(again.linear), m.joint.stroke_of(lin))
+    saved = StructureModel.from_dict(json.loads(json.dumps(again.to_dict())))
+    assert np.allclose(saved.predict(cubic_levels[1]).nrmse, after, rtol=1e-9)
