@@ -10,8 +10,8 @@ RMS, as the fit weighs them), exact given the joint, the poles kept. The joint's
 too: the stroke the joint feels was fitted as their difference (`linear.fit_linear`) and is kept as it was
 (`Joint.stroke`), so their residues say what each sensor measures without moving the joint's force. On an
 independent frame with a cubic joint at the driving point, a channel that the shared path left at 3× the noise
-at every level came to 1.3×; on independent ground vibration tests, a wing's payload at the joint's end went from
-0.063 to 0.042 at level 2 (its noise 0.012), a chain's friction joint's sensor from 0.22 to 0.14 at level 6.
+at every level came to 1.3×; on independent ground vibration tests, a wing's sensor at one end of a friction
+joint went from 0.063 to 0.042 at its worst held-out level (its noise 0.012), a chain's from 0.22 to 0.14.
 """
 from __future__ import annotations
 
