@@ -39,7 +39,10 @@ from .laws import law as law_named
 from .linear import LinearStructure, as_pairs, discretise, from_pairs, modal_states, response
 from .spectra import drive_force, warmup_of
 
-SCHEMA = "satmd-structure-model/1"
+SCHEMA = "satmd-structure-model/2"
+#: the schemas a model may be read from: /1 had no ``stroke`` (the pair's residues were never re-solved), so a
+#: reader of /1 would take /2's re-solved residues for the stroke
+SCHEMAS = ("satmd-structure-model/1", SCHEMA)
 PREDICTION_SCHEMA = "satmd-prediction/1"
 
 
@@ -274,7 +277,7 @@ class StructureModel:
 
     @classmethod
     def from_dict(cls, d: dict) -> "StructureModel":
-        if d.get("schema") != SCHEMA:
+        if d.get("schema") not in SCHEMAS:
             raise DataError(f"not a structure model (schema {d.get('schema')!r}, expected {SCHEMA!r})")
         linear = LinearStructure.from_dict(d["linear"])
         joint = None if d.get("joint") is None else Joint.from_dict(d["joint"])

@@ -219,11 +219,28 @@ def test_a_saved_model_loads_and_predicts_the_same(cubic_levels, cubic_model, tm
     path = tmp_path / "model.json"
     cubic_model.save(path)
     doc = json.loads(path.read_text())
-    assert doc["schema"] == "satmd-structure-model/1" and doc["joint"]["between"] == ["acc3", "acc4"]
+    assert doc["schema"] == "satmd-structure-model/2" and doc["joint"]["between"] == ["acc3", "acc4"]
     again = StructureModel.load(path)
     assert again.joint.ci95 == cubic_model.joint.ci95
     assert np.array_equal(again.joint.column, cubic_model.joint.column)
+    assert np.array_equal(again.joint.stroke, cubic_model.joint.stroke)
     assert again.predict(cubic_levels[1]).nrmse == pytest.approx(cubic_model.predict(cubic_levels[1]).nrmse, rel=1e-9)
+
+
+def test_a_model_saved_before_the_stroke_was_kept_loads(cubic_levels, cubic_model, tmp_path):
+    """A /1 model (no stroke: its pair's residues were the stroke) reads as it was written."""
+    doc = cubic_model.to_dict()
+    stroke = cubic_model.joint.stroke
+    a, b = (cubic_model.linear.index(c) for c in cubic_model.joint.between)
+    residues = cubic_model.linear.residues.copy()
+    residues[a] = residues[b] + stroke  # the pair's difference is the stroke, as /1 had it
+    doc["linear"]["residues"][a] = [[float(x.real), float(x.imag)] for x in residues[a]]
+    del doc["joint"]["stroke"]
+    doc["schema"] = "satmd-structure-model/1"
+    (tmp_path / "old.json").write_text(json.dumps(doc))
+    old = StructureModel.load(tmp_path / "old.json")
+    assert old.joint.stroke is None
+    assert np.allclose(old.joint.stroke_of(old.linear), stroke, rtol=1e-12, atol=0)
 
 
 def test_bad_models_and_recordings_are_refused(cubic_levels, cubic_model, tmp_path):
