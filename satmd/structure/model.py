@@ -148,10 +148,10 @@ class Prediction:
     """A model's simulation of one recording: NRMSE per channel, nonlinear and linear (SPEC §11).
 
     ``signals`` holds the measured, linear and nonlinear responses {channel: (3, N)} for figures. A simulation
-    with the joint that ran away (the model is not stable at this level) has NRMSE inf. ``above_band`` splits
-    the NRMSE by frequency (`bands`): the error above the force's band (``band_top_hz``) and the measured
-    response there, per channel, each over the channel's RMS: a model that predicts no harmonics misses by the
-    second at least."""
+    with the joint that ran away (the model is not stable at this level: no finite force, or a response a
+    million times the measured one, `RAN_AWAY`) has NRMSE inf. ``above_band`` splits the NRMSE by frequency
+    (`bands`): the error above the force's band (``band_top_hz``) and the measured response there, per channel,
+    each over the channel's RMS: a model that predicts no harmonics misses by the second at least."""
 
     file: str
     level: float
@@ -334,9 +334,12 @@ def nrmse(simulated, measured) -> float:
     return float(np.sqrt(np.mean((np.asarray(simulated, float) - m) ** 2)) / scale)
 
 
+RAN_AWAY = 1e6  # an NRMSE beyond it is a simulation that grew without bound within the record, not a prediction
+
+
 def _finite_nrmse(simulated, measured) -> float:
     value = nrmse(simulated, measured)
-    return value if np.isfinite(value) else float("inf")
+    return value if np.isfinite(value) and value < RAN_AWAY else float("inf")
 
 
 class Drive:

@@ -445,3 +445,15 @@ def test_the_pair_s_sensors_are_re_solved_their_stroke_kept(cubic_levels, cubic_
     assert np.array_equal(again.joint.stroke_of(again.linear), m.joint.stroke_of(lin))
     saved = StructureModel.from_dict(json.loads(json.dumps(again.to_dict())))
     assert np.allclose(saved.predict(cubic_levels[1]).nrmse, after, rtol=1e-9)
+
+
+def test_a_simulation_that_grew_without_bound_is_called_run_away():
+    """A finite response a million times the measured one (an unstable joint growing over the record, 5e30 on an
+    independent chain's friction joint at 12 times its lowest level) is no prediction: NRMSE inf, as a force
+    with no finite solution is."""
+    from satmd.structure.model import RAN_AWAY, _finite_nrmse
+
+    measured = np.sin(2 * np.pi * 5 * np.arange(500) / 500)
+    assert _finite_nrmse(1.5 * measured, measured) == pytest.approx(0.5)
+    assert _finite_nrmse(2 * RAN_AWAY * measured, measured) == float("inf")
+    assert _finite_nrmse(np.full(500, np.nan), measured) == float("inf")
