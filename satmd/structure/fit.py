@@ -282,8 +282,9 @@ def _redrive(drive, model):
 
 
 def _cost(model, drives) -> float:
-    total = float(sum(np.sum(((d.outputs(model.joint) - m) / m.std(axis=1, keepdims=True)) ** 2) / m.size
-                      for d, m in drives))
+    with np.errstate(over="ignore", invalid="ignore"):  # a candidate that runs away costs inf, said by no warning
+        total = float(sum(np.sum(((d.outputs(model.joint) - m) / m.std(axis=1, keepdims=True)) ** 2) / m.size
+                          for d, m in drives))
     return total if np.isfinite(total) else np.inf
 
 

@@ -457,3 +457,18 @@ def test_a_simulation_that_grew_without_bound_is_called_run_away():
     assert _finite_nrmse(1.5 * measured, measured) == pytest.approx(0.5)
     assert _finite_nrmse(2 * RAN_AWAY * measured, measured) == float("inf")
     assert _finite_nrmse(np.full(500, np.nan), measured) == float("inf")
+
+
+def test_a_candidate_that_runs_away_costs_inf_without_a_warning():
+    """The fit weighs candidates by `_cost`; one whose response overflows is out, and the user sees no numpy
+    overflow warning for it (the F-16's `discover` printed two)."""
+    import warnings
+    from types import SimpleNamespace
+
+    from satmd.structure.fit import _cost
+
+    measured = np.array([[1.0, -1.0, 2.0, -2.0]])
+    drive = SimpleNamespace(outputs=lambda joint: np.full((1, 4), 1e200))
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        assert _cost(SimpleNamespace(joint=None), [(drive, measured)]) == float("inf")
