@@ -183,6 +183,8 @@ class Prediction:
         flag = " (extrapolated: outside the fitted levels)" if self.extrapolated else ""
         rows = ", ".join(f"{c} {n:.3f} (linear {ln:.3f})" for c, n, ln in zip(self.channels, self.nrmse, self.linear_nrmse))
         text = f"{self.file}: force {self.level:.4g} N RMS{flag}; NRMSE {rows}"
+        if not all(np.isfinite(self.nrmse)):
+            text += "; the simulation ran away: the model is not stable at this level"
         there = self.above_band.get("measured", [])
         if there and max(there) >= SHOWN_ABOVE:
             text += (f"; above the force's band ({self.band_top_hz:.4g} Hz) the measured response is "
