@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from satmd.structure import Joint, JointLocation, LinearStructure, StructureModel
-from satmd.structure.choice import best_place
+from satmd.structure.choice import best_place, ranked_laws
 
 LINEAR = LinearStructure(("acc1", "acc2", "acc3"), np.array([-1.0 + 60j]), np.ones((3, 1), complex), np.zeros(3))
 
@@ -44,7 +44,7 @@ def test_a_next_place_that_simulates_the_levels_better_is_kept_and_its_law_weigh
     assert fits.calls[1:] == [(("acc2", "acc3"), "cubic"), (("acc2", "acc3"), "softening"), (("acc2", "acc3"), "friction")]
 
 
-def test_thebest_place_stays_where_no_next_place_simulates_better_or_none_is_near():
+def test_the_best_place_stays_where_no_next_place_simulates_better_or_none_is_near():
     fits = _Fits({(("acc1", "acc2"), "cubic"): 0.02, (("acc2", "acc3"), "cubic"): 0.03})
     model = fits.law(("acc1", "acc2"), "cubic", None)
     assert best_place(fits, _located(50.0), model, ["cubic"], ["softening"], None) is model
@@ -57,8 +57,6 @@ def test_thebest_place_stays_where_no_next_place_simulates_better_or_none_is_nea
 
 
 def test_the_laws_tried_at_a_next_place_are_the_best_simulated_named_ones():
-    from satmd.structure.choice import ranked_laws
-
     fits = _Fits({(("acc1", "acc2"), w): x for w, x in (("sparse", 0.01), ("cubic", 0.04), ("friction", 0.02))})
     models = [fits.law(("acc1", "acc2"), w, None) for w in ("sparse", "cubic", "friction")]
     assert ranked_laws(models) == ["friction", "cubic", "sparse"]
