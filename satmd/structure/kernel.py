@@ -51,6 +51,8 @@ def joint_states(psi, G0, G1, rd, rv, dF, vF, codes, coefs, aux, first, stride):
     g : (N,) float, as `joint_force`
     states : (n, M) complex at the samples asked for; none (M = 0) when ``stride`` is 0
     """
+    if not len(codes) == len(coefs) == len(aux):  # the compiled pass reads past an array's end unchecked
+        raise ValueError(f"{len(codes)} terms, {len(coefs)} coefficients and {len(aux)} shape constants")
     args = (psi, G0, G1, rd, rv, dF, vF, codes, coefs, aux, int(first), int(stride))
     if _compiled() is not None:
         return _compiled()(*args)

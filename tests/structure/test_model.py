@@ -87,8 +87,10 @@ def test_the_pass_keeps_the_states_the_joint_s_force_drives():
     psi, G0, G1 = discretise(poles, 400.0)
     rd, rv = 1e-3 * (rng.standard_normal(3) + 1j), 1e-2 * (rng.standard_normal(3) + 1j)
     dF, vF = 1e-3 * rng.standard_normal(1001), 1e-2 * rng.standard_normal(1001)
-    law_ = LAWS["cubic"].variants()[0]
-    args = (psi, G0, G1, rd, rv, dF, vF, law_.codes, np.array([2e5, 30.0]), np.array([1.0, 1.0]))
+    law_ = LAWS["cubic"].variants()[0]  # d³, d, v: one coefficient each (two had the compiled pass read past the end)
+    args = (psi, G0, G1, rd, rv, dF, vF, law_.codes, np.array([2e5, 30.0, 0.0]), np.array([1.0, 1.0, 1.0]))
+    with pytest.raises(ValueError, match="3 terms, 2 coefficients"):
+        joint_states(*args[:8], args[8][:2], args[9], 0, 1)
     for first, stride in ((0, 1), (5, 4), (999, 7), (1001, 2)):
         g, states = joint_states(*args, first, stride)
         expected = modal_states(g, poles, 400.0)[:, first::stride]
