@@ -27,7 +27,7 @@ GAIN = 1e6             # κ of a mode the joint alone drives over the largest of
 MIN_GAIN = 0.3         # the fit must explain this share of what the model leaves above the band
 
 
-def above_band(model, spectra):
+def above_band(model, spectra, apart: float = 0.0):
     """``model`` with modes above the force's band that the joint's harmonics drive, where they explain most
     of what the model leaves at the lines above the band (on every level but the lowest); else ``model``.
 
@@ -35,6 +35,9 @@ def above_band(model, spectra):
     ----------
     model : StructureModel with a joint (its start: coefficients and path from the spectra)
     spectra : the levels' `PeriodicSpectra` (with each channel's whole spectrum, `PeriodicSpectra.whole`)
+    apart : a set of added modes is refused where one lies within this share of another's frequency (0: none
+        refused). A cluster of lightly damped poles can fit the harmonics of the fitted levels and ring at
+        others (`fit.fit_structure` finishes the model both ways and keeps the one that simulates best)
 
     Returns
     -------
@@ -49,6 +52,7 @@ def above_band(model, spectra):
     before = sum(float(np.sum(np.abs(E * W) ** 2)) for _, _, E, W, _ in blocks)
     best, best_rss = None, before
     band_top = band_top_hz(spectra)
+    lin = model.linear
     for pairs in range(1, MAX_PAIRS + 1):
         try:
             poles, _, _ = vector_fit_inputs([(f, G[None, :], E, W) for f, G, E, W, _ in blocks], pairs)
@@ -57,7 +61,7 @@ def above_band(model, spectra):
         f_hz = poles.imag / (2 * np.pi)
         zeta = -poles.real / np.maximum(np.abs(poles), TINY)
         poles = poles[(f_hz > band_top) & (zeta > 0) & (zeta < 0.3)]
-        if poles.size == 0:
+        if poles.size == 0 or _crowded(poles, lin.poles, apart):
             continue
         T, rss = _residues(poles, blocks)
         n_rows = sum(2 * E.size for _, _, E, _, _ in blocks)
@@ -67,7 +71,6 @@ def above_band(model, spectra):
     if best is None or best_rss > (1 - MIN_GAIN) * before:
         return model
     poles, T = best
-    lin = model.linear
     kappa = np.asarray(model.joint.coupling, complex)
     # in relative units the path's size is the joint force's unit (on a chain 1e9-1e11): a gain of 1e6 alone let
     # the shaker drive the added modes 1e4 times harder than the joint does, and the linear part ran away
@@ -76,6 +79,15 @@ def above_band(model, spectra):
                             np.hstack([lin.residues, T / gain]), lin.feedthrough)
     joint = replace(model.joint, coupling=np.concatenate([kappa, np.full(poles.size, gain, complex)]))
     return replace(model, linear=extra, joint=joint)
+
+
+def _crowded(added, poles, apart: float) -> bool:
+    """Whether an added pole lies within ``apart`` (a share of its frequency) of another added one or of ``poles``."""
+    if apart <= 0:
+        return False
+    f_added, f_all = np.abs(added), np.abs(np.concatenate([added, poles]))
+    near = np.abs(f_added[:, None] - f_all[None, :]) <= apart * f_added[:, None]
+    return bool(np.any(near.sum(axis=1) > 1))  # each added pole is near itself
 
 
 def _block(model, s):

@@ -108,3 +108,46 @@ def test_the_fitted_joint_s_harmonics_add_the_modes_above_the_band(cubic):
     assert after < 0.4 * before, (before, after)  # 5.7 times lower here
     again = fit.widened(wider)
     assert _cost(again, fit.whole(again)) <= after * (1 + 1e-9)
+
+
+def test_modes_kept_apart_above_the_band_are_apart(cubic):
+    """``apart``: a set of added modes with one within that share of another's frequency (or of a mode already in
+    the model) is refused. Here the lowest level's fit already holds a mode at 47.3 Hz (the chain's 48.8 Hz one
+    seen through the band's edge), and the joint's harmonics add two, at 48.0 and 59.4 Hz: 1.5 % from it, so kept
+    apart at 1 % and refused at 2 %; whatever is added stays that far from every other mode."""
+    spectra = [periodic_spectra(r) for r in cubic]
+    linear = fit_linear(spectra[0], CHANNELS)
+    model = StructureModel(linear, Joint(("acc3", "acc4"), "cubic", np.array([3e9, 0.0, 0.0]), np.ones(3),
+                                         linear.coupling("acc3", "acc4", "acc1")), (1.0, 8.0))
+    n = linear.poles.size
+    free = above_band(model, spectra)
+    assert free.linear.poles.size == n + 2
+    assert np.array_equal(above_band(model, spectra, apart=0.01).linear.poles, free.linear.poles)
+    for apart in (0.02, 0.3):
+        kept = above_band(model, spectra, apart=apart)
+        assert kept.linear.poles.size < free.linear.poles.size
+        added, everything = np.abs(kept.linear.poles[n:]), np.abs(kept.linear.poles)
+        gaps = np.abs(added[:, None] - everything[None, :]) / added[:, None]
+        assert np.all(np.sort(gaps, axis=1)[:, 1:] > apart)  # the first gap is each mode's own
+
+
+def test_a_law_fitted_again_with_its_modes_apart_is_kept_where_it_simulates_better(cubic, monkeypatch):
+    """`_Fit.kept_apart`: the law is fitted again from starts whose modes above the band lie apart only where that
+    changes a start's modes (the chain's start adds 48.5 and 59.8 Hz beside 45.1 and 51.5: no two within 2 %, all
+    within 10 %), and of the two finished models the one that simulates the whole records better is kept."""
+    from satmd.structure import fit as fitting
+
+    spectra = [periodic_spectra(r) for r in cubic]
+    fit = fitting._Fit(cubic, spectra, CHANNELS, None, 10, ("measured",), "acc1", lambda s: None)
+    files = ["L1", "L3", "L8"]
+    model = fit.law(("acc3", "acc4"), "cubic", files)
+    assert fit.law(("acc3", "acc4"), "cubic", files, apart=0.02) is None
+    apart = fit.law(("acc3", "acc4"), "cubic", files, apart=0.1)
+    assert apart.linear.poles.size < model.linear.poles.size
+    done, other = fit.finished(model, True, files), fit.finished(apart, True, files)
+    costs = [fitting._cost(m, fit.whole(m)) for m in (done, other)]
+    monkeypatch.setattr(fitting, "APART", 0.1)
+    kept = fit.kept_apart(done, True, files)
+    assert fitting._cost(kept, fit.whole(kept)) == pytest.approx(min(costs), rel=1e-9)
+    monkeypatch.setattr(fitting, "APART", 0.02)
+    assert fit.kept_apart(done, True, files) is done
