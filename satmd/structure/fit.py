@@ -126,6 +126,7 @@ class _Fit:
         self.span = [_fit_span(r) for r in recordings]
         self.measured = [np.array([np.asarray(r[ch], float)[:n] for ch in names]) for r, n in zip(recordings, self.span)]
         self.shapes: dict = {}  # (place, law) -> (linear part, law's form, shape constants): the start of `law`
+        self.references: dict = {}  # place -> the lowest level's linear part (`reference`)
 
     def law(self, between, law, files, shape=None, form=(), apart: float = 0.0) -> StructureModel | None:
         """The linear part and (``between`` not None) the joint of ``law`` between ``between``, its path as the
@@ -141,9 +142,7 @@ class _Fit:
             return self.linear_only(files)
         key = (tuple(between), law)
         if key not in self.shapes:
-            say(f"linear part from the lowest level ({ref.source}) ...")
-            reference = with_start_up_modes(fit_linear(ref, names, between, self.n_pairs), recordings, spectra,
-                                            between)
+            reference = self.reference(tuple(between))
             lw, aux = ((law_named(law).form(form), shape) if shape is not None
                        else shape_of(spectra, between, law, names))
             d0, v0 = ref.scales(*between)
@@ -206,10 +205,16 @@ class _Fit:
 
     def linear_only(self, files) -> StructureModel:
         """The lowest level's linear model, no joint, with its fit table."""
-        self.say(f"linear part from the lowest level ({self.ref.source}) ...")
-        reference = with_start_up_modes(fit_linear(self.ref, self.names, None, self.n_pairs), self.recordings,
-                                        self.spectra, None)
-        return _with_table(StructureModel(reference, None, self.levels), self.recordings, files)
+        return _with_table(StructureModel(self.reference(None), None, self.levels), self.recordings, files)
+
+    def reference(self, between):
+        """The lowest level's linear part for a joint between ``between`` (None: no joint), with the modes a start
+        from rest shows above the band; fitted once per place, whatever the laws tried there."""
+        if between not in self.references:
+            self.say(f"linear part from the lowest level ({self.ref.source}) ...")
+            self.references[between] = with_start_up_modes(fit_linear(self.ref, self.names, between, self.n_pairs),
+                                                           self.recordings, self.spectra, between)
+        return self.references[between]
 
     def kept_apart(self, model, free_path, files) -> StructureModel:
         """``model`` (finished), or its law fitted again from starts whose modes above the band lie `APART` from
