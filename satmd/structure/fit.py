@@ -141,15 +141,14 @@ class _Fit:
         if between is None:
             return self.linear_only(files)
         key = (tuple(between), law)
-        if key not in self.shapes:
+        d0, v0 = ref.scales(*between)
+        if key not in self.shapes:  # a law fitted again at its place (``apart``) starts where it started
             reference = self.reference(tuple(between))
             lw, aux = ((law_named(law).form(form), shape) if shape is not None
                        else shape_of(spectra, between, law, names))
-            d0, v0 = ref.scales(*between)
             self.shapes[key] = (reference, *_simulated_shape(reference, spectra, between, lw, d0, v0, aux, recordings,
                                                               self.measured, self.span, self.levels))
         reference, lw, aux = self.shapes[key]
-        d0, v0 = ref.scales(*between)
         fitted = []
         for start in self.starts:  # the lowest level as the linear part, or the structure under the joint
             if start == "underlying":
@@ -166,10 +165,11 @@ class _Fit:
                 say(f"the {start} start has no finite joint: left out")
                 continue
             joint = Joint(between, law, c, aux, kappa, form=lw.term_names)
-            start_model = StructureModel(linear, joint, self.levels, reference=reference)
-            if apart and _same_modes(above_band(start_model, spectra), above_band(start_model, spectra, apart)):
+            model = StructureModel(linear, joint, self.levels, reference=reference)
+            wider = above_band(model, spectra, apart)
+            if apart and _same_modes(wider, above_band(model, spectra)):
                 continue  # this start's fit is the one made without ``apart``
-            model, drives = _with_modes_above(start_model, spectra, recordings, self.measured, self.span, apart)
+            model, drives = _with_modes_above(model, wider, spectra[0].fs_hz, recordings, self.measured, self.span)
             say(f"output-error fit of the {law} joint between {between[0]} and {between[1]} on "
                 f"{len(recordings)} recordings (from the {start} linear part) ...")
             fitted.append(output_error(_stable(model, drives), drives, ref, self.max_nfev, fixed_path=True))
@@ -282,19 +282,19 @@ def _simulated_shape(linear, spectra, between, lw, d0, v0, aux, recordings, meas
     return best
 
 
-def _with_modes_above(model, spectra, recordings, measured, span, apart: float = 0.0):
-    """(model, its drives): the start with the modes above the band its joint's harmonics drive (`above_band`)
-    where its simulation of the recordings is the closer (an added mode can also carry the joint's feedback
-    away: on a chain with a cubic joint it did), else the start as it was."""
-    wider = above_band(model, spectra, apart)
+def _with_modes_above(model, wider, fs_hz, recordings, measured, span):
+    """(model, its drives): the start ``wider`` with the modes above the band its joint's harmonics drive
+    (`above_band`) where its simulation of the recordings is the closer (an added mode can also carry the joint's
+    feedback away: on a chain with a cubic joint it did), else the start as it was."""
     runs = []
     for m in (model,) if wider is model else (model, wider):
-        m = replace(m, oversample=oversampling(m.linear, spectra[0].fs_hz))
+        m = replace(m, oversample=oversampling(m.linear, fs_hz))
         runs.append((m, _drives(m, recordings, measured, span)))
     return min(runs, key=lambda run: _cost(_stable(*run), run[1]))
 
 
 def _same_modes(a, b) -> bool:
+    """Whether two models have the same poles."""
     return a.linear.poles.shape == b.linear.poles.shape and bool(np.allclose(a.linear.poles, b.linear.poles))
 
 
