@@ -10,6 +10,11 @@ from ..numerics import jacobian_covariance
 from .laws import SHAPE_GRID
 from .model import StructureModel
 
+#: how far (in log, either way) a shape constant may move from its start: a factor of 1e13, wider than anything a
+#: stroke or a velocity can tell apart, yet a step of the least squares never reaches 0 or inf (on a structure with
+#: no joint a saturating spring's stroke was stepped to exp(-1421) = 0, and the law divided by it)
+LOG_SHAPE_SPAN = 30.0
+
 
 def output_error(model, drives, ref, max_nfev, fixed_path=False) -> StructureModel:
     """Least squares of the simulated responses on every recording: the law's coefficients, its shape constants
@@ -21,6 +26,7 @@ def output_error(model, drives, ref, max_nfev, fixed_path=False) -> StructureMod
     j = model.joint
     n_c = j.coefficients.size
     shaped = [i for i, t in enumerate(j.terms) if t in SHAPE_GRID]
+    log_aux = np.log(j.aux[shaped])
     step = max(1, int(ref.fs_hz / (8 * ref.freq_hz[-1])))  # the responses are band-limited well below Nyquist
     scales = [m.std(axis=1, keepdims=True) for _, m in drives]
 
@@ -29,7 +35,7 @@ def output_error(model, drives, ref, max_nfev, fixed_path=False) -> StructureMod
     def unpack(theta):
         c = theta[:n_c] if fixed_path else np.concatenate([j.coefficients[:1], theta[:n_c - 1]])
         aux = j.aux.copy()
-        aux[shaped] = np.exp(theta[n_free:n_free + len(shaped)])
+        aux[shaped] = shape_constants(theta[n_free:n_free + len(shaped)], log_aux)
         if fixed_path:
             return replace(j, coefficients=c, aux=aux)
         k = theta[n_free + len(shaped):]
@@ -45,7 +51,6 @@ def output_error(model, drives, ref, max_nfev, fixed_path=False) -> StructureMod
         return np.concatenate(out)
 
     k0 = np.zeros(0) if fixed_path else np.column_stack([j.coupling.real, j.coupling.imag]).ravel()
-    log_aux = np.log(j.aux[shaped])
     theta0 = np.concatenate([j.coefficients if fixed_path else j.coefficients[1:], log_aux, k0])
     scale = np.maximum(np.abs(theta0), 1e-3 * (np.abs(theta0).max() or 1.0))
     scale[scale == 0] = 1.0
@@ -69,6 +74,11 @@ def output_error(model, drives, ref, max_nfev, fixed_path=False) -> StructureMod
         with np.errstate(over="ignore"):  # a shape the records leave open: its interval is unbounded, [0, inf]
             ci[names[n_c + k]] = [float(joint.aux[i] * np.exp(-h)), float(joint.aux[i] * np.exp(h))]
     return replace(model, joint=replace(joint, ci95=ci))
+
+
+def shape_constants(log_trial, log_start) -> np.ndarray:
+    """The shape constants of a step of the least squares (their logs), kept within `LOG_SHAPE_SPAN` of the start."""
+    return np.exp(np.clip(log_trial, log_start - LOG_SHAPE_SPAN, log_start + LOG_SHAPE_SPAN))
 
 
 def _half_widths(jac, residuals, sizes):

@@ -79,6 +79,32 @@ def test_the_compiled_joint_pass_is_the_numpy_pass():
         assert np.array_equal(joint_force(*args), g)
 
 
+def test_a_shape_constant_stepped_far_away_keeps_every_law_finite():
+    """A step of the output-error fit took a saturating spring's stroke (start 0.021) to exp(-1421) = 0 on a
+    structure with no joint, and the compiled pass divided by it. Clipped within `LOG_SHAPE_SPAN` of its start,
+    every shaped law's force stays finite at any step."""
+    from satmd.structure.laws import SHAPE_GRID
+    from satmd.structure.output_error import LOG_SHAPE_SPAN, shape_constants
+
+    start = np.log(np.array([0.021]))
+    for trial, expected in ((-1421.0, start - LOG_SHAPE_SPAN), (1421.0, start + LOG_SHAPE_SPAN), (-3.0, -3.0)):
+        assert np.allclose(np.log(shape_constants(np.array([trial]), start)), expected)
+    rng = np.random.default_rng(3)
+    poles = np.array([-1.0 + 30j, -2.0 + 70j])
+    psi, G0, G1 = discretise(poles, 400.0)
+    rd, rv = 1e-3 * (rng.standard_normal(2) + 1j), 1e-2 * (rng.standard_normal(2) + 1j)
+    dF, vF = 1e-3 * rng.standard_normal(500), 1e-2 * rng.standard_normal(500)
+    for law_ in (v for law in LAWS.values() for v in law.variants()):
+        shaped = np.array([t in SHAPE_GRID for t in law_.all_terms])
+        if not shaped.any():
+            continue
+        for trial in (-1421.0, 1421.0):
+            aux = np.where(shaped, shape_constants(np.full(shaped.size, trial), np.full(shaped.size, start[0])), 1.0)
+            coefs = np.r_[np.full(len(law_.term_names), 0.5), 20.0, 1.0]
+            g, _ = joint_states(psi, G0, G1, rd, rv, dF, vF, law_.codes, coefs, aux, 0, 0)
+            assert np.all(np.isfinite(g)), (law_.term_names, trial)
+
+
 def test_the_pass_keeps_the_states_the_joint_s_force_drives():
     """The states kept by the pass are the modes' response to its force (`modal_states`) at the samples asked
     for: the outputs need no second filtering of the force."""
