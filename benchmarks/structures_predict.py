@@ -172,7 +172,9 @@ def harmonics_bursts(recordings, channels, fast: float = 1.5) -> dict:
     of the channels' summed, normalised power above the band)."""
     from itertools import combinations
 
+    from satmd.numerics import force_level
     from satmd.signal.excitation import excitation_of, received
+    from satmd.structure.outside import TOP_SHARE
     from satmd.structure.spectra import periodic_spectra
 
     levels, top = [], None
@@ -180,8 +182,8 @@ def harmonics_bursts(recordings, channels, fast: float = 1.5) -> dict:
         rec = received(r)
         exc = excitation_of(rec)
         n = exc.period_samples
-        above = np.arange(max(exc.lines) + 1, int(0.8 * (n // 2)) + 1)  # to the anti-alias filter (outside.TOP_SHARE)
-        row = {"level_n_rms": round(float(np.std(rec["force"])), 1), "share": [], "periodic": [], "kurtosis": []}
+        above = np.arange(max(exc.lines) + 1, int(TOP_SHARE * (n // 2)) + 1)  # below the anti-alias filter
+        row = {"level_n_rms": round(force_level(rec["force"]), 1), "share": [], "periodic": [], "kurtosis": []}
         power = np.zeros(n)
         for c in channels:
             X = np.fft.rfft(np.asarray(rec[c], float)[: exc.periods * n].reshape(exc.periods, n)[list(exc.steady)],
