@@ -20,11 +20,13 @@ between responses at the top levels: at 1 % off, chain softening 4 moved 0.78 at
 those tests apart.
 
     python benchmarks/structures_gvt.py [--count 120] [--seed0 0] [--out PATH]
+    python benchmarks/structures_gvt.py --seeds 31,50,58 --out part.json   (those tests alone)
     python benchmarks/structures_gvt.py --merge part1.json part2.json [--out PATH]
     python benchmarks/structures_gvt.py --add-truth-sensitivity PATH   (to a result written before the field)
 
 The issue's protocol is 100 structures with a joint (``--count 120``: a null every sixth), about 4 h on one
-core; parts (``--seed0``, ``--count``) run apart and merge.
+core; parts (``--seed0``, ``--count``) run apart and merge. A change that can only touch some tests is measured by
+rerunning those (``--seeds``) and merging them over the last result: the later part's rows replace the earlier.
 
 Writes benchmarks/results/structures_gvt.json and prints one line of figures.
 """
@@ -52,10 +54,12 @@ SENSITIVITY = 1e-3  # the truth's joint parameter moved by this share to see how
 OUT = ROOT / "benchmarks" / "results" / "structures_gvt.json"
 
 
-def plan(count: int, seed0: int) -> list:
-    """(structure, law, seed): structures in turn, each law and the null in turn."""
+def plan(count: int, seed0: int, seeds=None) -> list:
+    """(structure, law, seed): structures in turn, each law and the null in turn; ``seeds`` (a list) those tests
+    alone, as they stand in the full plan."""
     laws = (*sim.LAWS, None)
-    return [(sim.STRUCTURES[i % 4], laws[(i // 4) % len(laws)], i) for i in range(seed0, seed0 + count)]
+    return [(sim.STRUCTURES[i % 4], laws[(i // 4) % len(laws)], i)
+            for i in (seeds if seeds is not None else range(seed0, seed0 + count))]
 
 
 def _satmd(*args, cwd) -> dict:
@@ -246,12 +250,20 @@ def line(result: dict) -> str:
 
 
 def merge(paths, out: Path, summary_of=None) -> dict:
-    """Parts of one run (``--seed0``, ``--count``) in one result, summarised again (``summary_of``, default
-    `summarise`)."""
+    """Parts of one run (``--seed0``, ``--count``, ``--seeds``) in one result, summarised again (``summary_of``,
+    default `summarise`). A test in a later part replaces the same test in an earlier one (a change that can only
+    touch some tests, rerun on those: the run that replaced them says which)."""
     parts = [json.loads(Path(p).read_text()) for p in paths]
-    rows = [r for p in parts for r in p["rows"]]
-    result = {"machine": parts[-1]["machine"], "runs": [{"file": str(p), "machine": q["machine"]}
-                                                        for p, q in zip(paths, parts)],
+    by_seed: dict = {}
+    runs = []
+    for path, part in zip(paths, parts):
+        replaced = sorted(r["seed"] for r in part["rows"] if r["seed"] in by_seed)
+        by_seed.update({r["seed"]: r for r in part["rows"]})
+        # a merged result's own runs stand as they were; a part's rows replace the same tests of parts before it
+        runs += part.get("runs") or [{"file": str(path), "machine": part["machine"],
+                                      **({"replaced_seeds": replaced} if replaced else {})}]
+    rows = sorted(by_seed.values(), key=lambda r: r["seed"])
+    result = {"machine": parts[-1]["machine"], "runs": runs,
               "rows": rows, "summary": (summary_of or summarise)(rows),
               "benchmark_seconds": sum(q.get("benchmark_seconds", 0.0) for q in parts)}
     out.write_text(json.dumps(result, indent=1))
@@ -262,6 +274,8 @@ def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--count", type=int, default=120, help="tests (structures and laws in turn, every sixth a null)")
     ap.add_argument("--seed0", type=int, default=0)
+    ap.add_argument("--seeds", type=lambda t: [int(x) for x in t.split(",")], default=None,
+                    help="comma-separated tests alone (instead of --count/--seed0)")
     ap.add_argument("--out", type=Path, default=OUT)
     ap.add_argument("--merge", nargs="+", default=None)
     ap.add_argument("--add-truth-sensitivity", type=Path, default=None, metavar="PATH")
@@ -274,20 +288,22 @@ def main(argv=None) -> int:
         return 0
     result = run_plan(case, summarise, args.count, args.seed0, args.out,
                       {"fitted_levels": list(FITTED), "held_levels": list(HELD)},
-                      lambda r: f"{r.get('found_between')} {r.get('found_law')} {r.get('right')} ({r.get('discover_s')} s)")
+                      lambda r: f"{r.get('found_between')} {r.get('found_law')} {r.get('right')} ({r.get('discover_s')} s)",
+                      seeds=args.seeds)
     print(line(result) + " | " + describe(result["machine"]))
     return 0
 
 
-def run_plan(case_of, summary_of, count: int, seed0: int, out: Path, extra: dict, tell) -> dict:
+def run_plan(case_of, summary_of, count: int, seed0: int, out: Path, extra: dict, tell, seeds=None) -> dict:
     """``case_of(structure, law, seed)`` over `plan`, the result (its rows and ``summary_of(rows)``) written to
     ``out`` after every test (a long run interrupted keeps what it measured); ``tell(row)`` on stderr."""
     t0 = time.perf_counter()
     result = {"machine": machine(threads=1), **extra, "rows": []}
-    for i, (structure, law, seed) in enumerate(plan(count, seed0)):
+    tests = plan(count, seed0, seeds)
+    for i, (structure, law, seed) in enumerate(tests):
         row = case_of(structure, law, seed)
         result["rows"].append(row)
-        print(f"[{i + 1}/{count}] {structure} {law} seed {seed}: {tell(row)}", file=sys.stderr, flush=True)
+        print(f"[{i + 1}/{len(tests)}] {structure} {law} seed {seed}: {tell(row)}", file=sys.stderr, flush=True)
         result["summary"] = summary_of(result["rows"])
         out.write_text(json.dumps(result, indent=1))
     result["benchmark_seconds"] = time.perf_counter() - t0

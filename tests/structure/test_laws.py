@@ -56,6 +56,37 @@ def test_the_best_fitting_law_is_kept_and_the_sparse_library_only_by_a_margin():
     assert best_fitting([none, clearance]) is clearance and best_fitting([none]) is none
 
 
+
+def test_the_sparse_library_is_weighed_against_the_best_named_law_once_both_are_finished():
+    """`_Fit.finished_choice`: first fitted, the library's extra terms take up what a named law's start path
+    leaves; finished, the named law may fit far better, and then it is kept. A library that still wins by the
+    margin, or a law given, is kept as it is."""
+    from types import SimpleNamespace
+
+    from satmd.structure.choice import SPARSE_MARGIN
+    from satmd.structure.fit import _Fit
+
+    def model(law, nrmse, between=("acc1", "ground")):
+        return SimpleNamespace(joint=SimpleNamespace(law=law, units="relative", parameters=dict, between=between),
+                               fit={"nonlinear": [[nrmse]]})
+
+    def fit_with(tried, finished):
+        fit = _Fit.__new__(_Fit)
+        fit.tried, fit.say = tried, lambda _: None
+        fit.finished = lambda m, free_path, files: finished[id(m)]
+        return fit
+
+    sparse, clearance, cubic = model("sparse", 0.133), model("clearance", 0.150), model("cubic", 0.19)
+    elsewhere = model("friction", 0.05, between=("acc2", "acc3"))
+    done = {id(sparse): model("sparse", 0.121), id(clearance): model("clearance", 0.041),
+            id(cubic): model("cubic", 0.03), id(elsewhere): model("friction", 0.01)}
+    chosen = fit_with([sparse, clearance, cubic, elsewhere], done).finished_choice(sparse, True, [])
+    assert chosen is done[id(clearance)]  # the best named at the place as first fitted, not the best finished
+    done[id(sparse)] = model("sparse", 0.041 * (1 - 2 * SPARSE_MARGIN))
+    assert fit_with([sparse, clearance], done).finished_choice(sparse, True, []) is done[id(sparse)]
+    assert fit_with([sparse, elsewhere], done).finished_choice(sparse, True, []) is done[id(sparse)]
+    assert fit_with([sparse, clearance], done).finished_choice(clearance, True, []) is done[id(clearance)]
+
 def _two_modes(kappa_scale):
     """A mass-normalised two-mode structure (channels a, b; the force at a) with a joint from b to the ground whose
     path is ``kappa_scale`` times reciprocity's, and that path's law fitted in relative units."""
