@@ -170,6 +170,7 @@ class _Data:
 
     def __init__(self, linear, recordings, fs, between):
         from ..physics.nonlinear.integrate import band_limited
+        from .spectra import drive_force
 
         self.linear, self.fs = linear, fs
         names = linear.channels
@@ -177,7 +178,7 @@ class _Data:
         self.ib = names.index(between[1]) if between and between[1] != "ground" else None
         us, ys = [], []
         for r in recordings:
-            u = np.asarray(r["force"], float)
+            u = drive_force(r)  # the load cell's noise left out, as the models are driven
             scale = max(force_level(u), TINY)
             y = np.array([np.asarray(r[c], float) for c in names]) / scale
             if self.ib is not None:
