@@ -161,7 +161,8 @@ def drive_force(recording) -> np.ndarray:
     if exc.kind != "periodic" or len(steady) < MIN_STEADY:
         return force
     n = int(exc.period_samples)
-    X = np.fft.rfft(force[: exc.periods * n].reshape(exc.periods, n)[steady], axis=1)
+    steady_periods = force[: exc.periods * n].reshape(exc.periods, n)[steady]
+    X = np.fft.rfft(steady_periods, axis=1)
     mean = X.mean(axis=0)
     standard_error = np.sqrt(np.mean(np.abs(X - mean) ** 2, axis=0) * len(steady) / (len(steady) - 1) / len(steady))
     keep = np.abs(mean) > SIGNIFICANT * standard_error
@@ -172,7 +173,7 @@ def drive_force(recording) -> np.ndarray:
         out[p * n:(p + 1) * n] = period
     start = steady[0] * n
     if start:
-        noise = float(np.std(force[: exc.periods * n].reshape(exc.periods, n)[steady] - period))
+        noise = float(np.std(steady_periods - period))
         periodic = np.tile(period, steady[0])
         out[:start] = periodic + start_transient(force[:start] - periodic, noise)
     return out
