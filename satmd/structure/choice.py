@@ -3,7 +3,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .newtons import path_sign
+from .newtons import passive_sign, path_sign
 
 SPARSE_MARGIN = 0.1
 PLACES = 3      # the spectra's best places simulated on every level (`best_place`)
@@ -79,12 +79,13 @@ NAMED_SIGN = {"softening": ("k_sat",), "clearance": ("k_contact",), "friction": 
 
 def contradicts(model) -> bool:
     """A law fitted with the sign its name excludes (`NAMED_SIGN`): not that law, whatever it fits. In newtons the
-    coefficient's own sign; in relative units its sign times the path's where the modes' shapes give that
-    (`newtons.path_sign`); otherwise open, and the law is kept."""
+    coefficient's own sign; in relative units its sign times the path's where the modes' shapes at the driving
+    point give that (`newtons.path_sign`), else where the joint's own path does (`newtons.passive_sign`);
+    otherwise open, and the law is kept."""
     joint = model.joint
     values = joint.parameters() if joint.law in NAMED_SIGN else {}
     signed = [values[k] for k in NAMED_SIGN.get(joint.law, ()) if k in values]
     if not signed:
         return False
-    sign = 1 if joint.units == "N" else path_sign(model)
+    sign = 1 if joint.units == "N" else (path_sign(model) or passive_sign(model))
     return any(sign * v < 0 for v in signed)

@@ -104,6 +104,10 @@ def fit_structure(recordings, between=None, law: str | None = None, channels=Non
             fitted = [fit.law(between, w, files) for w in weighed]
         else:
             fitted = [fit.law(between, law, files, shape, form)]
+            for other in ([] if law_given else [w for w in weighed if w != law]):
+                if fitted[-1].joint is None or not contradicts(fitted[-1]):
+                    break  # the spectra's law, or the next that does not contradict its name (`best_fitting`)
+                fitted.append(fit.law(between, other, files))
         model = best_fitting(fitted)
         if not place_given and len(recordings) >= 3:
             laws = [law] if law_given else ranked_laws(fitted)[:PLACE_LAWS]

@@ -57,6 +57,25 @@ def path_sign(model) -> int:
     return 1 if found[1] > 0 else -1
 
 
+def passive_sign(model) -> int:
+    """+1 or −1: the sign a relative coefficient takes in newtons, from the joint's own path alone (no driving
+    point needed); 0 where its modes do not agree (`SIGN_AGREEMENT`). A force at the pair moves the stroke as a
+    force at a driving point moves that point: with κ_r = −(A_ar − A_br)/A_dr (a positive coefficient restores
+    or resists) each mode's stroke residue ``R_r = pair_r κ_r`` has a receptance modal constant
+    ``−(φ_a − φ_b)²`` of one sign, whatever the shapes' scale. The agreement is the constants' sum over the sum
+    of their sizes. On an independent chain with a friction joint and no driving point found, a quadratic
+    damping was fitted with every mode's constant reversed: its force fed the structure, held back at the fitted
+    levels by the linear terms, and at 1.5 times the top level the simulation ran away."""
+    lin, j = model.linear, model.joint
+    R = np.asarray(j.stroke_of(lin), complex) * np.asarray(j.coupling, complex)
+    const = (2j * np.abs(lin.poles) * R / lin.poles ** 2).real
+    size = float(np.sum(np.abs(const)))
+    agreement = float(np.sum(const)) / size if size > 0 else 0.0
+    if not np.isfinite(agreement) or abs(agreement) < SIGN_AGREEMENT:
+        return 0
+    return 1 if agreement < 0 else -1
+
+
 def in_newtons(model, driving_point=None):
     """The joint with its path scaled as reciprocity says (κ_r = −(A_ar − A_br)/A_dr for a driving point d),
     so that its coefficients are forces; the simulation is unchanged (c s, κ / s). As it was when there is no

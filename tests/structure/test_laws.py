@@ -102,7 +102,8 @@ def _two_modes(kappa_scale):
     lin = LinearStructure(("a", "b"), lam, residues, np.zeros(2))
     kappa = kappa_scale * -lin.coupling("b", "ground", "a")
     return SimpleNamespace(linear=lin, reference=lin, driving_point=None,
-                           joint=SimpleNamespace(between=("b", "ground"), coupling=kappa))
+                           joint=SimpleNamespace(between=("b", "ground"), coupling=kappa,
+                                                 stroke_of=lambda linear: linear.pair_residues("b", "ground")))
 
 
 def test_the_path_gives_a_relative_coefficient_its_sign_where_the_modes_shapes_agree():
@@ -131,6 +132,36 @@ def test_the_path_gives_a_relative_coefficient_its_sign_where_the_modes_shapes_a
     n = in_newtons(StructureModel(two.linear, joint, (1.0, 2.0), reference=two.linear))
     assert n.joint.units == "N" and n.driving_point == "a" and np.allclose(n.joint.coefficients, [2.0, -6.0, 0.2])
     assert np.allclose(n.joint.coupling * n.joint.coefficients[0], joint.coupling * joint.coefficients[0])
+
+
+def test_the_joint_own_path_gives_its_sign_without_a_driving_point():
+    """`newtons.passive_sign`: a force at the pair moves its stroke as a driving point's force moves that point,
+    every mode's receptance constant of one sign; a path reversed (a negative scale) reverses them all. Modes that
+    cancel give no sign. With no channel at the driving point, `contradicts` reads a relative law's sign so: a
+    quadratic damping on a reversed path feeds the structure (on an independent chain it ran away at 1.5 times
+    the fitted level)."""
+    from types import SimpleNamespace
+
+    from satmd.structure.choice import contradicts
+    from satmd.structure.linear import LinearStructure
+    from satmd.structure.newtons import passive_sign, path_sign
+
+    for scale in (0.3, 2.0, -0.5, -4.0):
+        assert passive_sign(_two_modes(scale)) == (1 if scale > 0 else -1)
+    m = _two_modes(1.0)
+    lin = m.linear
+    R = lin.pair_residues("b", "ground") * m.joint.coupling
+    const = (2j * np.abs(lin.poles) * R / lin.poles ** 2).real
+    m.joint.coupling = m.joint.coupling * np.array([1.0, -const[0] / const[1]])  # the modes cancel: no sign
+    assert passive_sign(m) == 0
+    for scale, feeds in ((2.0, False), (-2.0, True)):
+        m = _two_modes(scale)
+        res = m.linear.residues.copy()
+        res[0, 1] *= -1  # channel a's constants of both signs: no driving point
+        m.linear = m.reference = LinearStructure(m.linear.channels, m.linear.poles, res, m.linear.feedthrough)
+        vars(m.joint).update(law="quadratic_damping", units="relative", parameters=lambda: {"c2": 1.0})
+        assert path_sign(m) == 0 and passive_sign(m) == (-1 if feeds else 1)
+        assert contradicts(SimpleNamespace(**vars(m))) is feeds
 
 
 def test_a_saturating_spring_that_stiffens_is_no_softening():
