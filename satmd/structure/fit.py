@@ -105,7 +105,8 @@ def fit_structure(recordings, between=None, law: str | None = None, channels=Non
         else:
             fitted = [fit.law(between, law, files, shape, form)]
             for other in ([] if law_given else [w for w in weighed if w != law]):
-                if fitted[-1].joint is None or not contradicts(fitted[-1]):
+                last = fitted[-1]
+                if last is None or last.joint is None or not contradicts(last):
                     break  # the spectra's law, or the next that does not contradict its name (`best_fitting`)
                 fitted.append(fit.law(between, other, files))
         model = best_fitting(fitted)
