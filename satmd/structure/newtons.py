@@ -63,9 +63,10 @@ def passive_sign(model) -> int:
     force at a driving point moves that point: with κ_r = −(A_ar − A_br)/A_dr (a positive coefficient restores
     or resists) each mode's stroke residue ``R_r = pair_r κ_r`` has a receptance modal constant
     ``−(φ_a − φ_b)²`` of one sign, whatever the shapes' scale. The agreement is the constants' sum over the sum
-    of their sizes. On an independent chain with a friction joint and no driving point found, a quadratic
-    damping was fitted with every mode's constant reversed: its force fed the structure, held back at the fitted
-    levels by the linear terms, and at 1.5 times the top level the simulation ran away."""
+    of their sizes. On an independent chain with a friction joint, whose fitted path agreed with the driving
+    point's shapes too little to give a sign (0.42), a quadratic damping was fitted with every mode's constant
+    reversed: its force fed the structure, held back at the fitted levels by the linear terms, and at 1.5 times
+    the top level the simulation ran away."""
     lin, j = model.linear, model.joint
     R = np.asarray(j.stroke_of(lin), complex) * np.asarray(j.coupling, complex)
     const = (2j * np.abs(lin.poles) * R / lin.poles ** 2).real
