@@ -67,9 +67,10 @@ def passive_sign(model) -> int:
     point's shapes too little to give a sign (0.42), a quadratic damping was fitted with every mode's constant
     reversed: its force fed the structure, held back at the fitted levels by the linear terms, and at 1.5 times
     the top level the simulation ran away."""
+    from .linear import modal_constants
+
     lin, j = model.linear, model.joint
-    R = np.asarray(j.stroke_of(lin), complex) * np.asarray(j.coupling, complex)
-    const = (2j * np.abs(lin.poles) * R / lin.poles ** 2).real
+    const = modal_constants(np.asarray(j.stroke_of(lin), complex) * np.asarray(j.coupling, complex), lin.poles)
     size = float(np.sum(np.abs(const)))
     agreement = float(np.sum(const)) / size if size > 0 else 0.0
     if not np.isfinite(agreement) or abs(agreement) < SIGN_AGREEMENT:
