@@ -9,6 +9,7 @@ from ..conventions import TINY
 from ..numerics import jacobian_covariance
 from .laws import SHAPE_GRID
 from .model import StructureModel
+from .outputs import Projection
 
 #: how far (in log, either way) a shape constant may move from its start: a factor of 1e13, wider than anything a
 #: stroke or a velocity can tell apart, yet a step of the least squares never reaches 0 or inf (on a structure with
@@ -19,7 +20,14 @@ LOG_SHAPE_SPAN = 30.0
 def output_error(model, drives, ref, max_nfev, fixed_path=False) -> StructureModel:
     """Least squares of the simulated responses on every recording: the law's coefficients, its shape constants
     (in log: a gap, a friction's smoothing) and, unless ``fixed_path``, the path κ (then the law's first
-    coefficient is held: it fixes the scale the path shares)."""
+    coefficient is held: it fixes the scale the path shares).
+
+    With the path free, every channel's residues, joint's column and feed-through are solved inside each step
+    (`outputs.Projection`) and returned so: the path then moves for the joint's force and its feedback alone.
+    Moved with every channel's coefficients tied to it (the column the force's times κ, re-solved after), on
+    independent ground vibration tests, place and law given, the held-out worst NRMSE was 0.074, 0.041, 0.073,
+    0.140 where solved inside it is 0.050, 0.032, 0.062, 0.115 (chain cubic, beam softening, beam cubic, wing
+    softening), and the same to 0.001 on three others."""
 
     from scipy.optimize import least_squares
 
@@ -31,6 +39,7 @@ def output_error(model, drives, ref, max_nfev, fixed_path=False) -> StructureMod
     scales = [m.std(axis=1, keepdims=True) for _, m in drives]
 
     n_free = n_c if fixed_path else n_c - 1  # with the path free, the law's first term's size fixes the scale
+    projection = None if fixed_path else Projection(model, drives, step)
 
     def unpack(theta):
         c = theta[:n_c] if fixed_path else np.concatenate([j.coefficients[:1], theta[:n_c - 1]])
@@ -43,6 +52,9 @@ def output_error(model, drives, ref, max_nfev, fixed_path=False) -> StructureMod
 
     def residual(theta):
         trial = unpack(theta)
+        if projection is not None:
+            solved = projection.solve(trial)
+            return np.full(projection.size, 1e3 / np.sqrt(projection.size)) if solved is None else solved[0]
         out = []
         for (drive, measured), sd in zip(drives, scales):
             e = (drive.outputs(trial, step) - measured[:, ::step]) / sd
@@ -60,6 +72,10 @@ def output_error(model, drives, ref, max_nfev, fixed_path=False) -> StructureMod
     if sol.cost > 0.5 * float(start @ start):  # never worse than where it started
         return replace(model, joint=unpack(theta0))
     joint = unpack(sol.x)
+    if projection is not None:
+        solved = projection.solve(joint)
+        model = model if solved is None else solved[1]
+        joint = model.joint if solved is not None else joint
     half = _half_widths(sol.jac, sol.fun, [len(np.ravel(m[:, ::step])) for _, m in drives])
     if half is None:
         return replace(model, joint=joint)

@@ -26,45 +26,65 @@ def resolved_outputs(model, drives):
     """``model`` with the residues, joint's column and feed-through of every channel re-solved by least squares
     on ``drives`` [(Drive, measured (C, N))], the joint's stroke kept as it was (`Joint.stroke`); ``model`` itself
     where it has no joint or the joint ran away on a recording."""
-    joint, lin = model.joint, model.linear
-    if joint is None:
+    if model.joint is None:
         return model
-    n, channels = lin.poles.size, range(len(lin.channels))
-    rows = {i: ([], []) for i in channels}
-    for drive, measured in drives:
-        x, u = drive.states[:, drive.skip:], drive.u[drive.skip:]
-        g, w = drive.driven(joint)
-        if not np.all(np.isfinite(g)):
-            return model
-        basis = np.vstack([2 * x.real, -2 * x.imag, 2 * w.real, -2 * w.imag, u[None, :]]).T
-        for i in channels:
-            scale = max(float(measured[i].std()), TINY)
-            rows[i][0].append(basis / scale)
-            rows[i][1].append(measured[i] / scale)
-    residues, feedthrough = lin.residues.copy(), lin.feedthrough.copy()
-    column = joint.column_of(lin).copy()
-    for i in channels:
-        prior = np.concatenate([residues[i].real, residues[i].imag, column[i].real, column[i].imag, [feedthrough[i]]])
-        theta = prior + _ridge(np.vstack(rows[i][0]), np.concatenate(rows[i][1]), prior)
-        residues[i] = theta[:n] + 1j * theta[n:2 * n]
-        column[i] = theta[2 * n:3 * n] + 1j * theta[3 * n:4 * n]
-        feedthrough[i] = theta[4 * n]
-    return replace(model, linear=replace(lin, residues=residues, feedthrough=feedthrough),
-                   joint=replace(joint, column=column, stroke=joint.stroke_of(lin)))
+    solved = Projection(model, drives).solve(model.joint)
+    return model if solved is None else solved[1]
 
 
 RIDGE = 1e-6  # of the regressors' own scale: a direction the recordings barely see stays where the model had it
 
 
-def _ridge(basis, y, prior) -> np.ndarray:
-    """The step from ``prior`` that least squares on ``basis`` asks for, each regressor in units of its norm and
-    held to the prior in directions the data do not fix (``RIDGE``): a mode's state driven by the force and the
-    one driven by the joint can be nearly the same signal, and unheld they take huge opposite residues that
-    cancel on the records fitted and on no other."""
-    norms = np.linalg.norm(basis, axis=0)
+class Projection:
+    """Every channel's residues, joint's column and feed-through solved for a trial joint: the linear part of an
+    output-error fit, solved inside it (variable projection, Golub & Pereyra 1973) so that the least squares
+    moves the joint's law and path for what they alone decide, the joint's force and its feedback through the
+    stroke, and not for what each channel's own coefficients would do anyway.
+
+    Each regressor in units of its norm is held to the model's value in directions the data do not fix
+    (`RIDGE`): a mode's state driven by the force and the one driven by the joint can be nearly the same signal,
+    and unheld they take huge opposite residues that cancel on the records fitted and on no other. Each channel
+    of each recording is weighed by its RMS, as the output-error fit weighs them; ``step`` keeps every step-th
+    sample (`Drive.outputs`)."""
+
+    def __init__(self, model, drives, step: int = 1):
+        self.model, self.step, self.parts = model, int(step), []
+        for drive, measured in drives:
+            keep = slice(drive.skip, None, self.step)
+            x = drive.states[:, keep]
+            weight = 1.0 / np.maximum(measured.std(axis=1), TINY)
+            self.parts.append((drive, np.vstack([2 * x.real, -2 * x.imag]), drive.u[keep], measured[:, ::self.step],
+                               weight))
+        self.size = sum(y.size for *_, y, _ in self.parts)
+
+    def solve(self, joint):
+        """(residuals (every recording's weighted misfit, flat), the model with ``joint`` and every channel
+        solved); None where the joint ran away on a recording."""
+        lin = self.model.linear
+        n, n_out = lin.poles.size, len(lin.channels)
+        gram, moment, bases = 0.0, 0.0, []
+        for drive, fixed, u, y, weight in self.parts:
+            g, w = drive.driven(joint, self.step)
+            if not np.all(np.isfinite(g)):
+                return None
+            basis = np.vstack([fixed, 2 * w.real, -2 * w.imag, u[None, :]])
+            bases.append(basis)
+            gram = gram + (weight ** 2)[:, None, None] * (basis @ basis.T)[None]
+            moment = moment + (weight ** 2)[:, None] * (y @ basis.T)
+        column = joint.column_of(lin)
+        prior = np.hstack([lin.residues.real, lin.residues.imag, column.real, column.imag, lin.feedthrough[:, None]])
+        theta = prior + np.array([_ridge_step(gram[i], moment[i] - gram[i] @ prior[i]) for i in range(n_out)])
+        residuals = np.concatenate([((theta @ basis - y) * weight[:, None]).ravel()
+                                    for basis, (*_, y, weight) in zip(bases, self.parts)]) / np.sqrt(self.size)
+        solved = replace(lin, residues=theta[:, :n] + 1j * theta[:, n:2 * n], feedthrough=theta[:, 4 * n])
+        joint = replace(joint, column=theta[:, 2 * n:3 * n] + 1j * theta[:, 3 * n:4 * n], stroke=joint.stroke_of(lin))
+        return residuals, replace(self.model, linear=solved, joint=joint)
+
+
+def _ridge_step(gram, moment) -> np.ndarray:
+    """The step from the prior that least squares asks for (normal equations ``gram``, the misfit's ``moment``),
+    each regressor in units of its norm and held to the prior with weight `RIDGE`."""
+    norms = np.sqrt(np.maximum(np.diag(gram), 0.0))
     norms = np.where(norms > 0, norms, 1.0)
-    scaled = basis / norms
-    k = scaled.shape[1]
-    a = np.vstack([scaled, np.sqrt(RIDGE) * np.eye(k)])
-    b = np.concatenate([y - basis @ prior, np.zeros(k)])
-    return np.linalg.lstsq(a, b, rcond=None)[0] / norms
+    scaled = gram / np.outer(norms, norms) + RIDGE * np.eye(gram.shape[0])
+    return np.linalg.solve(scaled, moment / norms) / norms

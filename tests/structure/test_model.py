@@ -195,16 +195,17 @@ def test_a_fitted_model_predicts_a_level_it_never_saw(cubic_levels, cubic_model)
 
 def test_a_path_off_the_modes_is_fitted_back(cubic_levels):
     """The output-error fit with the path free (`fit_structure`'s last stage) puts back a path that the start
-    found 40 % off on every other mode; the law's coefficients alone cannot."""
+    found 40 % off on every other mode; the law's coefficients alone cannot. With the path free, every channel is
+    solved inside the fit (`outputs.Projection`): the model it returns has its channels re-solved."""
     from dataclasses import replace
 
     from satmd.structure.fit import _cost, _drives, _fit_span
     from satmd.structure.output_error import output_error
 
-    # the model as it was before its channels were re-solved (the path then reaches every channel through κ)
+    # the model as first fitted, its channels not re-solved (the path then reaches every channel through κ)
     with pytest.MonkeyPatch.context() as patch:
         patch.setattr("satmd.structure.fit.resolved_outputs", lambda model, drives: model)
-        m = fit_structure([cubic_levels[0], cubic_levels[2]])
+        m = fit_structure([cubic_levels[0], cubic_levels[2]], free_path=False)
     assert m.joint.column is None and m.joint.stroke is None
     recs = [cubic_levels[0], cubic_levels[2]]
     span = [_fit_span(r) for r in recs]
@@ -218,6 +219,7 @@ def test_a_path_off_the_modes_is_fitted_back(cubic_levels):
     right, wrong = _cost(m, drives), _cost(off, drives)  # 2.4e-4 and 2.7e-4 (the freed path 2.3e-4)
     assert _cost(fixed, drives) > right + 0.8 * (wrong - right)
     assert _cost(free, drives) < right + 0.1 * (wrong - right)
+    assert free.joint.column is not None and np.allclose(free.joint.stroke, m.joint.stroke_of(m.linear))
     assert max(free.predict(cubic_levels[1]).nrmse) < max(m.predict(cubic_levels[1]).nrmse) + 5e-4
 
 
