@@ -185,7 +185,7 @@ class _Fit:
             return _with_table(StructureModel(reference, None, self.levels), recordings, files)
         # judged on the whole records: a model that slowly gathers energy shows it only over many periods
         whole = self.whole(fitted[0])
-        model = min(fitted, key=lambda m: _cost(m, [(_redrive(d, m), y) for d, y in whole]))
+        model = min(fitted, key=lambda m: _cost(m, whole))
         model = _with_table(replace(model, driving_point=self.driving_point), recordings, files)
         if not apart:
             self.tried.append(model)
@@ -219,11 +219,13 @@ class _Fit:
         if free_path:
             a, b = model.joint.between
             self.say(f"output-error fit of the {model.joint.law} joint between {a} and {b} with its path free ...")
-            freed = output_error(model, _drives(model, self.recordings, self.measured, self.span), self.ref,
-                                 self.max_nfev, fixed_path=False)
-            # fitted on the first periods, kept where the whole records say so too (as the starts are judged)
-            whole = self.whole(model)
-            model = freed if _cost(freed, whole) <= _cost(model, whole) else model
+            drives, before = _drives(model, self.recordings, self.measured, self.span), _cost(model, self.whole(model))
+            for solved in (True, False):  # the channels solved inside the fit, else tied to the path (`output_error`)
+                freed = output_error(model, drives, self.ref, self.max_nfev, fixed_path=False, solved=solved)
+                # fitted on the first periods, kept where the whole records say so too (a slow run-away shows there)
+                if _cost(freed, self.whole(freed)) <= before:
+                    model = freed
+                    break
         model = in_newtons(model, self.driving_point)
         model = resolved_outputs(model, self.whole(model))
         chain = acquisition_of(model, self.whole(model), band_top_hz(self.spectra))
@@ -358,9 +360,10 @@ def _redrive(drive, model):
 
 
 def _cost(model, drives) -> float:
+    """Mean squared misfit of ``model`` on drives of the same forces (each through the model's own linear part)."""
     with np.errstate(over="ignore", invalid="ignore"):  # a candidate that runs away costs inf, said by no warning
-        total = float(sum(np.sum(((d.outputs(model.joint) - m) / m.std(axis=1, keepdims=True)) ** 2) / m.size
-                          for d, m in drives))
+        total = float(sum(np.sum(((_redrive(d, model).outputs(model.joint) - m) / m.std(axis=1, keepdims=True)) ** 2)
+                          / m.size for d, m in drives))
     return total if np.isfinite(total) else np.inf
 
 
