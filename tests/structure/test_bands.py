@@ -92,7 +92,8 @@ def test_the_fitted_joint_s_harmonics_add_the_modes_above_the_band(cubic):
     """The fit's last stages (`_Fit.widened`): a model of the chain without its modes above the band (48.8 and
     59.8 Hz), its cubic joint as simulated, gets poles there through the joint's harmonics and simulates the levels
     better; never worse, since the wider model is kept only where the whole records say so."""
-    from satmd.structure.fit import _Fit, _cost
+    from satmd.structure.fit import _Fit
+    from satmd.structure.simulations import cost
 
     spectra = [periodic_spectra(r) for r in cubic]
     linear = fit_linear(spectra[0], CHANNELS)
@@ -104,10 +105,10 @@ def test_the_fitted_joint_s_harmonics_add_the_modes_above_the_band(cubic):
     added = np.abs(wider.linear.poles[linear.poles.size:]) / (2 * np.pi)
     assert added.size and np.all(added > 40.0), added
     assert all(np.min(np.abs(added - f)) < 1.5 for f in (48.8, 59.8)), added
-    before, after = _cost(model, fit.whole(model)), _cost(wider, fit.whole(wider))
+    before, after = cost(model, fit.whole(model)), cost(wider, fit.whole(wider))
     assert after < 0.4 * before, (before, after)  # 5.7 times lower here
     again = fit.widened(wider)
-    assert _cost(again, fit.whole(again)) <= after * (1 + 1e-9)
+    assert cost(again, fit.whole(again)) <= after * (1 + 1e-9)
 
 
 def test_modes_kept_apart_above_the_band_are_apart(cubic):
@@ -137,6 +138,7 @@ def test_a_law_fitted_again_with_its_modes_apart_is_kept_where_it_simulates_bett
     rest; the joint's harmonics add 48.7 and 59.7 Hz beside them: within 2 %, none within 0.01 %), and of the two
     finished models the one that simulates the whole records better is kept."""
     from satmd.structure import fit as fitting
+    from satmd.structure.simulations import cost
 
     spectra = [periodic_spectra(r) for r in cubic]
     fit = fitting._Fit(cubic, spectra, CHANNELS, None, 10, ("measured",), "acc1", lambda s: None)
@@ -146,9 +148,9 @@ def test_a_law_fitted_again_with_its_modes_apart_is_kept_where_it_simulates_bett
     apart = fit.law(("acc3", "acc4"), "cubic", files, apart=0.02)
     assert apart.linear.poles.size < model.linear.poles.size
     done, other = fit.finished(model, True, files), fit.finished(apart, True, files)
-    costs = [fitting._cost(m, fit.whole(m)) for m in (done, other)]
+    costs = [cost(m, fit.whole(m)) for m in (done, other)]
     monkeypatch.setattr(fitting, "APART", 0.02)
     kept = fit.kept_apart(done, True, files)
-    assert fitting._cost(kept, fit.whole(kept)) == pytest.approx(min(costs), rel=1e-9)
+    assert cost(kept, fit.whole(kept)) == pytest.approx(min(costs), rel=1e-9)
     monkeypatch.setattr(fitting, "APART", 1e-4)
     assert fit.kept_apart(done, True, files) is done

@@ -199,7 +199,7 @@ def test_a_path_off_the_modes_is_fitted_back(cubic_levels):
     solved inside the fit (`outputs.Projection`): the model it returns has its channels re-solved."""
     from dataclasses import replace
 
-    from satmd.structure.fit import _cost, _drives, _fit_span
+    from satmd.structure.simulations import cost, drives_of, fit_span
     from satmd.structure.output_error import output_error
 
     # the model as first fitted, its channels not re-solved (the path then reaches every channel through κ)
@@ -208,17 +208,17 @@ def test_a_path_off_the_modes_is_fitted_back(cubic_levels):
         m = fit_structure([cubic_levels[0], cubic_levels[2]], free_path=False)
     assert m.joint.column is None and m.joint.stroke is None
     recs = [cubic_levels[0], cubic_levels[2]]
-    span = [_fit_span(r) for r in recs]
+    span = [fit_span(r) for r in recs]
     measured = [np.array([np.asarray(r[c], float)[:n] for c in m.channels]) for r, n in zip(recs, span)]
     k = m.joint.coupling.copy()
     k[::2] *= 0.6
     off = replace(m, joint=replace(m.joint, coupling=k))
-    drives = _drives(off, recs, measured, span)
+    drives = drives_of(off, recs, measured, span)
     ref = periodic_spectra(recs[0])
     fixed, free = (output_error(off, drives, ref, 40, fixed_path=f) for f in (True, False))
-    right, wrong = _cost(m, drives), _cost(off, drives)  # 2.4e-4 and 2.7e-4 (the freed path 2.3e-4)
-    assert _cost(fixed, drives) > right + 0.8 * (wrong - right)
-    assert _cost(free, _drives(free, recs, measured, span)) < right + 0.1 * (wrong - right)  # its own channels
+    right, wrong = cost(m, drives), cost(off, drives)  # 2.4e-4 and 2.7e-4 (the freed path 2.3e-4)
+    assert cost(fixed, drives) > right + 0.8 * (wrong - right)
+    assert cost(free, drives_of(free, recs, measured, span)) < right + 0.1 * (wrong - right)  # its own channels
     assert free.joint.column is not None and np.allclose(free.joint.stroke, m.joint.stroke_of(m.linear))
     assert max(free.predict(cubic_levels[1]).nrmse) < max(m.predict(cubic_levels[1]).nrmse) + 5e-4
 
@@ -500,10 +500,27 @@ def test_a_candidate_that_runs_away_costs_inf_without_a_warning():
     import warnings
     from types import SimpleNamespace
 
-    from satmd.structure.fit import _cost
+    from satmd.structure.simulations import cost
 
     measured = np.array([[1.0, -1.0, 2.0, -2.0]])
     drive = SimpleNamespace(outputs=lambda joint: np.full((1, 4), 1e200))
     with warnings.catch_warnings():
         warnings.simplefilter("error")
-        assert _cost(SimpleNamespace(joint=None), [(drive, measured)]) == float("inf")
+        assert cost(SimpleNamespace(joint=None), [(drive, measured)]) == float("inf")
+
+
+def test_a_model_that_runs_away_past_the_top_level_is_told(cubic_levels, cubic_model):
+    """`_Fit.holds_beyond`: the fitted hardening joint stays finite at twice the top level's force; the same joint
+    made a strong softening cubic (its k3 reversed, 100 times over) runs away there, as a freed path's loop can."""
+    from dataclasses import replace
+
+    from satmd.structure.fit import _Fit
+
+    recs = [cubic_levels[0], cubic_levels[2]]
+    fit = _Fit(recs, [periodic_spectra(r) for r in recs], cubic_model.channels, None, 10, ("measured",), None,
+               lambda s: None)
+    assert fit.holds_beyond(cubic_model)
+    c = np.asarray(cubic_model.joint.coefficients, float).copy()
+    c[0] *= -100.0
+    softened = replace(cubic_model, joint=replace(cubic_model.joint, coefficients=c))
+    assert not fit.holds_beyond(softened)
