@@ -495,18 +495,19 @@ def test_a_simulation_that_grew_without_bound_is_called_run_away():
 
 
 def test_a_candidate_that_runs_away_costs_inf_without_a_warning():
-    """The fit weighs candidates by `_cost`; one whose response overflows is out, and the user sees no numpy
-    overflow warning for it (the F-16's `discover` printed two)."""
+    """The fit weighs candidates by `simulations.cost`; one whose response overflows is out, and the user sees no
+    numpy overflow warning for it (the F-16's `discover` printed two)."""
     import warnings
     from types import SimpleNamespace
 
     from satmd.structure.simulations import cost
 
     measured = np.array([[1.0, -1.0, 2.0, -2.0]])
-    drive = SimpleNamespace(outputs=lambda joint: np.full((1, 4), 1e200))
+    linear = object()  # the drive was made for this model's linear part: it is used as it is
+    drive = SimpleNamespace(model=SimpleNamespace(linear=linear), outputs=lambda joint: np.full((1, 4), 1e200))
     with warnings.catch_warnings():
         warnings.simplefilter("error")
-        assert cost(SimpleNamespace(joint=None), [(drive, measured)]) == float("inf")
+        assert cost(SimpleNamespace(joint=None, linear=linear), [(drive, measured)]) == float("inf")
 
 
 def test_a_model_that_runs_away_past_the_top_level_is_told(cubic_levels, cubic_model):
