@@ -11,6 +11,7 @@ from __future__ import annotations
 import numpy as np
 
 FORCE_SHARE = 0.999  # of the force's power (about its mean) below the top of its band
+ROLL_OFF = 0.01      # of a record's Nyquist frequency: `below_nyquist` turns from one to zero over its top 1 %
 
 
 def band_top(signal, fs_hz: float, share: float = FORCE_SHARE) -> float:
@@ -43,3 +44,24 @@ def above_band_shares(simulated, measured, fs_hz: float, top_hz: float) -> tuple
     error = above_band(np.asarray(simulated, float) - m, fs_hz, top_hz)
     missed = float(np.sqrt(np.mean(error ** 2)) / scale) if np.all(np.isfinite(error)) else float("inf")
     return missed, there
+
+
+def below_nyquist(x, oversample: int, pad: int = 4096) -> np.ndarray:
+    """``x`` (..., M) real, sampled at ``oversample`` times a record's rate, low-passed below the record's Nyquist
+    frequency (a cosine roll-off over its top `ROLL_OFF`), as an acquisition's anti-alias filter does before it
+    samples: taken every ``oversample``-th sample, nothing above the Nyquist frequency folds into the band. The
+    record's end is mirrored over ``pad`` samples tapered to nothing, so the filter sees no step there (a
+    simulation from rest starts at nothing)."""
+    from scipy import fft
+
+    x = np.asarray(x, float)
+    n = x.shape[-1]
+    if oversample <= 1 or n < 2:
+        return x
+    p = min(n, pad)
+    taper = 0.5 * (1 + np.cos(np.pi * np.arange(p) / p))
+    extended = np.concatenate([x, x[..., :n - p - 1:-1] * taper], axis=-1)
+    size = fft.next_fast_len(n + p, real=True)
+    f = fft.rfftfreq(size) * 2 * oversample  # 1 at the record's Nyquist frequency
+    gain = 0.5 * (1 + np.cos(np.pi * np.clip((f - 1 + ROLL_OFF) / ROLL_OFF, 0.0, 1.0)))
+    return fft.irfft(fft.rfft(extended, size, axis=-1) * gain, size, axis=-1)[..., :n]

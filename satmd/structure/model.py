@@ -10,18 +10,15 @@ Fitted by `fit_structure` on recordings at several levels (SPEC §11):
    band that a start from rest rings (`startup.start_up_modes`).
 3. **Start** in the frequency domain, every level at once: the change ``E_o = A_o − H_o F`` is the
    joint's force ``G = Σ c_j t_j(d, v)`` (from the measured relative motion) through the joint's column,
-   ``A_or κ_r / (iω − λ_r)`` with a coupling ``κ_r`` per mode (reciprocity: the column of a force at
-   two sensors is the force's column scaled per mode). Linear in κ at fixed c and in c at fixed κ:
-   alternated to convergence. Where this open-loop start makes the closed loop run away, the joint's
-   terms are scaled down until it does not.
-4. **Output error** in time (`scipy.optimize.least_squares`): the responses simulated from rest with
-   each measured force (`simulate`), all levels and channels at once, each channel in units of its RMS;
-   the law's coefficients and the coupling are free.
+   ``A_or κ_r / (iω − λ_r)`` with a coupling ``κ_r`` per mode (reciprocity: the column of a force at two sensors
+   is the force's column scaled per mode). Linear in κ at fixed c and in c at fixed κ: alternated to
+   convergence; where this open-loop start makes the closed loop run away, the terms are scaled down until not.
+4. **Output error** in time (`scipy.optimize.least_squares`): the responses simulated with each measured force
+   (`simulate`), all levels and channels at once, each in units of its RMS; the law and the coupling free.
 
-A periodic force is simulated from rest over one extra period before the record (a lab's record starts
-in steady state: its first period is the structure's answer to the period before it) unless its start
-shows it began from rest (`warmup_of`); any other force from rest at the first sample. NRMSE (SPEC §11): RMS of the simulation's error over the RMS of the
-measured output, per channel.
+A periodic force is simulated from rest over one extra period before the record (a lab's record starts in steady
+state: its first period answers the period before it) unless its start shows it began from rest (`warmup_of`);
+any other force from rest at the first sample. NRMSE (SPEC §11): the error's RMS over the measured RMS, per channel.
 """
 from __future__ import annotations
 
@@ -33,7 +30,7 @@ import numpy as np
 from ..errors import DataError
 from ..numerics import force_level
 from .acquisition import Acquisition
-from .bands import above_band_shares, band_top
+from .bands import above_band_shares, band_top, below_nyquist
 from .kernel import joint_states
 from .laws import law as law_named
 from .linear import LinearStructure, as_pairs, discretise, from_pairs, modal_states, response
@@ -389,12 +386,14 @@ class Drive:
     def driven(self, joint: Joint, step: int = 1):
         """(g, w) at the kept samples: the joint's force (NaN from where it ran away) and each mode's state it
         drives with its direct part, ``w_r = z_r + g / λ_r``: a force at the joint's sensors moves them at once,
-        the column's flat part (receptance ~ 1/s²). The joint's share of the outputs is ``Re Σ 2 A_r κ_r w_r``."""
+        the column's flat part (receptance ~ 1/s²). The joint's share of the outputs is ``Re Σ 2 A_r κ_r w_r``.
+        The direct part is low-passed below Nyquist, as an acquisition samples (`bands.below_nyquist`); the states,
+        which integrate the force, fold less and are taken as they fall (docs/guide/nonlinear.md)."""
         lin = self.model.linear
         pair = self.pair * joint.coupling
         first, stride = self.r * self.skip, self.r * step  # the record's kept samples on the joint's finer steps
         g, z = joint_states(self.psi, self.G0, self.G1, 2 * pair / lin.poles ** 2, 2 * pair / lin.poles, self.dF,
                             self.vF, joint.law_form.codes, np.asarray(joint.coefficients, float),
                             np.asarray(joint.aux, float), first, stride)
-        g = g[first::stride]
-        return g, z + g[None, :] / lin.poles[:, None]
+        with np.errstate(invalid="ignore", over="ignore"):  # a run-away's NaN is told by ``g``
+            return g[first::stride], z + below_nyquist(g, self.r)[first::stride][None, :] / lin.poles[:, None]

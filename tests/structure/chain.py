@@ -28,6 +28,21 @@ def chain_matrices(n, m=1.0, k=4e4, zeta=0.01):
     return M, K, C
 
 
+def chain_modes(n, m=1.0, k=4e4, zeta=0.01):
+    """(poles, accelerance residues (n masses, modes) and feed-through of a force on the first mass): the chain's
+    own linear part, exact (its damping is proportional to its stiffness, so its modes are real)."""
+    from scipy import linalg
+
+    M, K, C = chain_matrices(n, m, k, zeta)
+    w2, phi = linalg.eigh(K, np.diag(M))
+    om = np.sqrt(w2)
+    z = np.diag(phi.T @ C @ phi) / (2 * om)
+    damped = om * np.sqrt(1 - z ** 2)
+    poles = -z * om + 1j * damped
+    residues = phi * phi[0][None, :] * poles[None, :] ** 2 / (2j * damped)[None, :]
+    return poles, residues, (phi * phi[0][None, :]).sum(axis=1)
+
+
 def multisine(period, fs, lo, hi, seed):
     rng = np.random.default_rng(seed)
     k = np.arange(period // 2 + 1)
@@ -45,9 +60,13 @@ def log_sweep(fs, duration_s, f_start, f_end, taper_s=0.5):
 
 
 def simulate_chain(n=5, joint=(2, 3), law=lambda d, v: 3e9 * d ** 3, levels=(1.0, 3.0, 8.0), fs=256.0,
-                   period=1024, periods=5, band=(3.0, 60.0), noise=0.01, seed=0, m=1.0, k=4e4, force=None):
+                   period=1024, periods=5, band=(3.0, 60.0), noise=0.01, seed=0, m=1.0, k=4e4, force=None,
+                   anti_alias=False):
     """Recordings (force, acc1..accN) of the chain at each level; ``joint`` = (i, j) masses (0-based), j None: ground.
-    ``force``: one record of the force shape (a sweep, ...) instead of ``periods`` of a multisine."""
+    ``force``: one record of the force shape (a sweep, ...) instead of ``periods`` of a multisine. ``anti_alias``:
+    the accelerations low-passed below the Nyquist frequency before they are sampled, as an acquisition's
+    anti-alias filter does (an ideal one, on the record mirrored at its end), the force band-limited between its
+    samples (a periodic force's: exact); else sampled as they are, the force straight between its samples."""
     M, K, C = chain_matrices(n, m, k)
     i, j = joint
     rng = np.random.default_rng(seed)
@@ -60,6 +79,7 @@ def simulate_chain(n=5, joint=(2, 3), law=lambda d, v: 3e9 * d ** 3, levels=(1.0
         h = 1.0 / (fs * sub)
         x, v = np.zeros(n), np.zeros(n)
         acc = np.zeros((f.size, n))
+        fine = np.zeros((f.size * sub, n))
 
         def rhs(x, v, fk):
             d = x[i] - (x[j] if j is not None else 0.0)
@@ -72,6 +92,10 @@ def simulate_chain(n=5, joint=(2, 3), law=lambda d, v: 3e9 * d ** 3, levels=(1.0
                 force[j] += g
             return force / M
 
+        if anti_alias:  # the force band-limited between its samples too (the record's periods: exact)
+            spectrum = np.fft.rfft(f)
+            smooth = np.fft.irfft(spectrum, f.size * 2 * sub) * 2 * sub
+            smooth = np.append(smooth, smooth[0])
         for s in range(f.size):
             f0, f1 = f[s], f[(s + 1) % f.size] if s + 1 < f.size else f[s]
             acc[s] = rhs(x, v, f0)
@@ -79,12 +103,20 @@ def simulate_chain(n=5, joint=(2, 3), law=lambda d, v: 3e9 * d ** 3, levels=(1.0
                 fa = f0 + (f1 - f0) * q / sub
                 fm = f0 + (f1 - f0) * (q + 0.5) / sub
                 fb = f0 + (f1 - f0) * (q + 1) / sub
+                if anti_alias:
+                    fa, fm, fb = smooth[2 * (s * sub + q):2 * (s * sub + q) + 3]
                 k1x, k1v = v, rhs(x, v, fa)
+                fine[s * sub + q] = k1v
                 k2x, k2v = v + 0.5 * h * k1v, rhs(x + 0.5 * h * k1x, v + 0.5 * h * k1v, fm)
                 k3x, k3v = v + 0.5 * h * k2v, rhs(x + 0.5 * h * k2x, v + 0.5 * h * k2v, fm)
                 k4x, k4v = v + h * k3v, rhs(x + h * k3x, v + h * k3v, fb)
                 x = x + h / 6 * (k1x + 2 * k2x + 2 * k3x + k4x)
                 v = v + h / 6 * (k1v + 2 * k2v + 2 * k3v + k4v)
+        if anti_alias:
+            mirrored = np.concatenate([fine, fine[::-1]])
+            spectrum = np.fft.rfft(mirrored, axis=0)
+            spectrum[np.fft.rfftfreq(mirrored.shape[0], 1.0 / (fs * sub)) >= fs / 2] = 0.0
+            acc = np.fft.irfft(spectrum, mirrored.shape[0], axis=0)[:fine.shape[0]:sub]
         chans = {"force": f + noise * 0.5 * np.std(f) * rng.standard_normal(f.size)}
         for q in range(n):
             a = acc[:, q]
