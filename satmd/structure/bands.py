@@ -60,7 +60,7 @@ def below_nyquist(x, oversample: int, pad: int = 4096) -> np.ndarray:
         return x
     p = min(n, pad)
     taper = 0.5 * (1 + np.cos(np.pi * np.arange(p) / p))
-    extended = np.concatenate([x, x[..., :n - p - 1:-1] * taper], axis=-1)
+    extended = np.concatenate([x, x[..., ::-1][..., :p] * taper], axis=-1)
     size = fft.next_fast_len(n + p, real=True)
     f = fft.rfftfreq(size) * 2 * oversample  # 1 at the record's Nyquist frequency
     gain = 0.5 * (1 + np.cos(np.pi * np.clip((f - 1 + ROLL_OFF) / ROLL_OFF, 0.0, 1.0)))

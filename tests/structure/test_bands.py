@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from satmd.structure import Joint, StructureModel
-from satmd.structure.bands import above_band_shares, band_top
+from satmd.structure.bands import above_band_shares, band_top, below_nyquist
 from satmd.structure.linear import fit_linear
 from satmd.structure.outside import above_band, harmonics_explained
 from satmd.structure.spectra import periodic_spectra
@@ -20,6 +20,20 @@ CHANNELS = ("acc1", "acc2", "acc3", "acc4")
 def cubic():
     return simulate_chain(n=4, joint=(2, 3), law=lambda d, v: 3e9 * d ** 3, band=(3.0, 36.0), levels=(1.0, 3.0, 8.0),
                           period=1024, periods=4, noise=0.005, seed=5)
+
+
+def test_below_nyquist_keeps_the_band_and_drops_what_would_fold():
+    """At 8 times a record's rate: a 20 Hz tone is kept, a 300 Hz one (above the record's 128 Hz Nyquist, where
+    it would fold to 44 Hz) is dropped up to a dozen record samples from either end (the end is mirrored, so there is
+    no step there, but the kink where the record starts rings over a few samples); at the record's rate nothing is
+    filtered; a record shorter than the mirror is filtered all the same."""
+    t = np.arange(40000) / 2048.0
+    kept, folding = np.sin(2 * np.pi * 20 * t), 0.5 * np.sin(2 * np.pi * 300 * t)
+    out = below_nyquist(kept + folding, 8)
+    assert np.max(np.abs(out - kept)[100:-100]) < 2e-3 and np.sqrt(np.mean((out - kept) ** 2)) < 2e-3
+    assert np.array_equal(below_nyquist(kept + folding, 1), kept + folding)
+    short = below_nyquist((kept + folding)[:1000], 8)
+    assert short.shape == (1000,) and np.sqrt(np.mean((short - kept[:1000])[100:900] ** 2)) < 0.01
 
 
 def test_the_force_band_is_where_the_force_puts_its_power(cubic):
