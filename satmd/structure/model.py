@@ -346,7 +346,7 @@ class Drive:
 
     The joint's force runs at ``oversample`` times the sample rate (the force interpolated band-limited): a
     stick-slip or a contact makes the force change faster than the record's samples follow, and a step at
-    the record's rate would smear it. Its response is then taken back to the record's samples."""
+    the record's rate would smear it. Its response is taken back to the record's samples (`driven`)."""
 
     def __init__(self, model: StructureModel, force, fs_hz: float, warmup: int):
         from ..physics.nonlinear.integrate import band_limited, upsample

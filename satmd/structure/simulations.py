@@ -69,7 +69,8 @@ def stable(model, drives) -> StructureModel:
 
 
 def with_table(model, recordings, files, drives=None) -> StructureModel:
-
+    """``model`` with its fit table: NRMSE per recording and channel, the lowest level's linear model against the
+    model with its joint, simulated on the whole records (or on ``drives`` [(Drive, measured)] where given)."""
     lin, nl = [], []
     for i, r in enumerate(recordings):
         if drives is None:
