@@ -81,6 +81,26 @@ def above_band(model, spectra, apart: float = 0.0):
     return replace(model, linear=extra, joint=joint)
 
 
+def loop_poles(model, spectra, pairs: int) -> np.ndarray:
+    """The poles above the force's band that a vector fit with ``pairs`` pairs finds in what ``model`` leaves at
+    the lines above the band (every level but the lowest), whatever share of it they explain: the starts of the
+    modes `loop.with_loop_modes` fits in the joint's loop. Empty where there are none."""
+    from ..modal.rational import vector_fit_inputs
+
+    ref = min(spectra, key=lambda s: s.level)
+    blocks = [b for b in (_block(model, s) for s in spectra if s is not ref) if b is not None]
+    if not blocks:
+        return np.zeros(0, complex)
+    try:
+        poles, _, _ = vector_fit_inputs([(f, G[None, :], E, W) for f, G, E, W, _ in blocks], pairs)
+    except np.linalg.LinAlgError:
+        return np.zeros(0, complex)
+    f_hz = poles.imag / (2 * np.pi)
+    zeta = -poles.real / np.maximum(np.abs(poles), TINY)
+    return np.sort_complex(poles[(f_hz > band_top_hz(spectra)) & (f_hz < spectra[0].fs_hz / 2) & (zeta > 0)
+                                 & (zeta < 0.3)])
+
+
 def _crowded(added, poles, apart: float) -> bool:
     """Whether an added pole lies within ``apart`` (a share of its frequency) of another added one or of ``poles``."""
     if apart <= 0:
