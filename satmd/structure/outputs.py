@@ -69,11 +69,17 @@ class Projection:
                 return None
             basis = np.vstack([fixed, 2 * w.real, -2 * w.imag, u[None, :]])
             bases.append(basis)
-            gram = gram + (weight ** 2)[:, None, None] * (basis @ basis.T)[None]
-            moment = moment + (weight ** 2)[:, None] * (y @ basis.T)
+            with np.errstate(over="ignore", invalid="ignore"):  # a state beyond floating point: told below
+                gram = gram + (weight ** 2)[:, None, None] * (basis @ basis.T)[None]
+                moment = moment + (weight ** 2)[:, None] * (y @ basis.T)
+        if not (np.all(np.isfinite(gram)) and np.all(np.isfinite(moment))):
+            return None  # a state beyond floating point: ran away as surely as the joint's force
         column = joint.column_of(lin)
         prior = np.hstack([lin.residues.real, lin.residues.imag, column.real, column.imag, lin.feedthrough[:, None]])
-        theta = prior + np.array([_ridge_step(gram[i], moment[i] - gram[i] @ prior[i]) for i in range(n_out)])
+        try:
+            theta = prior + np.array([_ridge_step(gram[i], moment[i] - gram[i] @ prior[i]) for i in range(n_out)])
+        except np.linalg.LinAlgError:
+            return None
         residuals = np.concatenate([((theta @ basis - y) * weight[:, None]).ravel()
                                     for basis, (*_, y, weight) in zip(bases, self.parts)]) / np.sqrt(self.size)
         solved = replace(lin, residues=theta[:, :n] + 1j * theta[:, n:2 * n], feedthrough=theta[:, 4 * n])
