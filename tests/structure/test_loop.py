@@ -68,3 +68,22 @@ def test_the_modes_above_the_band_are_found_and_fitted_in_the_joint_s_loop():
     before, after = _worst(model, held), _worst(looped, held)
     assert after < 0.35 * before, (before, after)
     assert 0.8 * STIFF < looped.joint.coefficients[0] < 1.2 * STIFF and "k3" in looped.joint.ci95
+
+
+def test_a_trial_whose_states_pass_floating_point_is_told_as_a_run_away():
+    """A trial mode in the loop can drive a state past floating point while the joint's force stays finite (on
+    `structures_predict`'s first chain): the channels' least squares would be singular; the trial is a run-away."""
+    from satmd.structure.outputs import Projection
+
+    recording = simulate_chain(n=4, joint=(2, 3), law=lambda d, v: STIFF * d ** 3, levels=(1.0,), seed=2)[0]
+    poles, residues, feed = chain_modes(4)
+    lin = LinearStructure(NAMES, poles, residues, feed)
+    joint = Joint(("acc3", "acc4"), "cubic", np.array([STIFF, 0.0, 0.0]), np.ones(3),
+                  -lin.coupling("acc3", "acc4", "acc1"), "N")
+    model = StructureModel(lin, joint, (1.0, 1.0), oversample=2)
+    projection = Projection(model, [_whole(model, recording)], 2)
+    assert projection.solve(joint) is not None
+    drive = projection.parts[0][0]
+    g, w = drive.driven(joint, 2)
+    drive.driven = lambda joint, step: (g, w * 1e300)
+    assert projection.solve(joint) is None
