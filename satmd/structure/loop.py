@@ -77,14 +77,14 @@ def with_loop_modes(model, poles, recordings, measured, span, max_nfev: int, fs_
 
     def residual(theta):
         answer = solved(theta)
-        return failed if answer is None else answer[0]
+        return failed if answer is None or not np.all(np.isfinite(answer[0])) else answer[0]
 
     f0 = np.abs(poles) / (2 * np.pi)
     zeta0 = np.clip(-poles.real / np.abs(poles), 1.01 * ZETA[0], 0.99 * ZETA[1])
     starts = [np.concatenate([j.coefficients, np.log(f0), np.log(zeta0), np.full(k, s / k), np.zeros(k)])
               for s in SHARES]
     answers = [(solved(t), t) for t in starts]
-    finite = [(float(a[0] @ a[0]), t, a[0].size) for a, t in answers if a is not None]
+    finite = [(float(a[0] @ a[0]), t, a[0].size) for a, t in answers if a is not None and np.all(np.isfinite(a[0]))]
     if not finite:
         return None
     start_cost, theta0, size = min(finite, key=lambda x: x[0])
