@@ -43,10 +43,8 @@ def above_band(model, spectra, apart: float = 0.0):
     -------
     StructureModel
     """
-    from ..modal.rational import vector_fit_inputs
 
-    ref = min(spectra, key=lambda s: s.level)
-    blocks = [b for b in (_block(model, s) for s in spectra if s is not ref) if b is not None]
+    blocks = _blocks(model, spectra)
     if not blocks:
         return model
     before = sum(float(np.sum(np.abs(E * W) ** 2)) for _, _, E, W, _ in blocks)
@@ -54,13 +52,7 @@ def above_band(model, spectra, apart: float = 0.0):
     band_top = band_top_hz(spectra)
     lin = model.linear
     for pairs in range(1, MAX_PAIRS + 1):
-        try:
-            poles, _, _ = vector_fit_inputs([(f, G[None, :], E, W) for f, G, E, W, _ in blocks], pairs)
-        except np.linalg.LinAlgError:
-            continue
-        f_hz = poles.imag / (2 * np.pi)
-        zeta = -poles.real / np.maximum(np.abs(poles), TINY)
-        poles = poles[(f_hz > band_top) & (zeta > 0) & (zeta < 0.3)]
+        poles = _poles_above(blocks, pairs, band_top)
         if poles.size == 0 or _crowded(poles, lin.poles, apart):
             continue
         T, rss = _residues(poles, blocks)
@@ -85,10 +77,21 @@ def loop_poles(model, spectra, pairs: int) -> np.ndarray:
     """The poles above the force's band that a vector fit with ``pairs`` pairs finds in what ``model`` leaves at
     the lines above the band (every level but the lowest), whatever share of it they explain: the starts of the
     modes `loop.with_loop_modes` fits in the joint's loop. Empty where there are none."""
+    poles = _poles_above(_blocks(model, spectra), pairs, band_top_hz(spectra))
+    return np.sort_complex(poles[poles.imag / (2 * np.pi) < spectra[0].fs_hz / 2])
+
+
+def _blocks(model, spectra) -> list:
+    """`_block` of every level but the lowest that has lines above the band."""
+    ref = min(spectra, key=lambda s: s.level)
+    return [b for b in (_block(model, s) for s in spectra if s is not ref) if b is not None]
+
+
+def _poles_above(blocks, pairs: int, band_top: float) -> np.ndarray:
+    """The poles a vector fit with ``pairs`` pairs finds in ``blocks`` (what a model leaves above the band), those
+    above ``band_top`` Hz with a damping ratio in (0, 0.3); empty where there are none or the fit fails."""
     from ..modal.rational import vector_fit_inputs
 
-    ref = min(spectra, key=lambda s: s.level)
-    blocks = [b for b in (_block(model, s) for s in spectra if s is not ref) if b is not None]
     if not blocks:
         return np.zeros(0, complex)
     try:
@@ -97,8 +100,7 @@ def loop_poles(model, spectra, pairs: int) -> np.ndarray:
         return np.zeros(0, complex)
     f_hz = poles.imag / (2 * np.pi)
     zeta = -poles.real / np.maximum(np.abs(poles), TINY)
-    return np.sort_complex(poles[(f_hz > band_top_hz(spectra)) & (f_hz < spectra[0].fs_hz / 2) & (zeta > 0)
-                                 & (zeta < 0.3)])
+    return poles[(f_hz > band_top) & (zeta > 0) & (zeta < 0.3)]
 
 
 def _crowded(added, poles, apart: float) -> bool:
