@@ -42,10 +42,12 @@ def static_flexibility(poles, stroke) -> float:
     return float(np.sum(2 * (stroke / (-poles ** 3)).real))
 
 
-def with_loop_modes(model, poles, recordings, measured, span, max_nfev: int, fs_hz: float):
+def with_loop_modes(model, poles, recordings, measured, span, max_nfev: int, fs_hz: float, promising=None):
     """``model`` (a joint, its path and channels solved) with modes at ``poles`` (complex, above the band) in the
     joint's loop, their poles, stroke residues and the law's coefficients fitted on the records' first ``span``
-    samples; None where no start keeps the loop finite or the fit gains nothing.
+    samples; None where no start keeps the loop finite or the fit gains nothing. The fit goes on past its first
+    `FIRST_NFEV` steps where they took `GAINING` off and ``promising`` (callable(model) -> bool, the caller's
+    judgement of the model they gave) agrees; None where it does not.
 
     Returns
     -------
@@ -100,7 +102,10 @@ def with_loop_modes(model, poles, recordings, measured, span, max_nfev: int, fs_
                         max_nfev=min(max_nfev, FIRST_NFEV))
     if not 2 * sol.cost < start_cost:
         return None
-    if 2 * sol.cost < (1 - GAINING) * start_cost and max_nfev > FIRST_NFEV:  # it gains: let it go on
+    if 2 * sol.cost < (1 - GAINING) * start_cost and max_nfev > FIRST_NFEV:  # it gains: let it go on ...
+        answer = solved(sol.x)
+        if answer is None or (promising is not None and not promising(answer[1])):
+            return None  # ... where the caller finds it promising (the F-16's gained here and lost on the records)
         sol = least_squares(residual, sol.x, x_scale=scale, diff_step=1e-4, bounds=(lower, upper),
                             max_nfev=max_nfev - FIRST_NFEV)
     answer = solved(sol.x)

@@ -61,8 +61,12 @@ def test_the_modes_above_the_band_are_found_and_fitted_in_the_joint_s_loop():
 
     span = [fit_span(r) for r in fitted]
     measured = [np.array([np.asarray(r[c], float)[:n] for c in NAMES]) for r, n in zip(fitted, span)]
-    looped = with_loop_modes(model, 0.93 * truth * 1j - 0.01 * truth, fitted, measured, span, 40, 256.0)
-    assert looped is not None
+    asked = []  # the caller is asked once, after the first steps gained, whether to go on
+    looped = with_loop_modes(model, 0.93 * truth * 1j - 0.01 * truth, fitted, measured, span, 40, 256.0,
+                             promising=lambda m: asked.append(m.linear.poles.size) or True)
+    assert looped is not None and asked == [lin.poles.size + 2]
+    assert with_loop_modes(model, 0.93 * truth * 1j - 0.01 * truth, fitted, measured, span, 40, 256.0,
+                           promising=lambda m: False) is None  # not promising: no further steps, nothing kept
     added = np.sort(np.abs(looped.linear.poles[lin.poles.size:]))
     assert np.allclose(added, truth, rtol=0.02), added / (2 * np.pi)
     before, after = _worst(model, held), _worst(looped, held)
@@ -87,3 +91,22 @@ def test_a_trial_whose_states_pass_floating_point_is_told_as_a_run_away():
     g, w = drive.driven(joint, 2)
     drive.driven = lambda joint, step: (g, w * 1e300)
     assert projection.solve(joint) is None
+
+
+def test_a_model_holds_beyond_the_top_level_where_its_response_grows_as_the_force_may():
+    """`_Fit.holds_beyond`: the chain's own model, driven by twice the top level's force, responds within ten
+    times the top level's measured response scaled by the force (a hardening joint: less than twice); against a
+    top level measured forty times lower, the same response is a run-away in all but floating point."""
+    from satmd.structure.fit import _Fit
+
+    recordings = simulate_chain(n=4, joint=(2, 3), law=lambda d, v: STIFF * d ** 3, levels=(1.0, 3.0), seed=2)
+    poles, residues, feed = chain_modes(4)
+    lin = LinearStructure(NAMES, poles, residues, feed)
+    joint = Joint(("acc3", "acc4"), "cubic", np.array([STIFF, 0.0, 0.0]), np.ones(3),
+                  -lin.coupling("acc3", "acc4", "acc1"), "N")
+    model = StructureModel(lin, joint, (1.0, 3.0), oversample=oversampling(lin, recordings[0].fs_hz))
+    fit = _Fit(recordings, [periodic_spectra(r) for r in recordings], NAMES, None, 10, ("measured",), "acc1",
+               lambda s: None)
+    assert fit.holds_beyond(model)
+    fit.measured[1] = fit.measured[1] / 40
+    assert not fit.holds_beyond(model)
