@@ -73,9 +73,13 @@ def with_loop_modes(model, poles, recordings, measured, span, max_nfev: int, fs_
                         column=np.hstack([column, np.zeros((n_out, k))]), stroke=np.concatenate([stroke, np.ones(k)]))
         return replace(model, linear=added, joint=joint, oversample=oversampling(added, fs_hz))
 
+    runs = []  # the residuals' runs in time, one per channel and recording (`half_widths`)
+
     def solved(theta):
         trial = build(theta)
-        return Projection(trial, drives_of(trial, recordings, measured, span), STEP).solve(trial.joint)
+        projection = Projection(trial, drives_of(trial, recordings, measured, span), STEP)
+        runs[:] = projection.runs
+        return projection.solve(trial.joint)
 
     def residual(theta):
         answer = solved(theta)
@@ -112,7 +116,7 @@ def with_loop_modes(model, poles, recordings, measured, span, max_nfev: int, fs_
     if answer is None:
         return None
     fitted = answer[1]
-    half = half_widths(sol.jac, sol.fun, [sol.fun.size])
+    half = half_widths(sol.jac, sol.fun, runs)
     names = list(fitted.joint.parameters())
     ci = dict(j.ci95)
     for i, c in enumerate(fitted.joint.coefficients):

@@ -79,7 +79,7 @@ def output_error(model, drives, ref, max_nfev, fixed_path=False, solved=True) ->
         answer = projection.solve(joint)
         model = model if answer is None else answer[1]
         joint = model.joint if answer is not None else joint
-    half = half_widths(sol.jac, sol.fun, [len(np.ravel(m[:, ::step])) for _, m in drives])
+    half = half_widths(sol.jac, sol.fun, [m[:, ::step].shape[1] for _, m in drives for _channel in m])
     if half is None:
         return replace(model, joint=joint)
     names = list(joint.parameters())
@@ -103,7 +103,8 @@ def shape_constants(log_trial, log_start) -> np.ndarray:
 def half_widths(jac, residuals, sizes):
     """95 % half-widths of the fitted parameters: (JᵀJ)⁻¹ scaled by the residuals' variance, inflated by
     (1 + ρ)/(1 − ρ) for their lag-one correlation ρ in time (a simulation's misfit is smooth, not white: without it
-    the intervals would count every sample as news). None when JᵀJ is singular (`numerics.jacobian_covariance`)."""
+    the intervals would count every sample as news); ``sizes``: the residuals' runs in time, one per channel and
+    recording. None when JᵀJ is singular (`numerics.jacobian_covariance`)."""
     jac = np.asarray(jac, float)
     n, p = jac.shape
     if n <= p:

@@ -56,6 +56,7 @@ class Projection:
             self.parts.append((drive, np.vstack([2 * x.real, -2 * x.imag]), drive.u[keep], measured[:, ::self.step],
                                weight))
         self.size = sum(y.size for *_, y, _ in self.parts)
+        self.runs = [y.shape[1] for *_, y, _ in self.parts for _ in y]  # the residuals' runs in time (`solve`)
 
     def solve(self, joint):
         """(residuals (every recording's weighted misfit, flat), the model with ``joint`` and every channel
