@@ -25,6 +25,7 @@ from ..conventions import TINY
 BANDS = 16        # bands of frequency between the force's band edge and Nyquist
 MIN_SHARE = 1e-6  # of the joint's share's power above the band: a band with less says nothing
 MIN_GAIN = 0.05   # the fitted records' misfit above the band must fall by this share
+EDGE = 512        # samples mirrored at each end of a record the gain is applied to (`Acquisition.apply`)
 
 
 @dataclass(frozen=True)
@@ -48,10 +49,17 @@ class Acquisition:
         return out
 
     def apply(self, share, fs_hz: float) -> np.ndarray:
-        """``share`` (C, N), sampled at ``fs_hz``, through the chain's gain (by FFT over the record)."""
+        """``share`` (C, N), sampled at ``fs_hz``, through the chain's gain, by FFT over the record mirrored about
+        its first and last samples (`EDGE`): over the record alone the FFT joins its end to its start, a step
+        that a gain rolling off toward Nyquist rings at both ends (on an independent wing the last sample of a
+        quiet channel was missed by 2.5 times its RMS, 0.024 of its held-out NRMSE of 0.035)."""
         x = np.asarray(share, float)
         n = x.shape[-1]
-        return np.fft.irfft(np.fft.rfft(x, axis=-1) * self.at(np.fft.rfftfreq(n, 1.0 / fs_hz)), n, axis=-1)
+        pad = min(EDGE, n - 1)
+        mirrored = np.concatenate([x[..., pad:0:-1], x, x[..., -2:-pad - 2:-1]], axis=-1)
+        m = mirrored.shape[-1]
+        out = np.fft.irfft(np.fft.rfft(mirrored, axis=-1) * self.at(np.fft.rfftfreq(m, 1.0 / fs_hz)), m, axis=-1)
+        return out[..., pad:pad + n]
 
     def cutoff_hz(self) -> float | None:
         """The first band's centre where the gain is below 1/√2 (the chain's -3 dB point lies in that band or the

@@ -28,6 +28,7 @@ MIN_GAIN = 0.05        # share of the remaining misfit a pole must remove
 TOP_SHARE = 0.8        # of the Nyquist frequency: beyond it an acquisition's anti-alias filter takes the response
 GRID_STEP = 1.02       # the frequency grid's ratio
 ZETAS = (0.003, 0.01, 0.03, 0.1)
+SAME_POLE = 1e-3       # poles above the band closer than this share of their modulus are one (`_distinct`)
 
 
 def band_top_hz(spectra) -> float:
@@ -94,7 +95,7 @@ def start_up_modes(linear: LinearStructure, recordings, band_top: float, between
         chosen, rss = np.append(chosen, lam), new
     if chosen.size == 0:
         return linear
-    chosen = _pruned(data, inband, _together(data, inband, chosen, band_top, top))
+    chosen = _pruned(data, inband, _distinct(_together(data, inband, chosen, band_top, top)))
     if data.rss(np.concatenate([inband, chosen])) > (1 - MIN_GAIN) * before:
         return linear
     return data.fitted(np.concatenate([inband, chosen]))
@@ -149,6 +150,18 @@ def _together(data, inband, chosen, lo: float, hi: float) -> np.ndarray:
     fit = least_squares(residual, np.clip(start, bounds[0] + 1e-9, bounds[1] - 1e-9), bounds=bounds,
                         x_scale=np.tile([1.0, 0.1], chosen.size), max_nfev=20)
     return poles(fit.x)
+
+
+def _distinct(chosen) -> np.ndarray:
+    """``chosen`` less each pole that coincides with one before it (within `SAME_POLE` of it): refined together,
+    two poles can run to the same corner of their bounds, and their residues, solved by least squares, then
+    cancel at a hundred million times the in-band ones (a double pole, no mode): a wing's quiet channel answered
+    every step of its force there (at the record's last sample 2.5 times its RMS)."""
+    kept: list = []
+    for p in chosen:
+        if all(abs(p - q) > SAME_POLE * abs(q) for q in kept):
+            kept.append(p)
+    return np.array(kept, complex)
 
 
 def _pruned(data, inband, chosen) -> np.ndarray:

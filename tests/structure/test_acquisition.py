@@ -97,6 +97,19 @@ def test_the_gain_is_one_in_the_band_and_round_trips(tmp_path):
         Acquisition.from_dict(doc)
 
 
+def test_the_gain_does_not_join_a_record_s_end_to_its_start():
+    """Applied by FFT over the record alone, the gain's roll-off rang the step from the record's end back to its
+    start; mirrored about its ends, a record's first samples come out as they do inside a longer one."""
+    from tests.structure.chain import multisine
+
+    gain = Acquisition(40.0, np.array([60.0, 100.0, 120.0]), np.array([0.9 * np.exp(-0.5j), 0.5 * np.exp(-2j),
+                                                                       0.1 * np.exp(-3j)]))
+    x = np.tile(multisine(1024, 256.0, 5.0, 90.0, 0), 4)
+    cut, whole = gain.apply(x[None, :2500], 256.0)[0], gain.apply(x[None, :], 256.0)[0][:2500]
+    assert np.max(np.abs(cut - whole)[:16]) < 1e-3 * np.std(x)
+    assert np.max(np.abs(cut - whole)[500:2000]) < 1e-3 * np.std(x)  # the gain on another grid of lines
+
+
 def test_a_saved_model_keeps_its_acquisition_and_a_cut_one_is_refused(tmp_path, chain):
     gain = Acquisition(40.0, np.array([60.0, 90.0]), np.array([0.9 - 0.2j, 0.5 - 0.6j]))
     model = replace(chain[0], acquisition=gain)

@@ -88,3 +88,17 @@ def test_a_record_begun_in_motion_is_no_start_from_rest(chain):
     assert excitation_of(received(moving)).transient_periods  # the drift reads as a transient
     assert warmup_of(moving) == n and warmup_of(fitted[0]) == 0
     assert start_up_modes(linear, [moving], band_top_hz(spectra)) is linear
+
+
+def test_poles_refined_to_one_point_are_one_pole():
+    """Refined together, two poles above the band can run to one corner of their bounds, their least-squares
+    residues then cancelling at a hundred million times the modes' (a double pole, no mode): one of them is kept.
+    So is one of two poles closer than a record of a few seconds resolves (86.79 and 86.82 Hz); poles apart, in
+    frequency (86.8 and 88 Hz) or in damping (27 % and 25 %), are all kept."""
+    from satmd.structure.startup import _distinct, _pole
+
+    corner = _pole(102.4, 0.3)
+    assert _distinct(np.array([corner, corner * (1 + 1e-5), _pole(86.8, 0.009)])).size == 2
+    assert _distinct(np.array([_pole(86.79, 0.0087), _pole(86.82, 0.0088)])).size == 1
+    apart = np.array([_pole(86.8, 0.0087), _pole(88.0, 0.0088), _pole(102.4, 0.27), _pole(102.4, 0.25)])
+    assert np.array_equal(_distinct(apart), apart)

@@ -88,50 +88,66 @@ def band_limited(force, fs_hz: float, pad: int = 2048) -> np.ndarray:
     """The samples whose straight-line interpolation drives the rig as the band-limited force would.
 
     Straight lines between samples pass a sinusoid at f with gain sinc²(f / fs) (-0.8 % at
-    100 Hz and 2048 Hz); dividing the spectrum by it (zero-padded, so the force is 0 outside
-    the record) makes the first-order-hold response that of the Shannon-interpolated force.
+    100 Hz and 2048 Hz); dividing the spectrum by it (padded: 0 before the record, its end mirrored
+    after it, `_padded`) makes the first-order-hold response that of the Shannon-interpolated force.
 
     Parameters
     ----------
     force : (N,) or (batch, N) samples.
     fs_hz : sample rate [Hz].
-    pad : zeros added at each end before the FFT.
+    pad : samples added at each end before the FFT.
 
     Returns
     -------
     ndarray, the shape of ``force``.
     """
-    from scipy.fft import irfft, next_fast_len, rfft, rfftfreq
+    from scipy.fft import irfft, rfft, rfftfreq
 
     x = np.asarray(force, float)
     n = x.shape[-1]
-    size = next_fast_len(n + 2 * pad, real=True)
-    padded = np.zeros(x.shape[:-1] + (size,))
-    padded[..., pad:pad + n] = x
+    padded, size = _padded(x, pad)
     gain = np.sinc(rfftfreq(size, 1.0)) ** 2  # f / fs on the rfft grid
     return irfft(rfft(padded) / gain, size)[..., pad:pad + n]
 
 
+def _padded(x, pad: int):
+    """(``x`` with ``pad`` zeros before it and its own end mirrored after it, tapered to zero; the FFT's size): a
+    record starts from rest, and its force goes on after its last sample; cut to zero there, the step rang over
+    the last samples through the modes near Nyquist (an independent wing's quiet channel missed its last sample
+    by 2.5 times its RMS; with its place and law given, its held-out levels' worst NRMSE went 0.034 → 0.025,
+    3x its noise 0.027)."""
+    from scipy.fft import next_fast_len
+
+    n = x.shape[-1]
+    size = next_fast_len(n + 2 * pad, real=True)
+    padded = np.zeros(x.shape[:-1] + (size,))
+    padded[..., pad:pad + n] = x
+    tail = min(pad, n)
+    if tail:
+        taper = np.cos(np.linspace(0.0, np.pi / 2, tail)) ** 2
+        padded[..., pad + n:pad + n + tail] = x[..., ::-1][..., :tail] * taper
+    return padded, size
+
+
 def upsample(force, k: int, pad: int = 2048) -> np.ndarray:
-    """Band-limited interpolation of samples to ``k`` times the rate (zero-padded FFT; 0 outside the record).
+    """Band-limited interpolation of samples to ``k`` times the rate (FFT; 0 before the record, its end mirrored
+    after it: `_padded`).
 
     Parameters
     ----------
     force : (N,) or (batch, N) samples.
     k : factor.
-    pad : zeros added at each end before the FFT.
+    pad : samples added at each end before the FFT.
 
     Returns
     -------
     ndarray (..., k N); every k-th sample is the input.
     """
-    from scipy.fft import irfft, next_fast_len, rfft
+    from scipy.fft import irfft, rfft
 
     x = np.asarray(force, float)
     n = x.shape[-1]
-    size = next_fast_len(n + 2 * pad, real=True)
-    padded = np.zeros(x.shape[:-1] + (size,))
-    padded[..., pad:pad + n] = x
+    padded, size = _padded(x, pad)
     spec = rfft(padded)
     if size % 2 == 0:
         spec[..., -1] *= 0.5  # split the Nyquist line between its two images
