@@ -73,7 +73,7 @@ def with_loop_modes(model, poles, recordings, measured, span, max_nfev: int, fs_
                         column=np.hstack([column, np.zeros((n_out, k))]), stroke=np.concatenate([stroke, np.ones(k)]))
         return replace(model, linear=added, joint=joint, oversample=oversampling(added, fs_hz))
 
-    runs = []  # the residuals' runs in time, one per channel and recording (`half_widths`)
+    runs: list = []  # the residuals' runs in time, one per channel and recording (`half_widths`)
 
     def solved(theta):
         trial = build(theta)
