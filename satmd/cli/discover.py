@@ -27,6 +27,9 @@ def register(sub):
     p.add_argument("--driving-point", default=None, metavar="NAME",
                    help="with --save-model: the channel at the shaker (default: found from its modal constants, or "
                         "none); it fixes the joint's force in newtons")
+    p.add_argument("--locate-only", action="store_true",
+                   help="recordings of a structure at several levels: place and name the joint, fit no model of it "
+                        "(seconds where the model takes minutes)")
     p.set_defaults(func=run)
 
 
@@ -42,6 +45,9 @@ def run(args):
         check_outputs([("--save-model", args.save_model, (".json",))], inputs=[args.data, *args.more])
     if args.driving_point and not args.save_model:
         raise SatmdError("--driving-point applies to a structure's model: give --save-model too")
+    if args.locate_only and (args.save_model or not args.more):
+        raise SatmdError("--locate-only applies to several recordings of a structure, without --save-model "
+                         "(the model is what it leaves out)")
     free = parse_list(args.free) or DEFAULT_FREE
     candidates = parse_names(args.candidates, registered_names(), "--candidates") if args.candidates else None
     channels = parse_list(args.channels)
@@ -52,7 +58,8 @@ def run(args):
             raise SatmdError(f"--driving-point {args.driving_point}: no such channel in {args.data} "
                              f"(channels: {', '.join(c for c in items[0].channels if c != 'force')})")
         with stages(lambda text: told.step(text, force=True)):  # a structure's model takes minutes: say what runs
-            rep = discover(items, free=free, candidates=candidates, channels=channels, alpha=args.alpha)
+            rep = discover(items, free=free, candidates=candidates, channels=channels, alpha=args.alpha,
+                           fit_joint=not args.locate_only)
     elif is_recording(args.data):  # the library's own path: estimate, discover, test linearity
         if args.plot:  # every output is checked before the first piece of work
             check_outputs([("--plot", args.plot, plot_suffixes())], inputs=[args.data])

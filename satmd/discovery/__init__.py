@@ -50,7 +50,7 @@ __all__ = ["discover", "discover_many", "DiscoveryReport", "EffectFinding", "Une
 
 @validate_params({"rig": [None, Rig], "free": [NAMES], "candidates": [None, NAMES], "channels": [None, NAMES],
                   "alpha": [Interval(Real, 0, 1, "both")], "max_effects": [Interval(Whole, 0)],
-                  "band_hz": [None, Band(open_ends=True)]})
+                  "band_hz": [None, Band(open_ends=True)], "fit_joint": [bool]})
 def discover(
     data,
     rig: Rig | None = None,
@@ -60,6 +60,7 @@ def discover(
     alpha: float = 1e-3,
     max_effects: int = 3,
     band_hz=None,
+    fit_joint: bool = True,
 ) -> DiscoveryReport:
     """Find what physics the nominal model leaves out of ``data``.
 
@@ -82,6 +83,8 @@ def discover(
     max_effects : most effects a model may hold.
     band_hz : (lo, hi) Hz, either None for open: the band a recording's FRFs are estimated in (default:
         the band the force excites); FRFData are cut to it.
+    fit_joint : recordings of a structure at several levels: fit the located joint's model on every level
+        (`satmd.structure.fit_structure`, minutes on two cores; default), else place and name it only (seconds).
 
     Returns
     -------
@@ -97,7 +100,7 @@ def discover(
 
         data = [_with_excitation(part) for part in data]
         return discover_recordings(data, discover, rig=rig, free=free, alpha=alpha, candidates=candidates,
-                                   channels=channels, max_effects=max_effects)
+                                   channels=channels, max_effects=max_effects, fit_joint=fit_joint)
     recording = data if isinstance(data, Recording) else None
     if recording is not None:
         from ..signal.estimate import estimate_frf

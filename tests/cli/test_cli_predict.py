@@ -57,6 +57,19 @@ def test_save_model_needs_a_structure(capsys, levels, tmp_path):
     assert not out.exists()
 
 
+def test_locate_only_places_the_joint_in_seconds_and_refuses_what_needs_a_model(capsys, levels, tmp_path):
+    rc, out, err = run(capsys, "discover", levels / "L1.csv", levels / "L8.csv", "--locate-only", "--json")
+    assert rc == 0, err
+    assert "locating the joint" in err and "output-error fit" not in err
+    joint = json.loads(out)["nonlinear"]["findings"][0]
+    assert joint["between"] == ["acc3", "acc4"] and "fit" not in joint
+    out_model = tmp_path / "m.json"
+    refused(capsys, "discover", levels / "L1.csv", levels / "L8.csv", "--locate-only", "--save-model", out_model,
+            says=("--locate-only",), alone=False)
+    refused(capsys, "discover", levels / "L1.csv", "--locate-only", says=("--locate-only",), alone=False)
+    assert not out_model.exists()
+
+
 def test_a_structure_with_no_joint_saves_its_linear_model(capsys, tmp_path):
     """SPEC §11: no joint, no joint finding, and the linear model predicts every level within the noise; its
     model is saved as asked, not refused (a ground vibration test of a linear structure is a result too)."""

@@ -126,6 +126,16 @@ def test_discover_says_where_the_joint_acts(cubic_between_3_and_4, monkeypatch):
     assert len(fig.axes) == 3 and "a joint between acc3 and acc4 (cubic)" in fig.texts[0].get_text()
 
 
+def test_discover_can_place_the_joint_without_fitting_it(cubic_between_3_and_4):
+    """``fit_joint=False`` (the CLI's ``--locate-only``): the same place and law, no model fitted or claimed."""
+    from satmd import discover
+
+    rep = discover(cubic_between_3_and_4, fit_joint=False)
+    joint = rep.to_dict()["nonlinear"]["findings"][0]
+    assert joint["between"] == ["acc3", "acc4"] and joint["law"] == "cubic" and "fit" not in joint
+    assert rep.model is None and "modelled" not in rep.report()
+
+
 def test_discover_refuses_a_sensor_missing_at_one_level(cubic_between_3_and_4):
     from satmd import discover
 

@@ -34,14 +34,14 @@ from .findings import analyse_recordings
 _UNEXPLAINED = "unexplained"
 
 
-def discover_recordings(items, linear, rig=None, free=None, alpha: float = 1e-3, **kwargs):
+def discover_recordings(items, linear, rig=None, free=None, alpha: float = 1e-3, fit_joint: bool = True, **kwargs):
     """Discovery on several recordings (or FRFData with std) of one rig: effects and the nonlinear block.
 
     Parameters
     ----------
     items : list of Recording (force, acc1, acc2) or of FRFData with std, in any level order
     linear : the linear discovery, ``linear(data, rig=..., free=..., alpha=..., **kwargs)``
-    rig, free, alpha, **kwargs : as `satmd.discovery.discover`
+    rig, free, alpha, fit_joint, **kwargs : as `satmd.discovery.discover`
 
     Returns
     -------
@@ -89,7 +89,7 @@ def discover_recordings(items, linear, rig=None, free=None, alpha: float = 1e-3,
 
         told = unexplained_by_modes(nl, datas, unit)
         if all(is_forced_recording(x) for x in items):  # many sensors: where the joint acts (SPEC §11)
-            told = with_joint(told, items)
+            told = with_joint(told, items, fit_joint)
         return replace(rep, nonlinear=told)
     # with the moving parameter free, an effect that restates it (or what is left unexplained) is the
     # nonlinearity seen at one level; without one, every linear effect may be

@@ -141,7 +141,7 @@ def _bands(tracks) -> list:
     return out
 
 
-def with_joint(report, recordings):
+def with_joint(report, recordings, fit_joint: bool = True):
     """``report`` (told per resonance) with the structure's joint located among its sensors (SPEC §11), when the
     recordings are periodic tests of two or more response channels and a joint explains the change between their
     levels (`satmd.structure.locate_joint`); unchanged otherwise.
@@ -150,6 +150,7 @@ def with_joint(report, recordings):
     ----------
     report : NonlinearReport with one ``nonlinear_unexplained`` finding (`unexplained_by_modes`)
     recordings : the Recordings of the levels
+    fit_joint : the joint's model fitted on every level (`satmd.structure.fit_structure`), else placed and named only
 
     Returns
     -------
@@ -172,7 +173,7 @@ def with_joint(report, recordings):
         return report
     a, b = loc.between
     near = [e for e in loc.location[1:] if e["delta_bic"] <= 10.0]
-    model = _structure_model(recordings, loc)
+    model = _structure_model(recordings, loc) if fit_joint else None
     named = model.joint.law if model is not None and model.joint is not None else loc.law
     explanation = (f"a joint between {a} and {b} ({named}): its relative motion explains the change between "
                    f"the levels (ΔBIC {loc.location[1]['delta_bic']:.0f} to the next place, "
@@ -217,8 +218,12 @@ def with_joint(report, recordings):
     joint = NonlinearFinding("joint", between=[a, b], location=loc.location, law=law, parameters=parameters or {},
                              ci95=ci95, equivalent=equivalent,
                              modes=old.get("modes"), fit=fit,
-                             explanation=explanation + (f". {old.explanation}" if old.explanation else ""))
+                             explanation=explanation + (f". {_sentence(old.explanation)}" if old.explanation else ""))
     return replace(report, findings=[joint], model=model)
+
+
+def _sentence(text: str) -> str:
+    return text[:1].upper() + text[1:]
 
 
 def _structure_model(recordings, loc):

@@ -63,7 +63,7 @@ def build(ctx) -> str:
     if read is None:
         return SKIPPED
     recs = list(read.values())
-    rep = discover(recs)
+    rep = discover(recs, fit_joint=not ctx.quick)  # quick: the joint placed and named, its model the next section's
     datas = [estimate_frf(r) for r in recs]
     levels = list(rep.nonlinear.levels) if rep.nonlinear is not None else [0.0] * len(recs)
     finding: dict = next((f for f in (rep.nonlinear.findings if rep.nonlinear is not None else [])), {})
