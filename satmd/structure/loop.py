@@ -73,13 +73,13 @@ def with_loop_modes(model, poles, recordings, measured, span, max_nfev: int, fs_
                         column=np.hstack([column, np.zeros((n_out, k))]), stroke=np.concatenate([stroke, np.ones(k)]))
         return replace(model, linear=added, joint=joint, oversample=oversampling(added, fs_hz))
 
-    runs: list = []  # the residuals' runs in time, one per channel and recording (`half_widths`)
+    def projected(theta):
+        trial = build(theta)
+        return Projection(trial, drives_of(trial, recordings, measured, span), STEP), trial.joint
 
     def solved(theta):
-        trial = build(theta)
-        projection = Projection(trial, drives_of(trial, recordings, measured, span), STEP)
-        runs[:] = projection.runs
-        return projection.solve(trial.joint)
+        projection, joint = projected(theta)
+        return projection.solve(joint)
 
     def residual(theta):
         answer = solved(theta)
@@ -112,11 +112,12 @@ def with_loop_modes(model, poles, recordings, measured, span, max_nfev: int, fs_
             return None  # ... where the caller finds it promising (the F-16's gained here and lost on the records)
         sol = least_squares(residual, sol.x, x_scale=scale, diff_step=1e-4, bounds=(lower, upper),
                             max_nfev=max_nfev - FIRST_NFEV)
-    answer = solved(sol.x)
+    projection, joint = projected(sol.x)
+    answer = projection.solve(joint)
     if answer is None:
         return None
     fitted = answer[1]
-    half = half_widths(sol.jac, sol.fun, runs)
+    half = half_widths(sol.jac, sol.fun, projection.runs)  # the residuals' runs, one per channel and recording
     names = list(fitted.joint.parameters())
     ci = dict(j.ci95)
     for i, c in enumerate(fitted.joint.coefficients):
