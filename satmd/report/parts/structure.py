@@ -22,7 +22,7 @@ def build(ctx) -> str:
     fitted = [recs[i] for i in levels]
     loc = locate_joint(fitted)
     model = fit_structure(fitted, location=loc, files=[f"level {i}" for i in levels],
-                          max_nfev=10 if ctx.quick else 40)
+                          max_nfev=5 if ctx.quick else 40)
     held = model.predict(recs[HELD], file=f"level {HELD}")
     ctx.results["structure"] = {"between": list(loc.between), "law": loc.law, "fit": model.fit,
                                 "held_out": held.to_dict(), "formula": model.joint.formula() if model.joint else None}
