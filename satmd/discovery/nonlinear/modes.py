@@ -218,12 +218,9 @@ def with_joint(report, recordings, fit_joint: bool = True):
     joint = NonlinearFinding("joint", between=[a, b], location=loc.location, law=law, parameters=parameters or {},
                              ci95=ci95, equivalent=equivalent,
                              modes=old.get("modes"), fit=fit,
-                             explanation=explanation + (f". {_sentence(old.explanation)}" if old.explanation else ""))
+                             explanation=explanation + (f". {old.explanation[:1].upper()}{old.explanation[1:]}"
+                                                        if old.explanation else ""))
     return replace(report, findings=[joint], model=model)
-
-
-def _sentence(text: str) -> str:
-    return text[:1].upper() + text[1:]
 
 
 def _structure_model(recordings, loc):
