@@ -84,7 +84,8 @@ def discover(
     band_hz : (lo, hi) Hz, either None for open: the band a recording's FRFs are estimated in (default:
         the band the force excites); FRFData are cut to it.
     fit_joint : recordings of a structure at several levels: fit the located joint's model on every level
-        (`satmd.structure.fit_structure`, minutes on two cores; default), else place and name it only (seconds).
+        (`satmd.structure.fit_structure`, minutes on two cores; default), else place and name it only (seconds;
+        refused for one recording or FRFs, which have no joint to place).
 
     Returns
     -------
@@ -95,6 +96,12 @@ def discover(
     from ..io.recording import Recording
 
     check_data(data, "data", (FRFData, Recording), "discover", many=True, hint=LOAD_HINT)
+    several = isinstance(data, (list, tuple)) and sum(isinstance(x, Recording) for x in data) >= 2
+    if not fit_joint and not several:
+        from ..errors import SatmdError
+
+        raise SatmdError("fit_joint=False places a structure's joint without its model: it applies to recordings at "
+                         "two or more levels, not to one recording or to FRFs")
     if isinstance(data, (list, tuple)):  # several recordings of one rig: judged together (issue 26)
         from .nonlinear.levels import discover_recordings
 

@@ -1,6 +1,7 @@
 """The report's F-16 section: four real levels, each resonance's trend, no SATMD element (issue 35)."""
 from __future__ import annotations
 
+import json
 
 from satmd.report import reproduce
 from tests.conftest import needs_real
@@ -27,3 +28,6 @@ def test_structure_section_places_models_and_predicts_the_f16(tmp_path):
     pairs = [cell.strip("* ").split(" → ") for cell in row.split("|")[2:-1]]
     assert len(pairs) == 3 and all(float(b) < float(a) for a, b in pairs)  # better than linear on every channel
     assert (tmp_path / "r" / "figures" / "structure_level5.png").is_file()
+    kept = json.loads((tmp_path / "r" / "results.json").read_text())["structure"]
+    assert kept["law"] in text and kept["formula"] in text  # the model's law, which may not be the spectra's
+    assert kept["spectra_law"] and kept["between"] == ["acc2", "acc3"]

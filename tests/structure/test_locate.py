@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from satmd.errors import DataError
+from satmd.errors import DataError, SatmdError
 from satmd.io import Recording
 from satmd.io.shared import real_data
 from satmd.structure import LAWS, locate_joint
@@ -134,6 +134,8 @@ def test_discover_can_place_the_joint_without_fitting_it(cubic_between_3_and_4):
     joint = rep.to_dict()["nonlinear"]["findings"][0]
     assert joint["between"] == ["acc3", "acc4"] and joint["law"] == "cubic" and "fit" not in joint
     assert rep.model is None and "modelled" not in rep.report()
+    with pytest.raises(SatmdError, match="fit_joint=False .* two or more levels"):
+        discover(cubic_between_3_and_4[0], fit_joint=False)  # one recording: no joint to place
 
 
 def test_discover_refuses_a_sensor_missing_at_one_level(cubic_between_3_and_4):

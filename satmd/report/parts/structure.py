@@ -24,15 +24,17 @@ def build(ctx) -> str:
     model = fit_structure(fitted, location=loc, files=[f"level {i}" for i in levels],
                           max_nfev=5 if ctx.quick else 40)
     held = model.predict(recs[HELD], file=f"level {HELD}")
-    ctx.results["structure"] = {"between": list(loc.between), "law": loc.law, "fit": model.fit,
-                                "held_out": held.to_dict(), "formula": model.joint.formula() if model.joint else None}
+    joint = model.joint
+    # the model's law: the weighing can keep another than the spectra's (`fit_structure`), both said
+    ctx.results["structure"] = {"between": list(loc.between), "law": joint.law if joint else None,
+                                "spectra_law": loc.law, "fit": model.fit, "held_out": held.to_dict(),
+                                "formula": joint.formula() if joint else None}
     names = list(model.channels)
     rows = [f"| {f} (fitted) | " + " | ".join(f"{a:.3f} → {b:.3f}" for a, b in zip(lin, nl)) + " |"
             for f, lin, nl in zip(model.fit["files"], model.fit["linear"], model.fit["nonlinear"])]
     rows.append(f"| **level {HELD} (never seen)** | " + " | ".join(
         f"**{a:.3f} → {b:.3f}**" for a, b in zip(held.linear_nrmse, held.nrmse)) + " |")
     nxt = loc.location[1] if len(loc.location) > 1 else None
-    joint = model.joint
     law_text = f"{joint.law}, force {joint.formula()}" + (" N" if joint.units == "N" else " (relative units)") \
         if joint else "none"
     if joint and joint.law != loc.law:
