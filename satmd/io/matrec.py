@@ -5,11 +5,14 @@ case; beside a force, one matrix called ``Acceleration``, ``acc``, ... is read a
 a channel map says
 (``"force=Force,a1=Acceleration[1],a2=Acceleration[2],a3=Acceleration[3]"``: a
 variable, or one row of a matrix of signals, counted from 1; the long axis of a
-matrix is time; any number of accelerometers ``a<N>``). The sample rate is
-given, or a variable (`FS_NAMES`, any case), or a uniform time vector (`TIME_NAMES`).
+matrix is time; any number of accelerometers ``a<N>``). An array of more axes (a lab's realizations: the
+F-16 benchmark's odd multisines hold ``Acceleration`` 3×9×49152, channel × realization × time) takes one index
+per axis but time, ``Acceleration[1,5]``; axes of length one are dropped (3×1×N reads as 3×N). The sample rate
+is given, or a variable (`FS_NAMES`, any case), or a uniform time vector (`TIME_NAMES`).
 """
 from __future__ import annotations
 
+import re
 from pathlib import Path
 
 import numpy as np
@@ -59,43 +62,70 @@ def _sample_rate(path, v, fs_hz):
 
 
 def _source(path, spec, role):
-    """``Name`` -> ('Name', None); ``Name[i]`` or ``Name(i)`` -> ('Name', i)."""
+    """``Name`` -> ('Name', None); ``Name[i]`` or ``Name(i)`` -> ('Name', (i,)); ``Name[i,j]`` -> ('Name', (i, j))."""
     spec = spec.strip()
     for open_, close in (("[", "]"), ("(", ")")):
         if spec.endswith(close) and open_ in spec:
             name, _, rest = spec[:-1].partition(open_)
             try:
-                return name.strip(), int(rest)
+                return name.strip(), tuple(int(i) for i in rest.split(","))
             except ValueError:
-                raise FormatError(path, f"map {role}={spec}: {rest!r} is not a row number") from None
+                raise FormatError(path, f"map {role}={spec}: {rest!r} is not a row number "
+                                        "(or, for an array of more axes, one number per axis but time)") from None
     return spec, None
 
 
 def _signal(path, v, spec, role):
-    """One signal from ``Name`` or ``Name[i]`` (row or column i, from 1, of a matrix: the long axis is time)."""
+    """One signal from ``Name`` or ``Name[i]`` (row or column i, from 1, of a matrix: the long axis is time), or
+    ``Name[i,j,...]`` of an array of more axes (one index per axis but time, the longest)."""
     spec = spec.strip()
     name, index = _source(path, spec, role)
     key = _lookup(v, name)
     if key is None:
         raise FormatError(path, f"map {role}={spec}: no variable {name!r}; found: "
                                 f"{', '.join(sorted(v)) or 'nothing'}")
-    a = np.asarray(v[key])
+    a = _squeezed(np.asarray(v[key]))
     if index is None:
-        return vector_variable(path, key, a)
-    if a.ndim != 2:
-        raise FormatError(path, f"map {role}={spec}: {key!r} has shape {a.shape}, not a matrix of signals")
-    rows = _signal_rows(a)
-    if not 1 <= index <= rows.shape[0]:
-        raise FormatError(path, f"map {role}={spec}: {key!r} holds {rows.shape[0]} signal(s) "
-                                f"(rows 1..{rows.shape[0]})")
-    return vector_variable(path, f"{key}[{index}]", rows[index - 1])
+        return _vector(path, key, a, f"map {role}={spec}: ")
+    if a.ndim < 2:
+        raise FormatError(path, f"map {role}={spec}: {key!r} has shape {_shape(a)}, not a matrix of signals")
+    signals = np.moveaxis(a, int(np.argmax(a.shape)), -1)  # time last, the other axes in their order
+    axes = signals.shape[:-1]
+    if len(index) != len(axes):
+        example = ",".join("1" for _ in axes)
+        raise FormatError(path, f"map {role}={spec}: {key!r} has shape {_shape(a)}: give one index per axis but "
+                                f"time ({len(axes)}), e.g. {key}[{example}]")
+    if not all(1 <= i <= n for i, n in zip(index, axes)):
+        raise FormatError(path, f"map {role}={spec}: {key!r} has shape {_shape(a)}: indices run "
+                                + ", ".join(f"1..{n}" for n in axes))
+    label = f"{key}[{','.join(map(str, index))}]"
+    return vector_variable(path, label, signals[tuple(i - 1 for i in index)])
+
+
+def _vector(path, key, a, where=""):
+    """Variable ``key`` as one signal; an array of several named with its shape and how to pick one."""
+    if a.ndim >= 2 and sum(n > 1 for n in a.shape) > 1:
+        axes = sum(n > 1 for n in a.shape) - 1
+        raise FormatError(path, f"{where}{key!r} has shape {_shape(a)}, several signals: say which, e.g. "
+                                f"{key}[{','.join('1' for _ in range(axes))}] in a channel map (from 1; time is the "
+                                "longest axis)")
+    return vector_variable(path, key, a)
+
+
+def _squeezed(a):
+    """``a`` without its axes of length one (a 3×1×N array of signals is 3×N), a vector kept a vector."""
+    return a.reshape([n for n in a.shape if n != 1] or [1]) if a.ndim > 2 else a
+
+
+def _shape(a) -> str:
+    return "×".join(map(str, a.shape))
 
 
 def _parse_variable_map(path, spec) -> dict:
     """'force=Force,a1=Acceleration[2]' -> {'force': 'Force', 'acc1': 'Acceleration[2]'}; any a<N> -> acc<N>."""
     out: dict = {}
     sources: dict = {}
-    for part in str(spec).split(","):
+    for part in re.split(r",(?![^\[(]*[\])])", str(spec)):  # the commas between entries, not inside [i,j]
         if not part.strip():
             continue
         role, eq, source = part.partition("=")
@@ -126,11 +156,12 @@ def _response_matrix(path, v):
     """(name, {acc1: row 1, acc2: row 2, ...}) from the one matrix of accelerations a lab's file holds beside its
     force (``Acceleration`` 3×N: rows 1, 2, 3 as acc1, acc2, acc3, the long axis being time); None when there is
     not exactly one."""
-    found = [k for k, a in v.items() if k.lower().startswith(ACCELERATION_PREFIX) and np.asarray(a).ndim == 2
-             and min(np.asarray(a).shape) > 1 and np.asarray(a).dtype.kind in "biuf"]
+    found = [k for k, a in v.items() if k.lower().startswith(ACCELERATION_PREFIX)
+             and _squeezed(np.asarray(a)).ndim == 2 and min(_squeezed(np.asarray(a)).shape) > 1
+             and np.asarray(a).dtype.kind in "biuf"]
     if len(found) != 1:
         return None
-    a = np.asarray(v[found[0]])
+    a = _squeezed(np.asarray(v[found[0]]))
     rows = _signal_rows(a)
     if rows.shape[0] > MAX_MATRIX_ROWS:
         return None
@@ -160,10 +191,10 @@ def read_recording_variables(path, channel_map=None, fs_hz=None):
         for n in ordered({k.lower() for k in v if is_role(k.lower())}):  # force, acc1, acc2, ...
             key = _lookup(v, n)
             if key is not None:
-                signals[n] = vector_variable(path, key, v[key])
+                signals[n] = _vector(path, key, _squeezed(np.asarray(v[key])))
                 used.add(key)
-        matrices = [f"{k} {np.asarray(a).shape}" for k, a in v.items()
-                    if np.asarray(a).ndim == 2 and min(np.asarray(a).shape) > 1]
+        matrices = [f"{k} {_shape(np.asarray(a))}" for k, a in v.items()
+                    if _squeezed(np.asarray(a)).ndim >= 2 and min(np.asarray(a).shape) > 1]
         if "force" in signals and not accelerometers(signals):
             rows = _response_matrix(path, v)
             if rows is not None:
@@ -172,7 +203,8 @@ def read_recording_variables(path, channel_map=None, fs_hz=None):
                 used.add(key)
         if not signals or (matrices and not accelerometers(signals)):
             hint = (f"; it holds {', '.join(matrices)}: say which signal is which, e.g. "
-                    f"a channel map force=Force,a1=Acceleration[2],a2=Acceleration[3] (rows from 1)" if matrices else "")
+                    f"a channel map force=Force,a1=Acceleration[2],a2=Acceleration[3] (rows from 1; an array of "
+                    f"more axes takes one index per axis but time, Acceleration[2,1])" if matrices else "")
             raise FormatError(path, f"no {'response ' if signals else ''}signal variable (any of "
                                     f"{', '.join(RECORDING_NAMES)}){hint}; found: {', '.join(sorted(v)) or 'nothing'}")
     lengths = {n: s.size for n, s in signals.items()}

@@ -130,6 +130,40 @@ def test_acceleration_matrix_mapped_row_by_row(tmp_path, suffix):
         np.testing.assert_array_equal(unmapped[f"acc{k}"], chans[f"r{k}"])
 
 
+@pytest.mark.parametrize("suffix", [".npz", ".mat"])
+def test_realizations_are_read_one_at_a_time(tmp_path, suffix):
+    """The F-16 benchmark's odd multisines: ``Acceleration`` channel × realization × time, ``Force`` realization ×
+    time; its validation file keeps a realization axis of one (3×1×N)."""
+    rng = np.random.default_rng(3)
+    force, accel = rng.normal(size=(4, N)), rng.normal(size=(3, 4, N))
+    every, one = tmp_path / f"est{suffix}", tmp_path / f"val{suffix}"
+    for p, v in ((every, {"Force": force, "Acceleration": accel}),
+                 (one, {"Force": force[1:2], "Acceleration": accel[:, 1:2]})):
+        v = {**v, "Fs": np.float64(FS)}
+        if suffix == ".npz":
+            np.savez(p, **v)
+        else:
+            from scipy.io import savemat
+
+            savemat(p, v)
+    rec = load_recording(every, channel_map="force=Force[2],a1=Acceleration[1,2],a2=Acceleration[2,2],"
+                                            "a3=Acceleration[3,2]")
+    assert list(rec.channels) == ["force", "acc1", "acc2", "acc3"]
+    np.testing.assert_array_equal(rec["force"], force[1])
+    np.testing.assert_array_equal(rec["acc3"], accel[2, 1])
+    for val in (load_recording(one), load_recording(one, channel_map="force=Force,a1=Acceleration[1],"
+                                                                        "a2=Acceleration[2],a3=Acceleration[3]")):
+        assert list(val.channels) == ["force", "acc1", "acc2", "acc3"]
+        np.testing.assert_array_equal(val["acc2"], accel[1, 1])
+    with pytest.raises(FormatError, match=r"'Force' has shape 4×400, several signals: say which, e\.g\. Force\[1\]"):
+        load_recording(every)
+    with pytest.raises(FormatError, match=r"shape 3×4×400: give one index per axis but time \(2\), e\.g\. "
+                                          r"Acceleration\[1,1\]"):
+        load_recording(every, channel_map="force=Force[1],a1=Acceleration[1]")
+    with pytest.raises(FormatError, match=r"acc1=Acceleration\[1,5\]: .* indices run 1\.\.3, 1\.\.4"):
+        load_recording(every, channel_map="force=Force[1],a1=Acceleration[1,5]")
+
+
 def test_two_acceleration_matrices_are_asked_about(tmp_path):
     chans = _signals(["force", "r1", "r2", "r3"])
     p = tmp_path / "two.npz"
