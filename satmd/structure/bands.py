@@ -65,3 +65,18 @@ def below_nyquist(x, oversample: int, pad: int = 4096) -> np.ndarray:
     f = fft.rfftfreq(size) * 2 * oversample  # 1 at the record's Nyquist frequency
     gain = 0.5 * (1 + np.cos(np.pi * np.clip((f - 1 + ROLL_OFF) / ROLL_OFF, 0.0, 1.0)))
     return fft.irfft(fft.rfft(extended, size, axis=-1) * gain, size, axis=-1)[..., :n]
+
+
+def share_outside(signal, fs_hz: float, band_hz, margin: float = 0.02) -> float:
+    """The share of a signal's power (about its mean) outside ``band_hz`` (lo, hi), widened by ``margin`` of each
+    end: for a force, how much of it drives the structure where a model fitted in that band was never shown it."""
+    f = np.asarray(signal, float)
+    power = np.abs(np.fft.rfft(f - f.mean())) ** 2
+    total = float(power.sum())
+    if f.size < 2 or total <= 0:
+        return 0.0
+    freq = np.fft.rfftfreq(f.size, 1.0 / fs_hz)
+    lo, hi = band_hz
+    inside = (freq >= lo * (1 - margin)) & (freq <= hi * (1 + margin))
+    return float(power[~inside].sum() / total)
+

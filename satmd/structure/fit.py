@@ -93,7 +93,7 @@ def fit_structure(recordings, between=None, law: str | None = None, channels=Non
             say("locating the joint among every pair of sensors ...")
         loc = location or locate_joint(spectra, channels=names)
         if not loc.detected:
-            return fit.linear_only(files)
+            return replace(fit.linear_only(files), band_hz=fitted_band(spectra))
         place_given, law_given = between is not None, law is not None
         shape, form = None, ()
         if between is None or tuple(between) == loc.between:
@@ -118,7 +118,13 @@ def fit_structure(recordings, between=None, law: str | None = None, channels=Non
             model = best_place(fit, loc, model, laws, others, files)
     else:
         model = fit.law(tuple(between), law, files)
-    return fit.looped(fit.kept_apart(fit.finished_choice(model, free_path, files), free_path, files), files)
+    model = fit.looped(fit.kept_apart(fit.finished_choice(model, free_path, files), free_path, files), files)
+    return replace(model, band_hz=fitted_band(spectra))
+
+
+def fitted_band(spectra) -> tuple:
+    """(lo, hi) Hz: the lowest and highest lines the recordings' forces excite."""
+    return (min(float(s.freq_hz.min()) for s in spectra), max(float(s.freq_hz.max()) for s in spectra))
 
 
 class _Fit:

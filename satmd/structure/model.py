@@ -30,17 +30,17 @@ import numpy as np
 from ..errors import DataError
 from ..numerics import force_level
 from .acquisition import Acquisition
-from .bands import above_band_shares, band_top, below_nyquist
+from .bands import above_band_shares, band_top, below_nyquist, share_outside
 from .kernel import joint_states
 from .laws import law as law_named
 from .linear import LinearStructure, as_pairs, discretise, from_pairs, modal_states, response
+from .prediction import PREDICTION_SCHEMA, RAN_AWAY, Prediction, _finite_nrmse, nrmse  # noqa: F401  (the model's API)
 from .spectra import drive_force, warmup_of
 
 SCHEMA = "satmd-structure-model/2"
 #: the schemas a model may be read from: /1 had no ``stroke`` (the pair's residues were never re-solved), so a
 #: reader of /1 would take /2's re-solved residues for the stroke
 SCHEMAS = ("satmd-structure-model/1", SCHEMA)
-PREDICTION_SCHEMA = "satmd-prediction/1"
 
 
 @dataclass(frozen=True)
@@ -141,59 +141,6 @@ class Joint:
 
 
 @dataclass(frozen=True)
-class Prediction:
-    """A model's simulation of one recording: NRMSE per channel, nonlinear and linear (SPEC §11).
-
-    ``signals`` holds the measured, linear and nonlinear responses {channel: (3, N)} for figures. A simulation
-    with the joint that ran away (the model is not stable at this level: no finite force, or a response a
-    million times the measured one, `RAN_AWAY`) has NRMSE inf. ``above_band`` splits the NRMSE by frequency
-    (`bands`): the error above the force's band (``band_top_hz``) and the measured response there, per channel,
-    each over the channel's RMS: a model that predicts no harmonics misses by the second at least."""
-
-    file: str
-    level: float
-    extrapolated: bool
-    channels: tuple
-    nrmse: list
-    linear_nrmse: list
-    fs_hz: float = 0.0
-    signals: dict = field(default_factory=dict, repr=False)
-    band_top_hz: float = 0.0
-    above_band: dict = field(default_factory=dict)  # {"nrmse": [...], "measured": [...]}
-
-    def to_dict(self) -> dict:
-        out = {"file": self.file, "level": round(self.level, 6), "extrapolated": self.extrapolated,
-               "channels": list(self.channels), "nrmse": [round(x, 4) for x in self.nrmse],
-               "linear_nrmse": [round(x, 4) for x in self.linear_nrmse]}
-        if self.above_band:
-            out["band_top_hz"] = round(self.band_top_hz, 3)
-            out["above_band"] = {k: [round(x, 4) for x in v] for k, v in self.above_band.items()}
-        return out
-
-    def plot(self, path, title: str = ""):
-        """Measured, linear and nonlinear responses, time and spectrum (`figures.prediction_figure`)."""
-        from .figures import prediction_figure
-
-        return prediction_figure(self, path, title)
-
-    def report(self) -> str:
-        flag = " (extrapolated: outside the fitted levels)" if self.extrapolated else ""
-        rows = ", ".join(f"{c} {n:.3f} (linear {ln:.3f})" for c, n, ln in zip(self.channels, self.nrmse, self.linear_nrmse))
-        text = f"{self.file}: force {self.level:.4g} N RMS{flag}; NRMSE {rows}"
-        if not all(np.isfinite(self.nrmse)):
-            text += "; the simulation ran away: the model is not stable at this level"
-        there = self.above_band.get("measured", [])
-        if there and max(there) >= SHOWN_ABOVE:
-            text += (f"; above the force's band ({self.band_top_hz:.4g} Hz) the measured response is "
-                     + ", ".join(f"{x:.3f}" for x in there) + " of each channel's RMS, of which the model misses "
-                     + ", ".join(f"{x:.3f}" for x in self.above_band["nrmse"]))
-        return text
-
-
-SHOWN_ABOVE = 0.05  # a share of the response above the force's band worth a line of the report
-
-
-@dataclass(frozen=True)
 class StructureModel:
     """A structure's linear part and its joint, fitted on recordings at several levels (SPEC §11).
 
@@ -209,6 +156,8 @@ class StructureModel:
     driving_point : the channel at the force's point, when there is one
     oversample : the joint's force is integrated at this many times the record's rate
     acquisition : the acquisition's low-pass on the joint's share above the force's band (`acquisition`), or None
+    band_hz : (lo, hi) Hz the fitted recordings' forces excite: outside it the model was shown nothing of the
+        structure, and a force there is flagged (`Prediction.outside_band`); None for a model saved without it
     """
 
     linear: LinearStructure
@@ -220,6 +169,7 @@ class StructureModel:
     oversample: int = 4
     reference: LinearStructure | None = None
     acquisition: Acquisition | None = None
+    band_hz: tuple | None = None
 
     @property
     def channels(self) -> tuple:
@@ -256,7 +206,8 @@ class StructureModel:
                           [_finite_nrmse(s, m) for s, m in zip(nl, measured)],
                           [nrmse(s, m) for s, m in zip(lin, measured)],
                           fs, {c: np.array([m, a, b]) for c, m, a, b in zip(self.channels, measured, lin, nl)},
-                          top, {"nrmse": [e for e, _ in split], "measured": [t for _, t in split]})
+                          top, {"nrmse": [e for e, _ in split], "measured": [t for _, t in split]},
+                          self.band_hz, None if self.band_hz is None else share_outside(force, fs, self.band_hz))
 
     def to_dict(self) -> dict:
         return {"schema": SCHEMA, "channels": list(self.channels), "units": dict(self.units),
@@ -265,7 +216,8 @@ class StructureModel:
                 "linear": self.linear.to_dict(),
                 "reference": None if self.reference is None else self.reference.to_dict(),
                 "joint": None if self.joint is None else self.joint.to_dict(), "fit": self.fit,
-                "acquisition": None if self.acquisition is None else self.acquisition.to_dict()}
+                "acquisition": None if self.acquisition is None else self.acquisition.to_dict(),
+                "band_hz": None if self.band_hz is None else [float(x) for x in self.band_hz]}
 
     def save(self, path) -> None:
         """Write the model as JSON (never pickle), atomically."""
@@ -288,7 +240,8 @@ class StructureModel:
                    d.get("units", {"force": "N", "response": "m/s²"}), d.get("driving_point"),
                    int(d.get("oversample", 4)),
                    None if d.get("reference") is None else LinearStructure.from_dict(d["reference"]),
-                   None if d.get("acquisition") is None else Acquisition.from_dict(d["acquisition"]))
+                   None if d.get("acquisition") is None else Acquisition.from_dict(d["acquisition"]),
+                   _band(d.get("band_hz")))
 
     @classmethod
     def load(cls, path) -> "StructureModel":
@@ -326,19 +279,14 @@ class StructureModel:
         return "\n".join(lines)
 
 
-def nrmse(simulated, measured) -> float:
-    """RMS of the simulation's error over the RMS of the measured output (about its mean)."""
-    m = np.asarray(measured, float)
-    scale = float(np.sqrt(np.mean((m - m.mean()) ** 2))) or 1.0
-    return float(np.sqrt(np.mean((np.asarray(simulated, float) - m) ** 2)) / scale)
-
-
-RAN_AWAY = 1e6  # an NRMSE beyond it is a simulation that grew without bound within the record, not a prediction
-
-
-def _finite_nrmse(simulated, measured) -> float:
-    value = nrmse(simulated, measured)
-    return value if np.isfinite(value) and value < RAN_AWAY else float("inf")
+def _band(value) -> tuple | None:
+    """A saved model's fitted band: (lo, hi) Hz, 0 <= lo < hi, or None (saved before models kept it)."""
+    if value is None:
+        return None
+    lo, hi = (float(x) for x in value)
+    if not (np.isfinite(lo) and np.isfinite(hi) and 0 <= lo < hi):
+        raise ValueError(f"band_hz {value!r} is not 0 <= lo < hi")
+    return lo, hi
 
 
 class Drive:

@@ -262,8 +262,32 @@ def test_a_model_fitted_on_multisines_predicts_a_sine_sweep(cubic_model):
     rec = simulate_chain(joint=(2, 3), law=lambda d, v: CUBIC * d ** 3, levels=(4.0 / np.std(sweep),), seed=1,
                          force=sweep)[0]
     p = cubic_model.predict(rec, file="sweep")
-    assert not p.extrapolated
+    assert not p.extrapolated and p.outside_band < 0.05 and "outside the band" not in p.report()
     assert max(p.nrmse) < 0.03 and max(p.nrmse) < 0.5 * min(p.linear_nrmse), (p.nrmse, p.linear_nrmse)  # 1 % noise
+
+
+def test_a_force_outside_the_fitted_band_is_flagged(cubic_model, tmp_path):
+    """Fitted on 3-60 Hz multisines, the model is shown a 3-120 Hz one (the F-16's odd multisines reach 60 Hz where
+    its model was fitted on 2-15 Hz): the share of the force it never saw is said, kept in JSON and in a saved model;
+    a model saved before it kept its band says nothing."""
+    from tests.structure.chain import multisine
+
+    assert cubic_model.band_hz == pytest.approx((3.0, 60.0), abs=0.3)
+    wide = multisine(1024, 256.0, 3.0, 120.0, seed=4)
+    rec = simulate_chain(joint=(2, 3), law=lambda d, v: CUBIC * d ** 3, levels=(3.0,), seed=1, force=np.tile(wide, 5))[0]
+    p = cubic_model.predict(rec, file="wide")
+    assert 0.35 < p.outside_band < 0.65 and not p.extrapolated  # a level inside the range, a band outside
+    assert f"{100 * p.outside_band:.0f} % of the force's power lies outside the band the model was fitted in" in p.report()
+    d = p.to_dict()
+    assert d["force_outside_fitted_band"] == pytest.approx(p.outside_band, abs=1e-4) and len(d["fitted_band_hz"]) == 2
+    path = tmp_path / "m.json"
+    cubic_model.save(path)
+    assert StructureModel.load(path).band_hz == pytest.approx(cubic_model.band_hz)
+    older = {k: v for k, v in cubic_model.to_dict().items() if k != "band_hz"}
+    q = StructureModel.from_dict(older).predict(rec, file="wide")
+    assert q.outside_band is None and "fitted_band_hz" not in q.to_dict() and "outside the band" not in q.report()
+    with pytest.raises(ValueError, match="band_hz"):
+        StructureModel.from_dict({**older, "band_hz": [60.0, 3.0]})
 
 
 def test_a_level_outside_the_fitted_range_is_flagged(cubic_levels, cubic_model):
