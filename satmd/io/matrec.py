@@ -96,8 +96,9 @@ def _signal(path, v, spec, role):
         raise FormatError(path, f"map {role}={spec}: {key!r} has shape {_shape(a)}: give one index per axis but "
                                 f"time ({len(axes)}), e.g. {key}[{example}]")
     if not all(1 <= i <= n for i, n in zip(index, axes)):
-        raise FormatError(path, f"map {role}={spec}: {key!r} has shape {_shape(a)}: indices run "
-                                + ", ".join(f"1..{n}" for n in axes))
+        raise FormatError(path, f"map {role}={spec}: {key!r} holds {axes[0]} signal(s) (rows 1..{axes[0]})"
+                          if len(axes) == 1 else f"map {role}={spec}: {key!r} has shape {_shape(a)}: indices run "
+                          + ", ".join(f"1..{n}" for n in axes))
     label = f"{key}[{','.join(map(str, index))}]"
     return vector_variable(path, label, signals[tuple(i - 1 for i in index)])
 

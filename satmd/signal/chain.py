@@ -94,10 +94,11 @@ def welch_findings(freq_hz, channels: dict, std: dict, resolution_hz: float, seg
 
 
 def lpm_findings(freq_hz, channels: dict, std: dict, settings: dict, force_noise_bias: np.ndarray,
-                 requested_band=None, bias_bound=None) -> list[MeasurementFinding]:
+                 requested_band=None, bias_bound=None, sweep: bool = False) -> list[MeasurementFinding]:
     """Short record for the resonances, force-noise bias (corrected, or not told), unexcited band (LPM).
 
     ``bias_bound``: per point, the relative force-noise bias that may remain (`satmd.signal.lpm.LPMEstimate`).
+    ``sweep``: the force is a sweep, whose windows the local polynomial cannot fit are the structure's (`_lines`).
     """
     found = []
     sharp = sharpest_resonance(freq_hz, channels)
@@ -121,7 +122,7 @@ def lpm_findings(freq_hz, channels: dict, std: dict, settings: dict, force_noise
                 "a cleaner force signal (higher excitation level or a quieter load cell)", corrected=True))
     found += _unseen_floor(channels, std, settings, bias_bound)
     found += _lines(settings.get("lines_removed_hz") or {}, settings.get("line_windows_hz") or [],
-                    settings["window_hz"])
+                    settings["window_hz"], sweep)
     lo, hi = settings["band_hz"]
     req_lo, req_hi = requested_band or (None, None)
     cut = [f"{a:g}–{b:g} Hz" for a, b in ((req_lo, lo), (hi, req_hi))
@@ -135,8 +136,13 @@ def lpm_findings(freq_hz, channels: dict, std: dict, settings: dict, force_noise
     return found
 
 
-def _lines(removed: dict, dropped: list, window_hz: float) -> list[MeasurementFinding]:
-    """Lines in the responses that the force does not explain: removed from the record, or windows dropped."""
+def _lines(removed: dict, dropped: list, window_hz: float, sweep: bool = False) -> list[MeasurementFinding]:
+    """Lines in the responses that the force does not explain: removed from the record, or windows dropped.
+
+    Under a sweep, windows whose residual stands out are the structure's own unless they sit at the mains: its
+    response rings on at a resonance after the force has moved past it (on a simulated chain swept 15 → 2 Hz in
+    60 s, linear and without any interference, three windows beside its 7.1 Hz mode), and a joint's harmonics of
+    the force's frequency lie where the force is not; neither is the sensor chain's."""
     freqs = sorted({round(f, 2) for fs in removed.values() for f in fs} | {round(f, 2) for f in dropped})
     if not freqs:
         return []
@@ -144,6 +150,14 @@ def _lines(removed: dict, dropped: list, window_hz: float) -> list[MeasurementFi
     mains = [m for m in (50.0, 60.0) if all(min(abs(f - k * m) for k in range(1, int(f / m) + 2)) <= tol
                                                for f in freqs)]
     where = ", ".join(f"{f:.2f}" for f in freqs[:12]) + (" ..." if len(freqs) > 12 else "")
+    if sweep and not mains:
+        return [MeasurementFinding(
+            "sweep_windows_left_out",
+            f"{len(freqs)} estimate window(s) at {where} Hz carry response the force in them does not explain and "
+            "were left out: under a sweep, the structure ringing on at a resonance after the force moved past it, or "
+            "a nonlinearity's harmonics of the force's frequency, not the sensor chain",
+            "sweep slower through the resonances, or let the record ring out after the sweep (its whole transient is "
+            "then estimated without windows), or use a periodic excitation", corrected=True)]
     did = []
     if removed:
         did.append(f"{sum(len(v) for v in removed.values())} sinusoid(s) fitted and subtracted from "

@@ -102,7 +102,7 @@ def estimate_frf(recording: Recording, nperseg: int | None = None, window=None, 
     if method.lower() == "lpm":
         if welch_given:
             raise DataError("nperseg, window and overlap are Welch settings: they do not apply to the lpm estimator")
-        data = _estimate_lpm(recording, band_hz, width_hz)
+        data = _estimate_lpm(recording, band_hz, width_hz, sweep=exc.kind == "sweep")
     else:
         data = _estimate_welch(recording, nperseg, "hann" if window is None else window,
                                0.5 if overlap is None else overlap, method, band_hz)
@@ -163,7 +163,7 @@ def _check_constant(recording: Recording, source, responses):
                             f"{'nothing excited the rig' if name == 'force' else 'the sensor recorded nothing'}")
 
 
-def _estimate_lpm(recording: Recording, band_hz, width_hz) -> FRFData:
+def _estimate_lpm(recording: Recording, band_hz, width_hz, sweep: bool = False) -> FRFData:
     from .chain import clipping_findings, lpm_findings
     from .lpm import lpm
 
@@ -175,7 +175,8 @@ def _estimate_lpm(recording: Recording, band_hz, width_hz) -> FRFData:
     est = lpm(recording, band_hz=band_hz, width_hz=width_hz)
     s = est.settings
     findings = clipping_findings(recording) + lpm_findings(est.freq_hz, est.frf, est.std, s,
-                                                           est.force_noise_bias, band_hz, est.force_noise_bias_bound)
+                                                           est.force_noise_bias, band_hz, est.force_noise_bias_bound,
+                                                           sweep)
     floor = 1e-10 * max(np.max(np.abs(h)) for h in est.frf.values())
     std = {c: np.maximum(v, floor) for c, v in est.std.items()}
     info = {"method": "lpm", "reference": "Pintelon et al. 2010, local polynomial method",

@@ -4,6 +4,11 @@ A ground vibration test's multisine repeats; after the start-up transient every 
 (plus noise), so each line's spectrum is the mean over the steady periods (`satmd.signal.periodic`'s
 estimator), and the spread over periods is its noise. Displacements come from the accelerations by
 dividing by -ω² at the lines the force excites (the band where the accelerometers carry the motion).
+
+A sine sweep, the other classic of a ground vibration test, starts and ends at rest: padded with zeros until
+its response has rung out, the whole record is one period of a periodic signal, so ``A = H F`` holds exactly at
+every line of its DFT for the linear part and ``E = A − H F`` is the joint's force through its column, as for a
+multisine (`transient_spectra`); no smearing of a fast sweep, which only windowed estimates suffer.
 """
 from __future__ import annotations
 
@@ -116,9 +121,11 @@ def periodic_spectra(recording) -> PeriodicSpectra:
     source = str(recording.meta.get("source", "recording"))
     rec = received(recording)
     exc = excitation_of(rec)
+    if exc.kind == "sweep":
+        return transient_spectra(rec, exc, source)
     if exc.kind != "periodic":
         raise DataError(f"{source}: the force is {exc.kind}, not periodic; locating a joint needs a periodic force "
-                        "(a multisine, as a ground vibration test uses) at every level")
+                        "(a multisine, as a ground vibration test uses) or a sine sweep at every level")
     n = exc.period_samples
     lines = np.asarray(exc.lines, int)
     force = signal_spectra(rec, exc, "force").mean(axis=0)  # (steady periods, lines) of the periodic estimator
@@ -135,6 +142,44 @@ def periodic_spectra(recording) -> PeriodicSpectra:
         raise DataError(f"{source}: no response channel beside the force")
     return PeriodicSpectra(source, force_level(rec["force"]), float(rec.fs_hz), int(n), lines, force, responses, std,
                            whole)
+
+
+RING_OUT = 0.25     # of the record: zeros after it (to a whole number of `BLOCK`: levels of one design share lines)
+BLOCK = 1024
+
+
+def transient_spectra(rec, exc, source: str) -> PeriodicSpectra:
+    """`PeriodicSpectra` of a sine sweep at rest at both ends (`sweepfrf.at_rest_at_the_end`): the record with zeros
+    after it (`RING_OUT`) as one period, the lines between the sweep's two ends. One record has no periods to spread
+    over: ``std`` is NaN (locating weighs each level by its mean response, not by it)."""
+    from ..signal.sweepfrf import RUNG_DOWN, at_rest_at_the_end
+
+    n_rec = len(rec["force"])
+    n = int(np.ceil(n_rec * (1 + RING_OUT) / BLOCK)) * BLOCK
+    fs = float(rec.fs_hz)
+    lo, hi = sorted((float(exc.sweep["f_start_hz"]), float(exc.sweep["f_end_hz"])))
+    freq = np.fft.rfftfreq(n, 1.0 / fs)
+    lines = np.flatnonzero((freq >= lo) & (freq <= hi))
+    if lines.size < 8:
+        raise DataError(f"{source}: the sweep covers {lines.size} lines of its record ({lo:.3g}–{hi:.3g} Hz); "
+                        "at least 8 are needed")
+    force = np.fft.rfft(np.asarray(rec["force"], float), n)
+    names = [c for c in rec.channels if c != "force"]
+    moving = [c for c in names if not at_rest_at_the_end(rec, [c])]
+    if moving:
+        raise DataError(f"{source}: the sweep's record ends with the structure still moving ({', '.join(moving)} "
+                        f"above {100 * RUNG_DOWN:g} % of the loudest {'they' if len(moving) > 1 else 'it'} reached); "
+                        "locating a joint from a sweep needs "
+                        "the response recorded until it rings out (a few seconds of quiet after the sweep), or a "
+                        "periodic force")
+    responses, std, whole = {}, {}, {}
+    for name in names:
+        whole[name] = np.fft.rfft(np.asarray(rec[name], float), n)
+        responses[name] = whole[name][lines]
+        std[name] = np.full(lines.size, np.nan)
+    if not responses:
+        raise DataError(f"{source}: no response channel beside the force")
+    return PeriodicSpectra(source, force_level(rec["force"]), fs, n, lines, force[lines], responses, std, whole)
 
 
 FALSE_LINES = 0.1   # noise lines a record's force may keep by chance, on average (`significant_lines`)

@@ -41,3 +41,40 @@ def test_a_softening_mount_is_followed_over_swept_levels():
     assert soft, [m["trend"] for m in modes]  # before: no resonance followed (the levels shared no frequency)
     moved = max(soft, key=lambda m: 1 - m["f_hz"][-1] / m["f_hz"][0])
     assert 1 - moved["f_hz"][-1] / moved["f_hz"][0] > 0.02
+
+
+def _rung_out(quiet_s, laws_seed=1):
+    """The mount of `_levels` on a 3-mass chain swept 15 -> 2 Hz in 30 s, with ``quiet_s`` of quiet recorded after."""
+    fs = 40.0
+    sweep = np.concatenate([log_sweep(fs, 30.0, 15.0, 2.0), np.zeros(int(quiet_s * fs))])
+    return simulate_chain(n=3, joint=(1, 2), law=lambda d, v: 3.0 * np.tanh(d / 2e-3), levels=(1.0, 4.0, 8.0), fs=fs,
+                          force=sweep, band=(2.0, 15.0), seed=laws_seed, k=2e3)
+
+
+def test_a_joint_is_located_from_sweeps_that_ring_out():
+    """A sweep at rest at both ends is one period of its padded DFT: ``E = A − H F`` holds at every line, and the
+    joint is placed as from multisines (the place's evidence far ahead of the next)."""
+    from satmd.structure import locate_joint
+
+    loc = locate_joint(_rung_out(30.0), laws=["softening", "cubic"])
+    assert loc.detected and loc.between == ("acc2", "acc3") and loc.law == "softening"
+    assert loc.location[1]["delta_bic"] > 100
+
+
+def test_a_sweep_cut_while_the_structure_moves_is_refused_and_said():
+    import pytest
+
+    from satmd.errors import DataError
+    from satmd.structure import locate_joint
+
+    levels = _rung_out(0.0)
+    with pytest.raises(DataError, match="the sweep.s record ends with the structure still moving .*a few seconds of "
+                                        "quiet after the sweep"):
+        locate_joint(levels)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        rep = discover(levels)
+    text = rep.report()
+    assert "the joint is not located among the sensors" in text and "still moving" in text
+    measurement = [m["name"] for m in rep.estimator.get("measurement", [])]
+    assert "narrowband_interference" not in measurement  # the sweep's own transient is not the sensor chain's

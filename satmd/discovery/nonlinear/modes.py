@@ -167,8 +167,11 @@ def with_joint(report, recordings, fit_joint: bool = True):
     stage(f"locating the joint among every pair of {len(responses)} sensors and the ground ...")
     try:
         loc = locate_joint(recordings)
-    except DataError:  # not periodic tests, or too few shared lines: the account per resonance stands
-        return report
+    except DataError as err:  # not tests a joint can be located from: the account per resonance stands, and why
+        old = report.findings[0]
+        why = f"the joint is not located among the sensors: {err}"
+        return replace(report, findings=[replace(old, explanation=f"{old.explanation}; {why}" if old.explanation
+                                                 else why[:1].upper() + why[1:]), *report.findings[1:]])
     if not loc.detected:
         return report
     a, b = loc.between
