@@ -119,7 +119,7 @@ def fit_structure(recordings, between=None, law: str | None = None, channels=Non
     else:
         model = fit.law(tuple(between), law, files)
     model = fit.looped(fit.kept_apart(fit.finished_choice(model, free_path, files), free_path, files), files)
-    return replace(model, band_hz=fitted_band(spectra))
+    return replace(model, band_hz=fitted_band(spectra), reach=fit.reach(model))
 
 
 def fitted_band(spectra) -> tuple:
@@ -289,6 +289,16 @@ class _Fit:
                 return False
             growth = np.sqrt(np.mean(y ** 2, axis=1)) / (BEYOND * self.measured[i].std(axis=1))
         return bool(np.all(growth <= RUNAWAY))
+
+    def reach(self, model) -> float | None:
+        """The joint's largest force over the recordings, simulated (`StructureModel.reach`); None without one."""
+        if model.joint is None:
+            return None
+        peaks = []
+        for drive, _ in self.whole(model):
+            drive.outputs(model.joint)
+            peaks.append(drive.joint_peak)
+        return max(peaks) if all(p is not None and p > 0 for p in peaks) else None
 
     def linear_only(self, files) -> StructureModel:
         """The lowest level's linear model, no joint, with its fit table."""

@@ -158,6 +158,9 @@ class StructureModel:
     acquisition : the acquisition's low-pass on the joint's share above the force's band (`acquisition`), or None
     band_hz : (lo, hi) Hz the fitted recordings' forces excite: outside it the model was shown nothing of the
         structure, and a force there is flagged (`Prediction.outside_band`); None for a model saved without it
+    reach : the largest force of the joint over the fitted recordings, simulated (its units): a force whose level
+        lies in the fitted range can still drive the joint beyond it (a sweep dwells on a resonance a multisine of
+        the same RMS spreads over its band), flagged (`Prediction.joint_reach`); None without a joint or saved before
     """
 
     linear: LinearStructure
@@ -170,6 +173,7 @@ class StructureModel:
     reference: LinearStructure | None = None
     acquisition: Acquisition | None = None
     band_hz: tuple | None = None
+    reach: float | None = None
 
     @property
     def channels(self) -> tuple:
@@ -197,6 +201,7 @@ class StructureModel:
         drive = Drive(self, drive_force(recording), float(recording.fs_hz), warm)
         lin = drive.outputs(None)
         nl = drive.outputs(self.joint) if self.joint is not None else lin
+        peak = drive.joint_peak
         level = force_level(force)
         lo, hi = self.levels
         fs = float(recording.fs_hz)
@@ -207,7 +212,8 @@ class StructureModel:
                           [nrmse(s, m) for s, m in zip(lin, measured)],
                           fs, {c: np.array([m, a, b]) for c, m, a, b in zip(self.channels, measured, lin, nl)},
                           top, {"nrmse": [e for e, _ in split], "measured": [t for _, t in split]},
-                          self.band_hz, None if self.band_hz is None else share_outside(force, fs, self.band_hz))
+                          self.band_hz, None if self.band_hz is None else share_outside(force, fs, self.band_hz),
+                          None if not self.reach or peak is None else peak / self.reach)
 
     def to_dict(self) -> dict:
         return {"schema": SCHEMA, "channels": list(self.channels), "units": dict(self.units),
@@ -217,7 +223,8 @@ class StructureModel:
                 "reference": None if self.reference is None else self.reference.to_dict(),
                 "joint": None if self.joint is None else self.joint.to_dict(), "fit": self.fit,
                 "acquisition": None if self.acquisition is None else self.acquisition.to_dict(),
-                "band_hz": None if self.band_hz is None else [float(x) for x in self.band_hz]}
+                "band_hz": None if self.band_hz is None else [float(x) for x in self.band_hz],
+                "reach": None if self.reach is None else float(self.reach)}
 
     def save(self, path) -> None:
         """Write the model as JSON (never pickle), atomically."""
@@ -241,7 +248,7 @@ class StructureModel:
                    int(d.get("oversample", 4)),
                    None if d.get("reference") is None else LinearStructure.from_dict(d["reference"]),
                    None if d.get("acquisition") is None else Acquisition.from_dict(d["acquisition"]),
-                   _band(d.get("band_hz")))
+                   _band(d.get("band_hz")), _reach(d.get("reach")))
 
     @classmethod
     def load(cls, path) -> "StructureModel":
@@ -289,6 +296,16 @@ def _band(value) -> tuple | None:
     return lo, hi
 
 
+def _reach(value) -> float | None:
+    """A saved model's ``reach``: a finite number > 0, or None."""
+    if value is None:
+        return None
+    x = float(value)
+    if not (np.isfinite(x) and x > 0):
+        raise ValueError(f"reach {value!r} is not a finite number > 0")
+    return x
+
+
 class Drive:
     """One force through the model: the linear part's response and the pair's motion, computed once.
 
@@ -300,6 +317,7 @@ class Drive:
         from ..physics.nonlinear.integrate import band_limited, upsample
 
         self.model, self.fs, self.skip, self.force = model, float(fs_hz), int(warmup), force
+        self.joint_peak: float | None = None  # the joint's largest force in the last `outputs` with a joint, step 1
         lin = model.linear
         u = np.concatenate([force[force.size - warmup:], force]) if warmup else force
         ub = band_limited(u, fs_hz)
@@ -327,6 +345,8 @@ class Drive:
         g, z = self.driven(joint, step)
         if not np.all(np.isfinite(g)):
             return np.full_like(self.linear[:, keep], np.nan)
+        if step == 1:
+            self.joint_peak = float(np.max(np.abs(g), initial=0.0))
         share = response(z, joint.column_of(self.model.linear))
         chain = self.model.acquisition
         return self.linear[:, keep] + (share if chain is None or step != 1 else chain.apply(share, self.fs))

@@ -30,6 +30,7 @@ class Prediction:
     above_band: dict = field(default_factory=dict)  # {"nrmse": [...], "measured": [...]}
     fitted_band_hz: tuple | None = None  # the band the model's recordings excited (`StructureModel.band_hz`)
     outside_band: float | None = None  # the share of this force's power outside it: there the model extrapolates
+    joint_reach: float | None = None  # the joint's largest force here over the largest in the fitted recordings
 
     def to_dict(self) -> dict:
         out = {"file": self.file, "level": round(self.level, 6), "extrapolated": self.extrapolated,
@@ -41,6 +42,8 @@ class Prediction:
         if self.outside_band is not None:
             out["fitted_band_hz"] = [round(float(x), 3) for x in self.fitted_band_hz]
             out["force_outside_fitted_band"] = round(self.outside_band, 4)
+        if self.joint_reach is not None:
+            out["joint_force_over_fitted"] = round(self.joint_reach, 4)
         return out
 
     def plot(self, path, title: str = ""):
@@ -57,6 +60,9 @@ class Prediction:
             lo, hi = self.fitted_band_hz
             text += (f"; {100 * self.outside_band:.0f} % of the force's power lies outside the band the model was "
                      f"fitted in ({lo:.3g}–{hi:.3g} Hz): there it extrapolates, with no mode it was not shown")
+        if self.joint_reach is not None and self.joint_reach > SHOWN_REACH:
+            text += (f"; the joint's force reaches {self.joint_reach:.2f} times the largest it had in the fitted "
+                     "recordings: its law is extrapolated there")
         if not all(np.isfinite(self.nrmse)):
             text += "; the simulation ran away: the model is not stable at this level"
         there = self.above_band.get("measured", [])
@@ -69,6 +75,7 @@ class Prediction:
 
 SHOWN_ABOVE = 0.05  # a share of the response above the force's band worth a line of the report
 SHOWN_OUTSIDE = 0.05  # a share of the force's power outside the fitted band worth a line of the report
+SHOWN_REACH = 1.1  # the joint's force beyond the fitted recordings' largest by this factor is said
 
 
 def nrmse(simulated, measured) -> float:

@@ -290,6 +290,31 @@ def test_a_force_outside_the_fitted_band_is_flagged(cubic_model, tmp_path):
         StructureModel.from_dict({**older, "band_hz": [60.0, 3.0]})
 
 
+def test_a_sweep_that_drives_the_joint_beyond_the_fitted_recordings_is_flagged(cubic_levels, cubic_model, tmp_path):
+    """At 7 N RMS, inside the fitted 1-8 N, a sweep dwells on each resonance that a multisine of the same RMS spreads
+    over its band: the joint's force reaches about 4 times the largest of the fitted recordings (a cubic: 1.6 times
+    the stroke), which the level alone would not tell; a multisine at 3 N stays well inside."""
+    from tests.structure.chain import log_sweep
+
+    assert cubic_model.reach > 0
+    sweep = log_sweep(256.0, 24.0, 3.0, 50.0)
+    rec = simulate_chain(joint=(2, 3), law=lambda d, v: CUBIC * d ** 3, levels=(7.0 / np.std(sweep),), seed=1,
+                         force=sweep)[0]
+    p = cubic_model.predict(rec, file="sweep")
+    assert not p.extrapolated and p.joint_reach > 2.0
+    assert f"the joint's force reaches {p.joint_reach:.2f} times the largest it had in the fitted" in p.report()
+    assert p.to_dict()["joint_force_over_fitted"] == pytest.approx(p.joint_reach, abs=1e-4)
+    inside = cubic_model.predict(cubic_levels[1])
+    assert inside.joint_reach < 0.5 and "the joint's force reaches" not in inside.report()
+    path = tmp_path / "m.json"
+    cubic_model.save(path)
+    assert StructureModel.load(path).reach == pytest.approx(cubic_model.reach)
+    older = {k: v for k, v in cubic_model.to_dict().items() if k != "reach"}
+    assert StructureModel.from_dict(older).predict(rec).joint_reach is None
+    with pytest.raises(ValueError, match="reach"):
+        StructureModel.from_dict({**older, "reach": -1.0})
+
+
 def test_a_level_outside_the_fitted_range_is_flagged(cubic_levels, cubic_model):
     quiet = Recording(cubic_levels[0].fs_hz, {c: 0.5 * np.asarray(cubic_levels[0][c]) for c in cubic_levels[0].channels},
                       meta={"source": "half"})
