@@ -119,11 +119,21 @@ def structure_cases(base) -> list[dict]:
     model = json.loads(open(f"{base}/structure.json", encoding="utf-8").read())
     for label, edit in (("no linear part", lambda d: d.pop("linear")), ("other schema", lambda d: d.update(schema="x")),
                         ("poles not numbers", lambda d: d["linear"].update(poles="many")),
-                        ("a joint without a law", lambda d: d["joint"].pop("law"))):
+                        ("a joint without a law", lambda d: d["joint"].pop("law")),
+                        ("a fitted band upside down", lambda d: d.update(band_hz=[60.0, 3.0])),
+                        ("a joint's reach below zero", lambda d: d.update(reach=-1.0))):
         bad = json.loads(json.dumps(model))
         edit(bad)
         add(case("structure levels", "cli", "refuse", ["bad.json"], argv=["predict", "{work}/bad.json", "{base}/s8.csv"],
                  files={"bad.json": json.dumps(bad).encode()}, label=label))
+    # a lab's realizations (the F-16's odd multisines: Acceleration channel × realization × time)
+    rng = np.random.default_rng(5)
+    real = _npz(Force=rng.normal(size=(3, 2048)), Acceleration=rng.normal(size=(2, 3, 2048)), Fs=np.float64(256.0))
+    add(case("structure levels", "cli", "refuse", ["real.npz", "Force", "3×2048", "Force[1]"],
+             argv=["discover", "{work}/real.npz"], files={"real.npz": real}, label="realizations, no index"))
+    add(case("structure levels", "cli", "refuse", ["real.npz", "Acceleration[1,9]", "1..2, 1..3"],
+             argv=["discover", "{work}/real.npz", "--map", "force=Force[1],a1=Acceleration[1,9],a2=Acceleration[2,1]"],
+             files={"real.npz": real}, label="a realization that is not there"))
     return cases
 
 
