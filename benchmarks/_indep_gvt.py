@@ -56,6 +56,7 @@ OVER = 8
 BAND = (5.0, 40.0)
 PERIOD = 2048
 PERIODS = 5
+SWEEP_S, QUIET_S = 40.0, 40.0   # a sweep's duration and the quiet recorded after it (`simulate(excitation="sweep")`)
 F_KEEP = 300.0
 LAWS = ("cubic", "softening", "clearance", "friction", "quadratic_damping")
 STRUCTURES = ("chain", "frame", "beam", "wing")
@@ -283,17 +284,37 @@ def multisine(rng) -> np.ndarray:
 
 
 # --------------------------------------------------------------------------------------------- simulation
-def simulate(test: Test) -> list:
-    """Seven levels: a list of dicts (``time_s``, ``force``, ``acc1`` …) at FS, from rest."""
+def sweep(seconds: float, quiet_s: float) -> np.ndarray:
+    """A linear sine sweep down the band (BAND[1] → BAND[0]) over ``seconds``, ends tapered over 0.5 s, unit RMS
+    over the sweep, then ``quiet_s`` of nothing, at 2·OVER × FS (exact between samples)."""
+    fine = FS * 2 * OVER
+    t = np.arange(int(round(seconds * fine))) / fine
+    f0, f1 = BAND[1], BAND[0]
+    x = np.sin(2 * np.pi * (f0 * t + (f1 - f0) / (2 * seconds) * t ** 2))
+    x *= np.clip(np.minimum(t, seconds - t) / 0.5, 0.0, 1.0)
+    x /= np.sqrt(np.mean(x ** 2))
+    return np.concatenate([x, np.zeros(int(round(quiet_s * fine)))])
+
+
+def simulate(test: Test, excitation: str = "multisine") -> list:
+    """Seven levels: a list of dicts (``time_s``, ``force``, ``acc1`` …) at FS, from rest. ``excitation``
+    ``"sweep"``: one sweep down the band in SWEEP_S seconds and QUIET_S of quiet after it, each level's RMS over the
+    sweep the multisine's."""
     L = LEVELS.size
     nm = test.freq_hz.size
     om = 2 * np.pi * test.freq_hz
     om2, dmp = np.tile(om ** 2, (L, 1)), np.tile(2 * test.zeta * om, (L, 1))
     psi, bm = test.psi, test.b
     law, par, kj = test.law, test.par, test.k_j
-    force_fine = np.stack([multisine(np.random.default_rng([test.seed, 99, lv])) * test.level1_n * LEVELS[lv]
-                           for lv in range(L)])
-    n = PERIOD * PERIODS
+    if excitation == "sweep":
+        one = sweep(SWEEP_S, QUIET_S)
+        force_fine = np.stack([one * test.level1_n * LEVELS[lv] for lv in range(L)])
+        n = one.size // (2 * OVER)
+        force_fine = np.concatenate([force_fine, np.zeros((L, 2))], axis=1)  # the last step's end
+    else:
+        force_fine = np.stack([multisine(np.random.default_rng([test.seed, 99, lv])) * test.level1_n * LEVELS[lv]
+                               for lv in range(L)])
+        n = PERIOD * PERIODS
     steps = n * OVER
 
     def joint(d, dv, r):
@@ -325,7 +346,7 @@ def simulate(test: Test) -> list:
     q, v, r = np.zeros((L, nm)), np.zeros((L, nm)), np.zeros(L)
     chunk = OVER * 512
     buf = np.zeros((L * nch, chunk))
-    period_fine = PERIOD * 2 * OVER
+    period_fine = PERIOD * 2 * OVER if excitation != "sweep" else force_fine.shape[1]
     for s0 in range(0, steps, chunk):
         for j in range(chunk):
             st = s0 + j

@@ -45,6 +45,10 @@ from .spectra import PeriodicSpectra, periodic_spectra
 
 #: ΔBIC within which two places (or two laws) are equally supported (SPEC §11).
 EQUIVALENT = 10.0
+#: lines the places and laws are weighed at, at most: a sweep's record padded to one period has a line every
+#: 1/(its length) Hz (80 s of a ground vibration test swept 40 → 5 Hz: 3 500), each exact, and every k-th of them
+#: weighs as well at a k-th of the cost; the motion a law sees is still made from every line
+MAX_LINES = 1024
 
 
 @dataclass(frozen=True)
@@ -220,6 +224,9 @@ def prepare(recordings, band_hz=None, channels=None):
         common, freq = common[keep], freq[keep]
     if common.size < 8:
         raise DataError(f"the levels share {common.size} excited lines; at least 8 are needed")
+    if common.size > MAX_LINES:  # a long sweep's record: every line holds, a share of them says as much
+        common = common[::int(np.ceil(common.size / MAX_LINES))]
+        freq = common * ref.fs_hz / ref.period_samples
     rows = {id(s): np.searchsorted(s.lines, common) for s in items}
     H = {c: ref.responses[c][rows[id(ref)]] / ref.force[rows[id(ref)]] for c in names}
     modal = fit_modes(freq, H, band_hz=(float(freq[0]), float(freq[-1])))

@@ -39,7 +39,7 @@ class Prediction:
         if self.above_band:
             out["band_top_hz"] = round(self.band_top_hz, 3)
             out["above_band"] = {k: [round(x, 4) for x in v] for k, v in self.above_band.items()}
-        if self.outside_band is not None:
+        if self.outside_band is not None and self.fitted_band_hz is not None:
             out["fitted_band_hz"] = [round(float(x), 3) for x in self.fitted_band_hz]
             out["force_outside_fitted_band"] = round(self.outside_band, 4)
         if self.joint_reach is not None:
@@ -56,7 +56,7 @@ class Prediction:
         flag = " (extrapolated: outside the fitted levels)" if self.extrapolated else ""
         rows = ", ".join(f"{c} {n:.3f} (linear {ln:.3f})" for c, n, ln in zip(self.channels, self.nrmse, self.linear_nrmse))
         text = f"{self.file}: force {self.level:.4g} N RMS{flag}; NRMSE {rows}"
-        if self.outside_band is not None and self.outside_band >= SHOWN_OUTSIDE:
+        if self.outside_band is not None and self.fitted_band_hz is not None and self.outside_band >= SHOWN_OUTSIDE:
             lo, hi = self.fitted_band_hz
             text += (f"; {100 * self.outside_band:.0f} % of the force's power lies outside the band the model was "
                      f"fitted in ({lo:.3g}–{hi:.3g} Hz): there it extrapolates, with no mode it was not shown")
