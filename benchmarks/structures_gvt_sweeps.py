@@ -3,12 +3,12 @@
 The independent simulator of `structures_gvt` (`benchmarks/_indep_gvt.py`, numpy/scipy only), each test's
 structure and joint as there, driven by one linear sine sweep down the band (40 → 5 Hz in 40 s, its RMS over the
 sweep the multisine's level) with 40 s of quiet recorded after it, so that the response rings out within the
-record (`satmd.structure.spectra.transient_spectra` needs it). Written to CSV and run as a user would:
+record (`satmd.structure.transient_spectra` needs it). Written to CSV, read back and located as a user who asks
+for it would (`discover` refuses sweeps; these figures are why):
 
-    satmd discover L1.csv L3.csv L5.csv L7.csv --locate-only --json
+    locate_joint([transient_spectra(load_recording(f)) for f in ("L1.csv", "L3.csv", "L5.csv", "L7.csv")])
 
-Scored as `structures_gvt` scores the place and the law (nulls: no joint). No model is fitted: a fit on
-20 480-sample records takes minutes per test, and the place is what sweeps were refused for before.
+Scored as `structures_gvt` scores the place and the law (nulls: no joint). No model is fitted.
 
     python benchmarks/structures_gvt_sweeps.py [--seeds 0,1,2 | --count 12 --seed0 0] [--out PATH]
 
@@ -27,7 +27,11 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "benchmarks"))
 import _indep_gvt as sim  # noqa: E402
 from _machine import machine  # noqa: E402
-from structures_gvt import FITTED, _satmd, plan  # noqa: E402
+from structures_gvt import FITTED, plan  # noqa: E402
+
+from satmd.errors import DataError  # noqa: E402
+from satmd.io import load_recording  # noqa: E402
+from satmd.structure import locate_joint, transient_spectra  # noqa: E402
 
 OUT = ROOT / "benchmarks" / "results" / "structures_gvt_sweeps.json"
 
@@ -41,21 +45,20 @@ def case(structure: str, law: str | None, seed: int) -> dict:
         for lv, rec in enumerate(recs, 1):
             sim.write_csv(rec, Path(tmp) / f"L{lv}.csv")
         t0 = time.perf_counter()
-        found = _satmd("discover", *(f"L{lv}.csv" for lv in FITTED), "--json", "--locate-only", cwd=tmp)
+        try:
+            loc = locate_joint([transient_spectra(load_recording(Path(tmp) / f"L{lv}.csv")) for lv in FITTED])
+        except DataError as err:
+            row["error"] = str(err)
+            return row
         row["locate_s"] = round(time.perf_counter() - t0, 1)
-    if "error" in found:
-        row["error"] = found["error"]
-        return row
-    findings = (found.get("nonlinear") or {}).get("findings", [])
-    joint = next((f for f in findings if f.get("name") == "joint"), None)
-    row["found_between"] = joint["between"] if joint else None
-    row["found_law"] = joint["law"] if joint else None
-    row["not_located"] = next((f.get("explanation", "") for f in findings if "not located" in f.get("explanation", "")),
-                              None)
+    found = loc.between if loc.detected else None
+    row["found_between"] = list(found) if found else None
+    row["found_law"] = loc.law if found else None
+    row["delta_bic_next"] = loc.location[1]["delta_bic"] if found and len(loc.location) > 1 else None
     truth = None if law is None else sorted(row["between"])
-    row["placed"] = None if law is None else bool(joint) and sorted(joint["between"]) == truth
-    row["named"] = None if law is None else bool(joint) and joint["law"] == law
-    row["null_clean"] = None if law is not None else joint is None
+    row["placed"] = None if law is None else bool(found) and sorted(found) == truth
+    row["named"] = None if law is None else bool(found) and loc.law == law
+    row["null_clean"] = None if law is not None else not found
     return row
 
 

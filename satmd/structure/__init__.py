@@ -41,6 +41,7 @@ from .fit import fit_structure
 from .linear import LinearStructure
 from .locate import JointLocation, locate_joint
 from .model import Joint, Prediction, StructureModel
+from .spectra import transient_spectra
 
 __all__ = ["locate_joint", "JointLocation", "JointLaw", "LAWS", "law", "fit_structure", "StructureModel", "Joint",
-           "Prediction", "LinearStructure"]
+           "Prediction", "LinearStructure", "transient_spectra"]

@@ -51,30 +51,39 @@ def _rung_out(quiet_s, laws_seed=1):
                           force=sweep, band=(2.0, 15.0), seed=laws_seed, k=2e3)
 
 
-def test_a_joint_is_located_from_sweeps_that_ring_out():
+def test_a_joint_is_located_from_sweeps_that_ring_out_when_asked():
     """A sweep at rest at both ends is one period of its padded DFT: ``E = A − H F`` holds at every line, and the
-    joint is placed as from multisines (the place's evidence far ahead of the next)."""
-    from satmd.structure import locate_joint
+    joint is placed as from multisines (the place's evidence far ahead of the next), where the sweeps' spectra are
+    given explicitly; on their own, sweeps are refused with the measured reason."""
+    import pytest
 
-    loc = locate_joint(_rung_out(30.0), laws=["softening", "cubic"])
+    from satmd.errors import DataError
+    from satmd.structure import locate_joint, transient_spectra
+
+    levels = _rung_out(30.0)
+    loc = locate_joint([transient_spectra(r) for r in levels], laws=["softening", "cubic"])
     assert loc.detected and loc.between == ("acc2", "acc3") and loc.law == "softening"
     assert loc.location[1]["delta_bic"] > 100
+    with pytest.raises(DataError, match="the force is a sweep; locating a joint needs a periodic force .* 5 of 10"):
+        locate_joint(levels)
 
 
-def test_a_sweep_cut_while_the_structure_moves_is_refused_and_said():
+def test_a_sweep_cut_while_the_structure_moves_is_refused_and_discover_says_why_no_joint():
     import pytest
 
     from satmd.errors import DataError
     from satmd.structure import locate_joint
 
+    from satmd.structure import transient_spectra
+
     levels = _rung_out(0.0)
     with pytest.raises(DataError, match="the sweep.s record ends with the structure still moving .*a few seconds of "
                                         "quiet after the sweep"):
-        locate_joint(levels)
+        locate_joint([transient_spectra(r) for r in levels])
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         rep = discover(levels)
     text = rep.report()
-    assert "the joint is not located among the sensors" in text and "still moving" in text
+    assert "the joint is not located among the sensors" in text and "needs a periodic force" in text
     measurement = [m["name"] for m in rep.estimator.get("measurement", [])]
     assert "narrowband_interference" not in measurement  # the sweep's own transient is not the sensor chain's
