@@ -34,7 +34,7 @@ from .bands import above_band_shares, band_top, below_nyquist, share_outside
 from .kernel import joint_states
 from .laws import law as law_named
 from .linear import LinearStructure, as_pairs, discretise, from_pairs, modal_states, response
-from .prediction import PREDICTION_SCHEMA, RAN_AWAY, Prediction, _finite_nrmse, nrmse  # noqa: F401  (the model's API)
+from .prediction import PREDICTION_SCHEMA, RAN_AWAY, Prediction, finite_nrmse, nrmse  # noqa: F401  (the model's API)
 from .spectra import drive_force, warmup_of
 
 SCHEMA = "satmd-structure-model/2"
@@ -208,7 +208,7 @@ class StructureModel:
         top = band_top(force, fs)
         split = [above_band_shares(s, m, fs, top) for s, m in zip(nl, measured)]
         return Prediction(name, level, bool(level < lo * 0.98 or level > hi * 1.02), self.channels,
-                          [_finite_nrmse(s, m) for s, m in zip(nl, measured)],
+                          [finite_nrmse(s, m) for s, m in zip(nl, measured)],
                           [nrmse(s, m) for s, m in zip(lin, measured)],
                           fs, {c: np.array([m, a, b]) for c, m, a, b in zip(self.channels, measured, lin, nl)},
                           top, {"nrmse": [e for e, _ in split], "measured": [t for _, t in split]},

@@ -88,6 +88,7 @@ def nrmse(simulated, measured) -> float:
 RAN_AWAY = 1e6  # an NRMSE beyond it is a simulation that grew without bound within the record, not a prediction
 
 
-def _finite_nrmse(simulated, measured) -> float:
+def finite_nrmse(simulated, measured) -> float:
+    """`nrmse`, inf where the simulation ran away (not finite, or beyond `RAN_AWAY`)."""
     value = nrmse(simulated, measured)
     return value if np.isfinite(value) and value < RAN_AWAY else float("inf")

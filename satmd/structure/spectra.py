@@ -160,7 +160,21 @@ def transient_spectra(recording) -> PeriodicSpectra:
     ``locate_joint([transient_spectra(r) for r in levels])``. On the independent ground vibration tests swept
     instead of multisined (`benchmarks/structures_gvt_sweeps.py`, 10 joints and 2 nulls) it placed 5 joints, named
     no law (the sparse library won every time) and left both nulls clean, where the multisines placed 9 and named 9:
-    one unaveraged record a level carries its noise into the motion every law is evaluated on."""
+    one unaveraged record a level carries its noise into the motion every law is evaluated on.
+
+    Parameters
+    ----------
+    recording : Recording of one level, its force a sine sweep, the structure at rest before it and rung down after
+
+    Returns
+    -------
+    PeriodicSpectra
+
+    Raises
+    ------
+    DataError
+        A force that is not a sweep, a response not rung down by the record's end, or fewer than 8 lines.
+    """
     from ..signal.sweepfrf import RUNG_DOWN, at_rest_at_the_end
 
     source = str(recording.meta.get("source", "recording"))

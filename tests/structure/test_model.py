@@ -561,12 +561,12 @@ def test_a_simulation_that_grew_without_bound_is_called_run_away():
     with no finite solution is."""
     from dataclasses import replace
 
-    from satmd.structure.model import RAN_AWAY, Prediction, _finite_nrmse
+    from satmd.structure.prediction import RAN_AWAY, Prediction, finite_nrmse
 
     measured = np.sin(2 * np.pi * 5 * np.arange(500) / 500)
-    assert _finite_nrmse(1.5 * measured, measured) == pytest.approx(0.5)
-    assert _finite_nrmse(2 * RAN_AWAY * measured, measured) == float("inf")
-    assert _finite_nrmse(np.full(500, np.nan), measured) == float("inf")
+    assert finite_nrmse(1.5 * measured, measured) == pytest.approx(0.5)
+    assert finite_nrmse(2 * RAN_AWAY * measured, measured) == float("inf")
+    assert finite_nrmse(np.full(500, np.nan), measured) == float("inf")
     away = Prediction("L9", 12.0, True, ("acc1", "acc2"), [0.02, float("inf")], [0.5, 0.6])
     assert "ran away" in away.report() and "ran away" not in replace(away, nrmse=[0.02, 0.03]).report()
 
