@@ -14,16 +14,22 @@ FORCE_SHARE = 0.999  # of the force's power (about its mean) below the top of it
 ROLL_OFF = 0.01      # of a record's Nyquist frequency: `below_nyquist` turns from one to zero over its top 1 %
 
 
+def _power(signal):
+    """(power spectrum about the mean, its total, samples) of a signal; total 0 for one that carries none."""
+    f = np.asarray(signal, float)
+    power = np.abs(np.fft.rfft(f - f.mean())) ** 2
+    total = float(power.sum()) if f.size >= 2 else 0.0
+    return power, total, f.size
+
+
 def band_top(signal, fs_hz: float, share: float = FORCE_SHARE) -> float:
     """The frequency below which a signal puts ``share`` of its power (about its mean): for a force, the top of its
     band (near the Nyquist frequency for a broadband force, whose response then has nothing above it)."""
-    f = np.asarray(signal, float)
-    power = np.abs(np.fft.rfft(f - f.mean())) ** 2
-    total = float(power.sum())
-    if f.size < 2 or total <= 0:
+    power, total, n = _power(signal)
+    if total <= 0:
         return fs_hz / 2
     k = min(int(np.searchsorted(np.cumsum(power), share * total)), power.size - 1)
-    return float(k * fs_hz / f.size)
+    return float(k * fs_hz / n)
 
 
 def above_band(signal, fs_hz: float, top_hz: float) -> np.ndarray:
@@ -70,13 +76,10 @@ def below_nyquist(x, oversample: int, pad: int = 4096) -> np.ndarray:
 def share_outside(signal, fs_hz: float, band_hz, margin: float = 0.02) -> float:
     """The share of a signal's power (about its mean) outside ``band_hz`` (lo, hi), widened by ``margin`` of each
     end: for a force, how much of it drives the structure where a model fitted in that band was never shown it."""
-    f = np.asarray(signal, float)
-    power = np.abs(np.fft.rfft(f - f.mean())) ** 2
-    total = float(power.sum())
-    if f.size < 2 or total <= 0:
+    power, total, n = _power(signal)
+    if total <= 0:
         return 0.0
-    freq = np.fft.rfftfreq(f.size, 1.0 / fs_hz)
+    freq = np.fft.rfftfreq(n, 1.0 / fs_hz)
     lo, hi = band_hz
     inside = (freq >= lo * (1 - margin)) & (freq <= hi * (1 + margin))
     return float(power[~inside].sum() / total)
-

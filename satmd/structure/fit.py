@@ -124,7 +124,7 @@ def fit_structure(recordings, between=None, law: str | None = None, channels=Non
 
 def fitted_band(spectra) -> tuple:
     """(lo, hi) Hz: the lowest and highest lines the recordings' forces excite."""
-    return (min(float(s.freq_hz.min()) for s in spectra), max(float(s.freq_hz.max()) for s in spectra))
+    return min(float(s.freq_hz.min()) for s in spectra), band_top_hz(spectra)
 
 
 class _Fit:

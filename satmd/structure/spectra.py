@@ -118,9 +118,7 @@ def periodic_spectra(recording) -> PeriodicSpectra:
     DataError
         A force that is not periodic, or fewer than two steady periods.
     """
-    source = str(recording.meta.get("source", "recording"))
-    rec = received(recording)
-    exc = excitation_of(rec)
+    source, rec, exc = _excited(recording)
     if exc.kind == "sweep":
         raise DataError(f"{source}: the force is a sweep; locating a joint needs a periodic force (a multisine, as a "
                         "ground vibration test uses) at every level: from one sweep a level, unaveraged, the place "
@@ -145,6 +143,12 @@ def periodic_spectra(recording) -> PeriodicSpectra:
         raise DataError(f"{source}: no response channel beside the force")
     return PeriodicSpectra(source, force_level(rec["force"]), float(rec.fs_hz), int(n), lines, force, responses, std,
                            whole)
+
+
+def _excited(recording):
+    """(its name, the recording with its excitation read, that excitation)."""
+    rec = received(recording)
+    return str(recording.meta.get("source", "recording")), rec, excitation_of(rec)
 
 
 RING_OUT = 0.25     # of the record: zeros after it (to a whole number of `BLOCK`: levels of one design share lines)
@@ -177,9 +181,7 @@ def transient_spectra(recording) -> PeriodicSpectra:
     """
     from ..signal.sweepfrf import RUNG_DOWN, at_rest_at_the_end
 
-    source = str(recording.meta.get("source", "recording"))
-    rec = received(recording)
-    exc = excitation_of(rec)
+    source, rec, exc = _excited(recording)
     if exc.kind != "sweep":
         raise DataError(f"{source}: the force is {exc.kind}, not a sweep")
 
