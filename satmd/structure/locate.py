@@ -264,8 +264,9 @@ def _evidence(place, law_, others, ref, H, names, rows, transfer, aux=None) -> f
     G: dict = {id(s): [] for s in others}
     if place is not None:
         d0, v0 = ref.scales(*place)
-        for s in others:
-            G[id(s)] = [s.at_lines(t)[rows[id(s)]] for t in law_.columns(*s.relative(*place), d0, v0, aux)]
+        for s in others:  # a sweep's stroke from every line: its start and its harmonics ring modes above its band
+            G[id(s)] = [s.at_lines(t)[rows[id(s)]]
+                        for t in law_.columns(*s.relative(*place, whole=s.transient), d0, v0, aux)]
     n_terms = len(G[id(others[0])])
     S_parts, y_parts, n_par = [], [], 0
     for c in names:  # each channel's own residual terms projected out first: the shared fit is then small
