@@ -64,7 +64,7 @@ def test_a_joint_is_located_from_sweeps_that_ring_out_when_asked():
     loc = locate_joint([transient_spectra(r) for r in levels], laws=["softening", "cubic"])
     assert loc.detected and loc.between == ("acc2", "acc3") and loc.law == "softening"
     assert loc.location[1]["delta_bic"] > 100
-    with pytest.raises(DataError, match="the force is a sweep; locating a joint needs a periodic force .* 5 of 10"):
+    with pytest.raises(DataError, match="the force is a sweep; locating a joint needs a periodic force .* 7 of 10"):
         locate_joint(levels)
 
 
