@@ -19,9 +19,16 @@ with κ real (`real_inputs`: a law in the stroke and one in the velocity are the
 law's shape refined off its grid. On 40 chains (`benchmarks/structures_joint.py`) that placed 35 joints and
 named 32 laws; free per-channel transfers had placed 31 and named 26.
 
+The stroke a law is evaluated on is made from every line from the band's lowest up to 0.8 of Nyquist
+(`PeriodicSpectra.motion`), not from the excited lines alone: the joint's harmonics, and the modes above the band
+they ring (a wing's root bounce), move its two ends as much as the force does. On the independent ground
+vibration tests (seeds 0-39, the place and law of `benchmarks/structures_gvt_locate.py`) that placed 33 of 36
+joints and named 20 laws where the excited lines placed 30 and named 17 (the nulls as before); on their sweeps
+(`benchmarks/structures_gvt_sweeps.py`) 7 of 10 where the excited lines placed 5.
+
 Evidence: BIC = N ln(RSS/N) + p ln N per pair and law. Rows are weighted by each channel's mean response
 at that level, not by each line's noise: between levels far above the noise the misfit is the model's
-(the poles of one level, the joint's terms from the in-band motion), which scales with the response, and
+(the poles of one level, the joint's terms from the measured motion), which scales with the response, and
 weighting by the noise let the quietest lines decide (on the F-16 it put the joint between acc2 and the
 ground). A law with a shape constant (a clearance's gap, a friction's smoothing) is tried at each of
 `laws.SHAPE_GRID`'s values and keeps its best, counted as one parameter more. A pair's
@@ -264,9 +271,8 @@ def _evidence(place, law_, others, ref, H, names, rows, transfer, aux=None) -> f
     G: dict = {id(s): [] for s in others}
     if place is not None:
         d0, v0 = ref.scales(*place)
-        for s in others:  # a sweep's stroke from every line: its start and its harmonics ring modes above its band
-            G[id(s)] = [s.at_lines(t)[rows[id(s)]]
-                        for t in law_.columns(*s.relative(*place, whole=s.transient), d0, v0, aux)]
+        for s in others:  # the stroke from every line: the joint's harmonics ring modes above the band
+            G[id(s)] = [s.at_lines(t)[rows[id(s)]] for t in law_.columns(*s.relative(*place, whole=True), d0, v0, aux)]
     n_terms = len(G[id(others[0])])
     S_parts, y_parts, n_par = [], [], 0
     for c in names:  # each channel's own residual terms projected out first: the shared fit is then small

@@ -38,7 +38,6 @@ class PeriodicSpectra:
     std : {channel: (K,) std of the mean's real and imaginary parts, from the spread over periods}
     whole : {channel: (n // 2 + 1,) complex mean spectrum at every line}: what a joint throws outside the lines
         the force excites (`satmd.structure.outside`); None where not kept
-    transient : one record from rest to rest as one period (`transient_spectra`), not a periodic steady state
     """
 
     source: str
@@ -50,7 +49,6 @@ class PeriodicSpectra:
     responses: dict
     std: dict
     whole: dict | None = None
-    transient: bool = False
 
     @property
     def freq_hz(self) -> np.ndarray:
@@ -219,8 +217,7 @@ def transient_spectra(recording) -> PeriodicSpectra:
         std[name] = np.full(lines.size, np.nan)
     if not responses:
         raise DataError(f"{source}: no response channel beside the force")
-    return PeriodicSpectra(source, force_level(rec["force"]), fs, n, lines, force[lines], responses, std, whole,
-                           transient=True)
+    return PeriodicSpectra(source, force_level(rec["force"]), fs, n, lines, force[lines], responses, std, whole)
 
 
 FALSE_LINES = 0.1   # noise lines a record's force may keep by chance, on average (`significant_lines`)
