@@ -3,7 +3,9 @@
 A ground vibration test's multisine repeats; after the start-up transient every channel is periodic
 (plus noise), so each line's spectrum is the mean over the steady periods (`satmd.signal.periodic`'s
 estimator), and the spread over periods is its noise. Displacements come from the accelerations by
-dividing by -ω² at the lines the force excites (the band where the accelerometers carry the motion).
+dividing by -ω² at the lines the force excites (the band where the accelerometers carry the motion), or, where a
+law is weighed on them (`PeriodicSpectra.motion` ``whole``), at every line from the band's lowest up to 0.8 of
+Nyquist: the joint's harmonics move the sensors too.
 
 A sine sweep, the other classic of a ground vibration test, starts and ends at rest: padded with zeros until
 its response has rung out, the whole record is one period of a periodic signal, so ``A = H F`` holds exactly at
@@ -170,7 +172,7 @@ def transient_spectra(recording) -> PeriodicSpectra:
     50 %, and 0.9 % once the acquisition's anti-alias low-pass is taken off the stroke the law is evaluated on (its
     phase on the joint's harmonics) and the lowest level's own joint response is subtracted (a sweep's levels are
     one sweep scaled: it is in every other level's change, scaled, not random-phase as a multisine's). Neither is
-    known before a model is fitted. A sweep's stroke is made from every line up to 0.8 of Nyquist (its start and its
+    known before a model is fitted. The stroke is made from every line up to 0.8 of Nyquist (a sweep's start and its
     harmonics ring modes above its band): from the band alone it placed 5 of the 10.
 
     Parameters
