@@ -8,7 +8,8 @@ On tests of the independent simulator (`benchmarks/_indep_gvt.py`) swept as in `
    and without any. The same verdicts say that the noise of one record a level is not what holds sweeps back.
 2. **as `locate_joint` weighs it** (cubic tests, noise-free): each level's change from the lowest level's FRF,
    ``E = A − H F``, against the true law's term at the true place through `locate_joint`'s fitted transfer (the
-   lowest level's modes, every mode's input real, each channel's residual terms): the share of E left unexplained.
+   lowest level's modes, every mode's input real, each channel's residual terms) and its stroke (every line up to
+   0.8 of Nyquist): the share of E left unexplained.
 3. **through the exact transfer** (the same tests): the simulator's own modes from the joint to every sensor, its
    anti-alias low-pass included, one real coefficient: the share left unexplained with H the lowest level's FRF
    (as 2), with the lowest level's own joint response subtracted (a sweep's levels are one sweep scaled, so
@@ -86,7 +87,7 @@ def as_located(spectra, between, law_name: str) -> float:
     law_ = LAWS[law_name]
     best = np.inf
     for aux in law_.shapes(d0, v0):
-        G = {id(s): [s.at_lines(t)[rows[id(s)]] for t in law_.columns(*s.relative(*between), d0, v0, aux)]
+        G = {id(s): [s.at_lines(t)[rows[id(s)]] for t in law_.columns(*s.relative(*between, whole=True), d0, v0, aux)]
              for s in others}
         S_parts, y_parts, total = [], [], 0.0
         for c in names:
