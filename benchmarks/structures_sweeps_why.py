@@ -9,7 +9,7 @@ On tests of the independent simulator (`benchmarks/_indep_gvt.py`) swept as in `
 2. **as `locate_joint` weighs it** (cubic tests, noise-free): each level's change from the lowest level's FRF,
    ``E = A − H F``, against the true law's term at the true place through `locate_joint`'s fitted transfer (the
    lowest level's modes, every mode's input real, each channel's residual terms) and its stroke (every line up to
-   0.8 of Nyquist): the share of E left unexplained.
+   0.8 of Nyquist): the share of E left unexplained (`satmd.structure.locate.unexplained`).
 3. **through the exact transfer** (the same tests): the simulator's own modes from the joint to every sensor, its
    anti-alias low-pass included, one real coefficient: the share left unexplained with H the lowest level's FRF
    (as 2), with the lowest level's own joint response subtracted (a sweep's levels are one sweep scaled, so
@@ -39,10 +39,8 @@ from _machine import machine  # noqa: E402
 from structures_gvt import plan  # noqa: E402
 
 from satmd.io import Recording  # noqa: E402
-from satmd.numerics import unit_columns  # noqa: E402
 from satmd.structure import locate_joint, transient_spectra  # noqa: E402
-from satmd.structure.laws import LAWS  # noqa: E402
-from satmd.structure.locate import prepare, real_inputs  # noqa: E402
+from satmd.structure.locate import unexplained  # noqa: E402
 from satmd.structure.spectra import motion  # noqa: E402
 
 OUT = ROOT / "benchmarks" / "results" / "structures_sweeps_why.json"
@@ -75,43 +73,6 @@ def stroke(s, a: str, b: str, deconvolved: bool) -> np.ndarray:
             x = x / low_pass(lines * s.fs_hz / s.period_samples)
         return motion(x, lines, s.fs_hz, s.period_samples)[0]
     return one(a) - one(b)
-
-
-def as_located(spectra, between, law_name: str) -> float:
-    """Share of the levels' change E = A − H F left unexplained by the law at ``between`` through `locate_joint`'s
-    fitted transfer (its weighing re-done here: each channel by its level's mean response, the residual terms
-    projected out, every mode's input real), at the best shape of the law's grid."""
-    ref, others, names, rows, H, transfer, _ = prepare(spectra)
-    real = real_inputs(transfer)
-    d0, v0 = ref.scales(*between)
-    law_ = LAWS[law_name]
-    best = np.inf
-    for aux in law_.shapes(d0, v0):
-        G = {id(s): [s.at_lines(t)[rows[id(s)]] for t in law_.columns(*s.relative(*between, whole=True), d0, v0, aux)]
-             for s in others}
-        S_parts, y_parts, total = [], [], 0.0
-        for c in names:
-            shared, own = real[c]
-            S_c, R_c, y_c = [], [], []
-            for s in others:
-                k = rows[id(s)]
-                E = s.responses[c][k] - H[c] * s.force[k]
-                sd = np.mean(np.abs(s.responses[c][k]))
-                S = np.hstack([shared * g[:, None] for g in G[id(s)]])
-                R = np.hstack([own * g[:, None] for g in G[id(s)]])
-                S_c += [S.real / sd, S.imag / sd]
-                R_c += [R.real / sd, R.imag / sd]
-                y_c += [E.real / sd, E.imag / sd]
-            S, R, y = np.vstack(S_c), unit_columns(np.vstack(R_c))[0], np.concatenate(y_c)
-            total += float(y @ y)
-            U, sv, _ = np.linalg.svd(R, full_matrices=False)
-            U = U[:, sv > sv[0] * 1e-10]
-            S_parts.append(S - U @ (U.T @ S))
-            y_parts.append(y - U @ (U.T @ y))
-        S, y = unit_columns(np.vstack(S_parts))[0], np.concatenate(y_parts)
-        r = y - S @ np.linalg.lstsq(S, y, rcond=None)[0]
-        best = min(best, float(r @ r) / total)
-    return best
 
 
 def exact_transfer(spectra, test) -> dict:
@@ -157,7 +118,7 @@ def case(structure: str, law: str, seed: int) -> dict:
         row[key] = {"found_between": list(loc.between), "placed": sorted(loc.between) == sorted(test.between),
                     "law": loc.law, "laws": loc.laws[:3], "locate_s": round(time.perf_counter() - t0, 1)}
         if scale == 0.0 and law == "cubic":
-            row["unexplained_as_located"] = {name: round(as_located(spectra, tuple(test.between), name), 4)
+            row["unexplained_as_located"] = {name: round(unexplained(spectra, tuple(test.between), name), 4)
                                              for name in ("cubic", "sparse")}
             row["unexplained_exact_transfer"] = exact_transfer(spectra, test)
     return row

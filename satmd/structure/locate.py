@@ -264,17 +264,50 @@ def real_inputs(transfer) -> dict:
     return {c: (shared[:, 0::2], own) for c, (shared, own) in transfer.items()}
 
 
+def unexplained(recordings, between, law_name: str, channels=None) -> float:
+    """The share of the levels' change from the lowest level's FRF that a law at a place leaves unexplained, as
+    `locate_joint` weighs it (each mode's input real), at the best of the law's shapes (`JointLaw.shapes`).
+
+    Parameters
+    ----------
+    recordings : two or more Recordings (or `PeriodicSpectra`) of one structure, as for `locate_joint`
+    between : (a, b) the pair (``b`` may be ``"ground"``)
+    law_name : one of `satmd.structure.laws.LAWS`
+    channels : the response channels (default every channel but the force)
+
+    Returns
+    -------
+    float
+        The weighted residual's sum of squares over the change's, 0 (all explained) to 1.
+    """
+    ref, others, names, rows, H, transfer, _ = prepare(recordings, None, channels)
+    real, law_ = real_inputs(transfer), LAWS[law_name]
+    d0, v0 = ref.scales(*between)
+    shares = []
+    for form in law_.variants():
+        for aux in form.shapes(d0, v0):
+            rss, total, _, _ = _regression(tuple(between), form, others, ref, H, names, rows, real, aux)
+            shares.append(rss / max(total, TINY))
+    return float(min(shares))
+
+
 def _evidence(place, law_, others, ref, H, names, rows, transfer, aux=None) -> float:
-    """BIC of one place and law: every channel and higher level in one weighted linear least-squares fit, the
-    joint's input to each mode shared by every channel (``place`` None: no joint, the levels one linear
-    structure)."""
+    """BIC of one place and law (`_regression`)."""
+    rss, _, n_rows, n_par = _regression(place, law_, others, ref, H, names, rows, transfer, aux)
+    return n_rows * np.log(max(rss, TINY) / n_rows) + n_par * np.log(n_rows)
+
+
+def _regression(place, law_, others, ref, H, names, rows, transfer, aux=None):
+    """(residual sum of squares, the change's sum of squares, rows, parameters) of one place and law: every channel
+    and higher level in one weighted linear least-squares fit, the joint's input to each mode shared by every
+    channel (``place`` None: no joint, the levels one linear structure)."""
     G: dict = {id(s): [] for s in others}
     if place is not None:
         d0, v0 = ref.scales(*place)
         for s in others:  # the stroke from every line: the joint's harmonics ring modes above the band
             G[id(s)] = [s.at_lines(t)[rows[id(s)]] for t in law_.columns(*s.relative(*place, whole=True), d0, v0, aux)]
     n_terms = len(G[id(others[0])])
-    S_parts, y_parts, n_par = [], [], 0
+    S_parts, y_parts, n_par, total = [], [], 0, 0.0
     for c in names:  # each channel's own residual terms projected out first: the shared fit is then small
         shared, own = transfer[c]
         S_c, R_c, y_c = [], [], []
@@ -288,6 +321,7 @@ def _evidence(place, law_, others, ref, H, names, rows, transfer, aux=None) -> f
             R_c += [R.real / sd, R.imag / sd]
             y_c += [E.real / sd, E.imag / sd]
         S, R, y = np.vstack(S_c), unit_columns(np.vstack(R_c))[0], np.concatenate(y_c)
+        total += float(y @ y)
         if R.shape[1]:
             U, sv, _ = np.linalg.svd(R, full_matrices=False)
             U = U[:, sv > sv[0] * 1e-10] if sv[0] > 0 else U[:, :0]
@@ -297,8 +331,7 @@ def _evidence(place, law_, others, ref, H, names, rows, transfer, aux=None) -> f
         y_parts.append(y)
     S, y = unit_columns(np.vstack(S_parts))[0], np.concatenate(y_parts)
     r = y - S @ np.linalg.lstsq(S, y, rcond=None)[0] if S.shape[1] else y
-    rss, n_rows = float(r @ r), y.size
-    return n_rows * np.log(max(rss, TINY) / n_rows) + (n_par + S.shape[1]) * np.log(n_rows)
+    return float(r @ r), total, y.size, n_par + S.shape[1]
 
 
 def _verdict(bic, places, laws, ref, items, modal, named) -> JointLocation:

@@ -151,3 +151,12 @@ def test_the_figure_draws_the_joint_and_the_evidence(cubic_between_3_and_4, tmp_
     loc = locate_joint(cubic_between_3_and_4, laws=["cubic"])
     out = loc.plot(tmp_path / "joint.png", title="chain")
     assert out.is_file() and out.stat().st_size > 10_000
+
+
+def test_the_true_place_and_law_leave_the_least_of_the_change_unexplained(cubic_between_3_and_4):
+    """`unexplained`: the share of the levels' change a law at a place leaves, as `locate_joint` weighs it."""
+    from satmd.structure.locate import unexplained
+
+    true = unexplained(cubic_between_3_and_4, ("acc3", "acc4"), "cubic")
+    elsewhere = unexplained(cubic_between_3_and_4, ("acc1", "acc2"), "cubic")
+    assert 0.0 <= true < 0.5 * elsewhere <= 0.5
