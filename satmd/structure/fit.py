@@ -8,8 +8,9 @@ import numpy as np
 from ..errors import DataError
 from ..validation import NAMES, Interval, Options, Whole, validate_params
 from .acquisition import acquisition_of
+from .band_modes import with_band_modes_refined
 from .choice import PLACE_LAWS, best_fitting, best_place, contradicts, ranked_laws, score
-from .laws import LAWS, SHAPE_GRID
+from .laws import LAWS
 from .laws import law as law_named
 from .linear import fit_linear
 from .locate import shape_of
@@ -21,7 +22,7 @@ from .output_error import output_error
 from .outputs import resolved_outputs
 from .simulations import cost, drives_of, fit_span, oversampling, stable, with_table
 from .spectra import drive_force, periodic_spectra, warmup_of
-from .starts import measured_start, underlying_start
+from .starts import measured_start, simulated_shape, underlying_start, with_modes_above
 from .startup import band_top_hz, with_start_up_modes
 
 #: named laws (the best by the levels' spectra) each fitted when three or more levels are given, the one that
@@ -119,6 +120,7 @@ def fit_structure(recordings, between=None, law: str | None = None, channels=Non
     else:
         model = fit.law(tuple(between), law, files)
     model = fit.looped(fit.kept_apart(fit.finished_choice(model, free_path, files), free_path, files), files)
+    model = fit.refined(model, files)
     return replace(model, band_hz=fitted_band(spectra), reach=fit.reach(model))
 
 
@@ -160,7 +162,7 @@ class _Fit:
             reference = self.reference(tuple(between))
             lw, aux = ((law_named(law).form(form), shape) if shape is not None
                        else shape_of(spectra, between, law, names))
-            self.shapes[key] = (reference, *_simulated_shape(reference, spectra, between, lw, d0, v0, aux, recordings,
+            self.shapes[key] = (reference, *simulated_shape(reference, spectra, between, lw, d0, v0, aux, recordings,
                                                               self.measured, self.span, self.levels))
         reference, lw, aux = self.shapes[key]
         fitted = []
@@ -183,7 +185,7 @@ class _Fit:
             wider = above_band(model, spectra, apart)
             if apart and _same_modes(wider, above_band(model, spectra)):
                 continue  # this start's fit is the one made without ``apart``
-            model, drives = _with_modes_above(model, wider, spectra[0].fs_hz, recordings, self.measured, self.span)
+            model, drives = with_modes_above(model, wider, spectra[0].fs_hz, recordings, self.measured, self.span)
             say(f"output-error fit of the {law} joint between {between[0]} and {between[1]} on "
                 f"{len(recordings)} recordings (from the {start} linear part) ...")
             fitted.append(output_error(stable(model, drives), drives, ref, self.max_nfev, fixed_path=True))
@@ -272,6 +274,19 @@ class _Fit:
             return model
         return with_table(looped, self.recordings, files)
 
+    def refined(self, model, files) -> StructureModel:
+        """``model`` with its in-band modes and its law's coefficients fitted together (`band_modes`), where that
+        simulates the whole records better and holds beyond the top level where ``model`` does."""
+        if model.joint is None:
+            return model
+        self.say("the modes in the band refined with the joint's law ...")
+        refined = with_band_modes_refined(model, self.recordings, self.measured, self.span, fitted_band(self.spectra))
+        if refined is None or cost(refined, self.whole(refined)) >= cost(model, self.whole(model)):
+            return model
+        if not self.holds_beyond(refined) and self.holds_beyond(model):
+            return model
+        return with_table(refined, self.recordings, files)
+
     def holds_beyond(self, model) -> bool:
         """Whether ``model`` stays finite driven by the top level's force `BEYOND` times over, its response within
         `RUNAWAY` times the top level's measured one scaled by the force: a path freed on the fitted levels can
@@ -353,41 +368,6 @@ class _Fit:
         """(Drive, measured responses) of every recording, whole, through ``model``."""
         return [(Drive(model, drive_force(r), float(r.fs_hz), warmup_of(r)),
                  np.array([np.asarray(r[ch], float) for ch in self.names])) for r in self.recordings]
-
-
-def _simulated_shape(linear, spectra, between, lw, d0, v0, aux, recordings, measured, span, levels):
-    """(the law in its form, its shape constants) the output-error fit starts from: of the spectra's choice and
-    every form's grid (`JointLaw.variants`, `JointLaw.shapes`), the one whose frequency-domain start simulates the
-    recordings best. The spectra weigh each level's change at the excited lines; the simulation weighs what the
-    fit will, and a fit of a sharp law stays near the shape it starts from (on the F-16 a friction started at 3 RMS
-    velocities of slip ended at worst NRMSE 0.30-0.45 per level, started at the best simulated one at 0.22-0.44)."""
-    tried = [(lw, aux)] + [(form, a) for form in law_named(lw.name).variants() for a in form.shapes(d0, v0)
-                           if any(t in SHAPE_GRID for t in form.all_terms)]
-    if len(tried) == 1:
-        return lw, aux
-    best, best_cost = (lw, aux), np.inf
-    for form, a in tried:
-        c, kappa = measured_start(linear, spectra, between, form, d0, v0, a)
-        if not (np.all(np.isfinite(c)) and np.all(np.isfinite(kappa))):
-            continue
-        model = StructureModel(linear, Joint(between, form.name, c, a, kappa, form=form.term_names), levels,
-                               reference=linear, oversample=oversampling(linear, spectra[0].fs_hz))
-        drives = drives_of(model, recordings, measured, span)
-        simulated = cost(stable(model, drives), drives)
-        if simulated < best_cost:
-            best, best_cost = (form, a), simulated
-    return best
-
-
-def _with_modes_above(model, wider, fs_hz, recordings, measured, span):
-    """(model, its drives): the start ``wider`` with the modes above the band its joint's harmonics drive
-    (`above_band`) where its simulation of the recordings is the closer (an added mode can also carry the joint's
-    feedback away: on a chain with a cubic joint it did), else the start as it was."""
-    runs = []
-    for m in (model,) if wider is model else (model, wider):
-        m = replace(m, oversample=oversampling(m.linear, fs_hz))
-        runs.append((m, drives_of(m, recordings, measured, span)))
-    return min(runs, key=lambda run: cost(stable(*run), run[1]))
 
 
 def _same_modes(a, b) -> bool:
