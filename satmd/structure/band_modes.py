@@ -24,6 +24,10 @@ from .outputs import Projection
 from .simulations import drives_of
 
 MAX_NFEV = 8            # steps of the fit: most of what it gains, it gains in the first few
+#: ... fewer where a step (a simulation of every record per parameter) would simulate more samples than this over
+#: them all: the F-16's four levels (131 072 samples, ten modes and three coefficients) get 5 steps, 40 s, so that
+#: `discover` stays within 5 minutes; a ground vibration test's 32 768 samples, 8 steps up to 30 parameters
+SAMPLE_EVALUATIONS = 16_000_000
 STEP = 2                # every STEP-th sample of the residuals (the records are band-limited well below Nyquist)
 FREQUENCY_SPAN = 0.2    # a mode's frequency moves at most this far (in log) from the start: it stays the mode it was
 ZETA = (1e-4, 0.9)      # the damping ratios are held within these
@@ -57,7 +61,7 @@ def with_band_modes_refined(model, recordings, measured, span, band_hz, max_nfev
     measured : (C, span) responses of each recording, in the model's channel order
     span : samples of each recording the fit uses (`simulations.fit_span`)
     band_hz : (lo, hi) Hz of the force's band (`fit.fitted_band`)
-    max_nfev : steps of the least squares
+    max_nfev : steps of the least squares at most (fewer for long records, `SAMPLE_EVALUATIONS`)
 
     Returns
     -------
@@ -101,8 +105,9 @@ def with_band_modes_refined(model, recordings, measured, span, band_hz, max_nfev
                                                                    np.full(idx.size, np.log(ZETA[1]))]).ravel()])
     scale = np.concatenate([np.maximum(np.abs(j.coefficients), 1e-3 * float(np.abs(j.coefficients).max() or 1.0)),
                             np.tile([0.01, 0.3], idx.size)])
+    steps = min(max_nfev, max(2, SAMPLE_EVALUATIONS // ((theta0.size + 1) * sum(span))))
     sol = least_squares(residual, np.clip(theta0, lower + 1e-12, upper - 1e-12), x_scale=scale, diff_step=1e-5,
-                        bounds=(lower, upper), max_nfev=max_nfev)
+                        bounds=(lower, upper), max_nfev=steps)
     if not 2 * sol.cost < float(start[0] @ start[0]):
         return None
     projection, joint = projected(sol.x)
