@@ -8,7 +8,6 @@ import numpy as np
 from ..errors import DataError
 from ..validation import NAMES, Interval, Options, Whole, validate_params
 from .acquisition import acquisition_of
-from .band_modes import with_band_modes_refined
 from .choice import PLACE_LAWS, best_fitting, best_place, contradicts, ranked_laws, score
 from .laws import LAWS
 from .laws import law as law_named
@@ -18,7 +17,7 @@ from .model import Drive, Joint, StructureModel
 from .newtons import in_newtons
 from .loop import PAIRS, with_loop_modes
 from .outside import above_band, loop_poles
-from .output_error import output_error
+from .output_error import output_error, with_band_modes_refined
 from .outputs import resolved_outputs
 from .simulations import cost, drives_of, fit_span, oversampling, stable, with_table
 from .spectra import drive_force, periodic_spectra, warmup_of
@@ -275,7 +274,7 @@ class _Fit:
         return with_table(looped, self.recordings, files)
 
     def refined(self, model, files) -> StructureModel:
-        """``model`` with its in-band modes and its law's coefficients fitted together (`band_modes`), where that
+        """``model`` with its in-band modes and its law's coefficients fitted together (`output_error.with_band_modes_refined`), where that
         simulates the whole records better and holds beyond the top level where ``model`` does."""
         if model.joint is None:
             return model

@@ -222,11 +222,11 @@ def test_a_fitted_model_predicts_a_level_it_never_saw(cubic_levels, cubic_model)
 
 def test_the_band_s_modes_are_refitted_with_the_law(cubic_levels, cubic_model):
     """In-band poles 1 % off in frequency and 50 % in damping (as a lowest level that holds its joint linearised
-    gives them) are put back by `band_modes`, which fits them in time with the law's coefficients: the fitted
+    gives them) are put back by `with_band_modes_refined`, which fits them in time with the law's coefficients: the fitted
     levels' cost and the held-out level's NRMSE come back to the model's, the poles within 0.1 %."""
     from dataclasses import replace
 
-    from satmd.structure.band_modes import in_band, with_band_modes_refined
+    from satmd.structure.output_error import in_band, with_band_modes_refined
     from satmd.structure.simulations import cost, drives_of, fit_span
 
     m, recs = cubic_model, [cubic_levels[0], cubic_levels[2]]
