@@ -17,7 +17,7 @@ from .model import Drive, Joint, StructureModel
 from .newtons import in_newtons
 from .loop import PAIRS, with_loop_modes
 from .outside import above_band, loop_poles
-from .output_error import output_error, with_band_modes_refined
+from .output_error import BAND_STEPS, output_error, with_band_modes_refined
 from .outputs import resolved_outputs
 from .simulations import cost, drives_of, fit_span, oversampling, stable, with_table
 from .spectra import drive_force, periodic_spectra, warmup_of
@@ -279,7 +279,8 @@ class _Fit:
         if model.joint is None:
             return model
         self.say("the modes in the band refined with the joint's law ...")
-        refined = with_band_modes_refined(model, self.recordings, self.measured, self.span, fitted_band(self.spectra))
+        refined = with_band_modes_refined(model, self.recordings, self.measured, self.span, fitted_band(self.spectra),
+                                          min(self.max_nfev, BAND_STEPS))
         if refined is None or cost(refined, self.whole(refined)) >= cost(model, self.whole(model)):
             return model
         if not self.holds_beyond(refined) and self.holds_beyond(model):

@@ -138,12 +138,12 @@ def half_widths(jac, residuals, sizes):
     return np.where(var >= 0, 1.96 * np.sqrt(np.abs(var)), np.nan)
 
 
-MAX_NFEV = 8            # steps of the fit: most of what it gains, it gains in the first few
+BAND_STEPS = 8          # steps of the band's refit: most of what it gains, it gains in the first few
 #: ... fewer where a step (a simulation of every record per parameter) would simulate more samples than this over
 #: them all: the F-16's four levels (131 072 samples, ten modes and three coefficients) get 5 steps, 40 s, so that
 #: `discover` stays within 5 minutes; a ground vibration test's 32 768 samples, 8 steps up to 30 parameters
 SAMPLE_EVALUATIONS = 16_000_000
-STEP = 2                # every STEP-th sample of the residuals (the records are band-limited well below Nyquist)
+BAND_STEP = 2           # every BAND_STEP-th sample of the residuals (the records are band-limited well below Nyquist)
 FREQUENCY_SPAN = 0.2    # a mode's frequency moves at most this far (in log) from the start: it stays the mode it was
 ZETA = (1e-4, 0.9)      # the damping ratios are held within these
 
@@ -164,7 +164,7 @@ def in_band(poles, band_hz) -> np.ndarray:
     return np.flatnonzero((f >= band_hz[0]) & (f <= band_hz[1]))
 
 
-def with_band_modes_refined(model, recordings, measured, span, band_hz, max_nfev: int = MAX_NFEV):
+def with_band_modes_refined(model, recordings, measured, span, band_hz, max_nfev: int = BAND_STEPS):
     """``model`` with its in-band modes' poles and its law's coefficients fitted on the records' first ``span``
     samples, every channel solved inside; None where it has no joint or no mode in the band, a step runs away, or
     the fit gains nothing.
@@ -200,7 +200,7 @@ def with_band_modes_refined(model, recordings, measured, span, band_hz, max_nfev
 
     def projected(theta):
         trial = build(theta)
-        return Projection(trial, drives_of(trial, recordings, measured, span), STEP), trial.joint
+        return Projection(trial, drives_of(trial, recordings, measured, span), BAND_STEP), trial.joint
 
     def residual(theta):
         projection, joint = projected(theta)
