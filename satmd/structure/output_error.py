@@ -14,7 +14,7 @@ channel's residues, joint's column and feed-through solved inside each step (`ou
 place and law found), a wing's friction joint went from worst NRMSE 0.060, 0.042, 0.026 (level 1 fitted, levels 2
 and 6 held out) to 0.013, 0.014, 0.016 (its noise 0.012), a beam's friction support from 0.046, 0.036, 0.036 to
 0.016, 0.016, 0.033 (its noise 0.011). On the F-16 (levels 1, 3, 7 fitted) the fitted levels' worst came from
-0.19, 0.20, 0.44 to 0.17, 0.16, 0.42 and held-out level 5 from 0.284, 0.279, 0.394 to 0.261, 0.282, 0.402.
+0.19, 0.20, 0.44 to 0.17, 0.16, 0.42 and held-out level 5 from 0.284, 0.279, 0.394 to 0.268, 0.273, 0.395.
 """
 from __future__ import annotations
 
