@@ -17,7 +17,7 @@ from .model import Drive, Joint, StructureModel
 from .newtons import in_newtons
 from .loop import PAIRS, with_loop_modes
 from .outside import above_band, loop_poles
-from .output_error import BAND_STEPS, output_error, with_band_modes_refined
+from .output_error import BAND_STEPS, in_band, output_error, with_band_modes_refined
 from .outputs import resolved_outputs
 from .simulations import cost, drives_of, fit_span, oversampling, stable, with_table
 from .spectra import drive_force, periodic_spectra, warmup_of
@@ -274,18 +274,25 @@ class _Fit:
         return with_table(looped, self.recordings, files)
 
     def refined(self, model, files) -> StructureModel:
-        """``model`` with its in-band modes and its law's coefficients fitted together (`output_error.with_band_modes_refined`), where that
-        simulates the whole records better and holds beyond the top level where ``model`` does."""
+        """``model`` with its in-band modes and its law's coefficients fitted together (`output_error.with_band_modes_refined`),
+        then the modes above the band with them (their harmonics drive those), each kept where it simulates the whole
+        records better and holds beyond the top level where ``model`` does. In one fit, the modes above the band took
+        a test chain's in-band poles elsewhere (its fitted levels' cost twice the two fits')."""
         if model.joint is None:
             return model
-        self.say("the modes in the band refined with the joint's law ...")
-        refined = with_band_modes_refined(model, self.recordings, self.measured, self.span, fitted_band(self.spectra),
-                                          min(self.max_nfev, BAND_STEPS))
-        if refined is None or cost(refined, self.whole(refined)) >= cost(model, self.whole(model)):
-            return model
-        if not self.holds_beyond(refined) and self.holds_beyond(model):
-            return model
-        return with_table(refined, self.recordings, files)
+        band = fitted_band(self.spectra)
+        for free, which in ((band, "in the band"), ((band[0], np.inf), "in and above the band")):
+            if which != "in the band" and in_band(model.linear.poles, (band[1], np.inf)).size == 0:
+                break
+            self.say(f"the modes {which} refined with the joint's law ...")
+            refined = with_band_modes_refined(model, self.recordings, self.measured, self.span, free,
+                                              min(self.max_nfev, BAND_STEPS))
+            if refined is None or cost(refined, self.whole(refined)) >= cost(model, self.whole(model)):
+                continue
+            if not self.holds_beyond(refined) and self.holds_beyond(model):
+                continue
+            model = with_table(refined, self.recordings, files)
+        return model
 
     def holds_beyond(self, model) -> bool:
         """Whether ``model`` stays finite driven by the top level's force `BEYOND` times over, its response within

@@ -146,6 +146,7 @@ SAMPLE_EVALUATIONS = 16_000_000
 BAND_STEP = 2           # every BAND_STEP-th sample of the residuals (the records are band-limited well below Nyquist)
 FREQUENCY_SPAN = 0.2    # a mode's frequency moves at most this far (in log) from the start: it stays the mode it was
 ZETA = (1e-4, 0.9)      # the damping ratios are held within these
+TOP = 0.95              # of the Nyquist frequency: a mode above the band stays below it
 
 
 def in_band(poles, band_hz) -> np.ndarray:
@@ -187,10 +188,12 @@ def with_band_modes_refined(model, recordings, measured, span, band_hz, max_nfev
     j, lin = model.joint, model.linear
     if j is None:
         return None
-    idx = in_band(lin.poles, band_hz)
+    nyquist = float(recordings[0].fs_hz) / 2
+    idx = in_band(lin.poles, (band_hz[0], min(band_hz[1], TOP * nyquist)))
     if idx.size == 0:
         return None
     n_c, p0 = j.coefficients.size, lin.poles[idx]
+    top = np.log(TOP * nyquist)
 
     def build(theta):
         f, zeta = np.exp(theta[n_c::2]), np.exp(theta[n_c + 1::2])
@@ -216,7 +219,7 @@ def with_band_modes_refined(model, recordings, measured, span, band_hz, max_nfev
     failed = np.full(start[0].size, 1e3 / np.sqrt(start[0].size))
     lower = np.concatenate([np.full(n_c, -np.inf), np.column_stack([log_f - FREQUENCY_SPAN,
                                                                     np.full(idx.size, np.log(ZETA[0]))]).ravel()])
-    upper = np.concatenate([np.full(n_c, np.inf), np.column_stack([log_f + FREQUENCY_SPAN,
+    upper = np.concatenate([np.full(n_c, np.inf), np.column_stack([np.minimum(log_f + FREQUENCY_SPAN, top),
                                                                    np.full(idx.size, np.log(ZETA[1]))]).ravel()])
     scale = np.concatenate([np.maximum(np.abs(j.coefficients), 1e-3 * float(np.abs(j.coefficients).max() or 1.0)),
                             np.tile([0.01, 0.3], idx.size)])
