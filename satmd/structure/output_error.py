@@ -1,7 +1,7 @@
 """The output-error fits of a structure's joint: least squares of its simulated responses on every recording.
 
 `output_error` moves the joint (its law's coefficients and shape constants, and its path). `with_band_modes_refined`,
-the fit's last stage, moves the modes in the force's band with the law's coefficients:
+the fit's last stage, moves the modes in the force's band with the law's coefficients, then those above it too:
 
 The linear part's poles come from the lowest level's FRF (or, for the structure under the joint, from every
 level's spectra), and the output-error fits move the joint alone. But the lowest level already holds the joint
@@ -166,9 +166,9 @@ def in_band(poles, band_hz) -> np.ndarray:
 
 
 def with_band_modes_refined(model, recordings, measured, span, band_hz, max_nfev: int = BAND_STEPS):
-    """``model`` with its in-band modes' poles and its law's coefficients fitted on the records' first ``span``
-    samples, every channel solved inside; None where it has no joint or no mode in the band, a step runs away, or
-    the fit gains nothing.
+    """``model`` with the poles of its modes in ``band_hz`` (below `TOP` of the Nyquist frequency) and its law's
+    coefficients fitted on the records' first ``span`` samples, every channel solved inside; None where it has no
+    joint or no such mode, a step runs away, or the fit gains nothing.
 
     Parameters
     ----------
@@ -176,7 +176,7 @@ def with_band_modes_refined(model, recordings, measured, span, band_hz, max_nfev
     recordings : the Recordings it was fitted on
     measured : (C, span) responses of each recording, in the model's channel order
     span : samples of each recording the fit uses (`simulations.fit_span`)
-    band_hz : (lo, hi) Hz of the force's band (`fit.fitted_band`)
+    band_hz : (lo, hi) Hz of the modes to move: the force's band (`fit.fitted_band`), or from its foot up
     max_nfev : steps of the least squares at most (fewer for long records, `SAMPLE_EVALUATIONS`)
 
     Returns
