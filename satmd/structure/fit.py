@@ -17,7 +17,7 @@ from .model import Drive, Joint, StructureModel
 from .newtons import in_newtons
 from .loop import PAIRS, with_loop_modes
 from .outside import above_band, loop_poles
-from .output_error import BAND_STEPS, in_band, output_error, with_band_modes_refined
+from .output_error import BAND_STEPS, TOP, in_band, output_error, with_band_modes_refined
 from .outputs import resolved_outputs
 from .simulations import cost, drives_of, fit_span, oversampling, stable, with_table
 from .spectra import drive_force, periodic_spectra, warmup_of
@@ -280,18 +280,21 @@ class _Fit:
         a test chain's in-band poles elsewhere (its fitted levels' cost twice the two fits')."""
         if model.joint is None:
             return model
-        band = fitted_band(self.spectra)
-        for free, which in ((band, "in the band"), ((band[0], np.inf), "in and above the band")):
-            if which != "in the band" and in_band(model.linear.poles, (band[1], np.inf)).size == 0:
+        band, top = fitted_band(self.spectra), TOP * float(self.recordings[0].fs_hz) / 2
+        current, holds = cost(model, self.whole(model)), self.holds_beyond(model)
+        for free, which in ((band, "in the band"), ((band[0], top), "in and above the band")):
+            if which != "in the band" and in_band(model.linear.poles, (band[1], top)).size == 0:
                 break
             self.say(f"the modes {which} refined with the joint's law ...")
             refined = with_band_modes_refined(model, self.recordings, self.measured, self.span, free,
                                               min(self.max_nfev, BAND_STEPS))
-            if refined is None or cost(refined, self.whole(refined)) >= cost(model, self.whole(model)):
+            trial = np.inf if refined is None else cost(refined, self.whole(refined))
+            if trial >= current:
                 continue
-            if not self.holds_beyond(refined) and self.holds_beyond(model):
+            held = self.holds_beyond(refined)
+            if holds and not held:
                 continue
-            model = with_table(refined, self.recordings, files)
+            model, current, holds = with_table(refined, self.recordings, files), trial, held
         return model
 
     def holds_beyond(self, model) -> bool:
