@@ -282,9 +282,9 @@ class _Fit:
             return model
         band, top = fitted_band(self.spectra), TOP * float(self.recordings[0].fs_hz) / 2
         current, holds = cost(model, self.whole(model)), self.holds_beyond(model)
-        for free, which in ((band, "in the band"), ((band[0], top), "in and above the band")):
-            if which != "in the band" and in_band(model.linear.poles, (band[1], top)).size == 0:
-                break
+        for stage, (free, which) in enumerate(((band, "in the band"), ((band[0], top), "in and above the band"))):
+            if stage and in_band(model.linear.poles, (band[1], top)).size == 0:
+                break  # no mode above the band: the second fit would repeat the first
             self.say(f"the modes {which} refined with the joint's law ...")
             refined = with_band_modes_refined(model, self.recordings, self.measured, self.span, free,
                                               min(self.max_nfev, BAND_STEPS))
