@@ -25,11 +25,12 @@ def njit_cached(numba, func, sources):
     -------
     numba dispatcher
     """
-    dispatcher = numba.njit(cache=True, fastmath=False)(func)
+    dispatcher = numba.njit(cache=True, fastmath=False, nogil=True)(func)  # threads run it side by side
     cache = getattr(dispatcher, "_cache", None)
     where = getattr(cache, "cache_path", None)
     if where:
-        digest = hashlib.sha256(b"".join(Path(s).read_bytes() for s in sources)).hexdigest()
+        # this file too: numba's cache key holds no compile options, and code compiled with others would load
+        digest = hashlib.sha256(b"".join(Path(s).read_bytes() for s in [*sources, __file__])).hexdigest()
         stamp = Path(where) / f"{func.__module__}.{func.__qualname__}.sources"
         try:
             if not stamp.exists() or stamp.read_text() != digest:

@@ -1,9 +1,12 @@
 """Small numerical routines more than one package needs, written once (issue 25).
 
 At the floor of the import graph (numpy only): the pick of distinct best starts of a multistart
-search, the lag-1 autocorrelation of residual series, and every least-squares fit's covariance.
+search, the lag-1 autocorrelation of residual series, every least-squares fit's covariance, and the
+forward differences of a costly residual on every core.
 """
 from __future__ import annotations
+
+import os
 
 import numpy as np
 
@@ -138,6 +141,58 @@ def batched_least_squares(residuals, x0, bounds, max_nfev: int, steps=None, rel_
     opts = {"xtol": 1e-10, "ftol": 1e-10, **tolerances}
     sol = least_squares(fun, x0, jac=jac, bounds=bounds, method="trf", x_scale="jac", max_nfev=max_nfev, **opts)
     return sol, jac
+
+
+def threaded_differences(fun, rel_step: float, bounds=(-np.inf, np.inf), workers: int | None = None):
+    """(fun, jac) for `scipy.optimize.least_squares`: ``fun`` remembering its last value, and its Jacobian by
+    forward differences, the steps least squares' own ``'2-point'`` takes with ``diff_step=rel_step`` (each
+    ``rel_step · |x|``, √eps at zero, turned back where it would leave ``bounds``), the columns evaluated on ``workers``
+    threads. Each column of an output-error fit is a simulation of every record, in compiled code and filters
+    that let go of the interpreter's lock: two cores fill two columns at once (each on one BLAS thread: BLAS's own
+    threads beside them only wait on each other).
+
+    Parameters
+    ----------
+    fun : callable (p,) -> (n,), safe to call from several threads at once (it builds, never changes, what it shares)
+    rel_step : relative step
+    bounds : (lower, upper) of the parameters, as given to least squares
+    workers : threads (default: the cores this process may run on)
+
+    Returns
+    -------
+    (callable, callable)
+    """
+    from concurrent.futures import ThreadPoolExecutor
+
+    from threadpoolctl import threadpool_limits
+
+    last: dict = {}
+    if workers is None:
+        workers = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else (os.cpu_count() or 1)
+
+    def value(x):
+        f = np.asarray(fun(x), float)
+        last["x"], last["f"] = np.array(x, float), f
+        return f
+
+    def jac(x):
+        x = np.asarray(x, float)
+        f0 = last["f"] if "x" in last and np.array_equal(last["x"], x) else value(x)
+        lower, upper = (np.broadcast_to(np.asarray(b, float), x.shape) for b in bounds)
+        sign = np.where(x >= 0, 1.0, -1.0)
+        h = rel_step * sign * np.abs(x)
+        h = np.where((x + h) - x == 0, np.sqrt(np.finfo(float).eps) * sign * np.maximum(1.0, np.abs(x)), h)
+        below, above = x - lower, upper - x
+        fits = np.abs(h) <= np.maximum(below, above)
+        h = np.where((x + h < lower) | (x + h > upper), np.where(fits, -h, np.where(above >= below, above, -below)), h)
+        shifted = [x + h[i] * np.eye(x.size)[i] for i in range(x.size)]
+        steps = np.array([s[i] - x[i] for i, s in enumerate(shifted)])  # the step as floating point takes it
+        threads = max(1, min(workers, x.size))
+        with threadpool_limits(1 if threads > 1 else None), ThreadPoolExecutor(threads) as pool:
+            columns = list(pool.map(lambda s: np.asarray(fun(s), float), shifted))
+        return np.column_stack([(c - f0) / d for c, d in zip(columns, steps)]).reshape(f0.size, x.size)
+
+    return value, jac
 
 
 def force_level(force) -> float:

@@ -12,7 +12,7 @@ from hypothesis.extra.numpy import arrays
 
 from satmd.conventions import ACCEL_CHANNELS, DEFAULT_FREE, RECORDING_CHANNELS, SPEC_RANGES, TINY
 from satmd.errors import DataWarning, PinnedParameterWarning, PoorFitWarning, WarningRecord
-from satmd.numerics import distinct_best, lag1_autocorrelation
+from satmd.numerics import distinct_best, lag1_autocorrelation, threaded_differences
 
 
 def test_conventions_agree_with_each_other_and_the_rig():
@@ -65,6 +65,28 @@ def test_lag1_matches_the_concatenated_form_bit_for_bit(v):
         power = np.sum(x * x)
         expected = float(np.sum(lagged * ahead) / power) if power > 0 else 0.0
     assert _lag1(v) == expected
+
+
+def _rosenbrock(x):
+    return np.array([10 * (x[1] - x[0] ** 2), 1 - x[0], 0.5 * x[2] * x[0], np.sin(x[2])])
+
+
+@pytest.mark.parametrize("bounds", [(-np.inf, np.inf), ([-2.0, -1.0, 0.0], [1.2, 2.0, 1.0])])
+def test_threaded_differences_take_least_squares_own_steps(bounds):
+    """The output-error fits' Jacobian on threads: the same steps as `least_squares`' own ``'2-point'`` (turned back
+    at a bound), so the same fit, and the same numbers on one thread or many."""
+    from scipy.optimize import least_squares
+
+    x0 = np.array([-1.2, 0.0, 0.999999])  # the second at zero; the third within a step of its upper bound
+    own = least_squares(_rosenbrock, x0, diff_step=1e-6, bounds=bounds, max_nfev=30)
+    fun, jac = threaded_differences(_rosenbrock, 1e-6, bounds, workers=3)
+    ours = least_squares(fun, x0, jac=jac, bounds=bounds, max_nfev=30)
+    assert np.allclose(ours.x, own.x, rtol=1e-12, atol=1e-13) and ours.nfev == own.nfev  # round-off apart
+    x = np.array([0.3, -0.7, 0.9999999])
+    serial = threaded_differences(_rosenbrock, 1e-6, bounds, workers=1)[1](x)
+    assert np.array_equal(jac(x), serial)
+    exact = np.array([[-20 * x[0], 10, 0], [-1, 0, 0], [0.5 * x[2], 0, 0.5 * x[0]], [0, 0, np.cos(x[2])]])
+    assert np.allclose(serial, exact, atol=1e-4)
 
 
 def test_lag1_of_white_noise_and_of_a_smooth_curve():

@@ -24,6 +24,7 @@ from dataclasses import replace
 
 import numpy as np
 
+from ..numerics import threaded_differences
 from .output_error import half_widths
 from .outputs import Projection
 from .simulations import drives_of, oversampling
@@ -102,16 +103,15 @@ def with_loop_modes(model, poles, recordings, measured, span, max_nfev: int, fs_
     theta0 = np.clip(theta0, lower + 1e-9, upper - 1e-9)
     scale = np.concatenate([np.maximum(np.abs(j.coefficients), 1e-3 * float(np.abs(j.coefficients).max() or 1.0)),
                             np.full(2 * k, 0.1), np.full(2 * k, 1.0 / k)])
-    sol = least_squares(residual, theta0, x_scale=scale, diff_step=1e-4, bounds=(lower, upper),
-                        max_nfev=min(max_nfev, FIRST_NFEV))
+    fun, jac = threaded_differences(residual, 1e-4, (lower, upper))
+    sol = least_squares(fun, theta0, jac=jac, x_scale=scale, bounds=(lower, upper), max_nfev=min(max_nfev, FIRST_NFEV))
     if not 2 * sol.cost < start_cost:
         return None
     if 2 * sol.cost < (1 - GAINING) * start_cost and max_nfev > FIRST_NFEV:  # it gains: let it go on ...
         answer = solved(sol.x)
         if answer is None or (promising is not None and not promising(answer[1])):
             return None  # ... where the caller finds it promising (the F-16's gained here and lost on the records)
-        sol = least_squares(residual, sol.x, x_scale=scale, diff_step=1e-4, bounds=(lower, upper),
-                            max_nfev=max_nfev - FIRST_NFEV)
+        sol = least_squares(fun, sol.x, jac=jac, x_scale=scale, bounds=(lower, upper), max_nfev=max_nfev - FIRST_NFEV)
     projection, joint = projected(sol.x)
     answer = projection.solve(joint)
     if answer is None:

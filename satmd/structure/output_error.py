@@ -23,7 +23,7 @@ from dataclasses import replace
 import numpy as np
 
 from ..conventions import TINY
-from ..numerics import jacobian_covariance
+from ..numerics import jacobian_covariance, threaded_differences
 from .laws import SHAPE_GRID
 from .model import StructureModel
 from .outputs import Projection
@@ -88,7 +88,8 @@ def output_error(model, drives, ref, max_nfev, fixed_path=False, solved=True) ->
     scale = np.maximum(np.abs(theta0), 1e-3 * (np.abs(theta0).max() or 1.0))
     scale[scale == 0] = 1.0
     scale[n_free:n_free + len(shaped)] = 1.0  # a log: steps of order one
-    sol = least_squares(residual, theta0, x_scale=scale, diff_step=1e-4, max_nfev=max_nfev)
+    fun, jac = threaded_differences(residual, 1e-4)
+    sol = least_squares(fun, theta0, jac=jac, x_scale=scale, max_nfev=max_nfev)
     start = residual(theta0)
     if sol.cost > 0.5 * float(start @ start):  # never worse than where it started
         return replace(model, joint=unpack(theta0))
@@ -224,7 +225,8 @@ def with_band_modes_refined(model, recordings, measured, span, band_hz, max_nfev
     scale = np.concatenate([np.maximum(np.abs(j.coefficients), 1e-3 * float(np.abs(j.coefficients).max() or 1.0)),
                             np.tile([0.01, 0.3], idx.size)])
     steps = min(max_nfev, max(2, SAMPLE_EVALUATIONS // ((theta0.size + 1) * sum(span))))
-    sol = least_squares(residual, np.clip(theta0, lower + 1e-12, upper - 1e-12), x_scale=scale, diff_step=1e-5,
+    fun, jac = threaded_differences(residual, 1e-5, (lower, upper))
+    sol = least_squares(fun, np.clip(theta0, lower + 1e-12, upper - 1e-12), jac=jac, x_scale=scale,
                         bounds=(lower, upper), max_nfev=steps)
     if not 2 * sol.cost < float(start[0] @ start[0]):
         return None
