@@ -195,6 +195,23 @@ def threaded_differences(fun, rel_step: float, bounds=(-np.inf, np.inf), workers
     return value, jac
 
 
+def on_one_blas_thread(func):
+    """``func`` run with BLAS on one thread. The structure fits' matrices are tall and narrow and their products
+    many and small: BLAS's threads cost more than they gain (on two cores the F-16's `discover` took 218 s with
+    them and 193 s without, a chain's fit 44 s and 30 s); their parallel work is the Jacobian's columns, each on its
+    own thread (`threaded_differences`)."""
+    import functools
+
+    @functools.wraps(func)
+    def wrapper(*args, **kwargs):
+        from threadpoolctl import threadpool_limits
+
+        with threadpool_limits(1):
+            return func(*args, **kwargs)
+
+    return wrapper
+
+
 def force_level(force) -> float:
     """The drive level of a recording: the force's RMS about its mean (a load cell's offset is no drive).
 

@@ -6,6 +6,7 @@ from dataclasses import replace
 import numpy as np
 
 from ..errors import DataError
+from ..numerics import on_one_blas_thread
 from ..validation import NAMES, Interval, Options, Whole, validate_params
 from .acquisition import acquisition_of
 from .choice import PLACE_LAWS, best_fitting, best_place, contradicts, ranked_laws, score
@@ -38,6 +39,7 @@ RUNAWAY = 10.0  # ... nor respond more than this times the top level's measured 
 @validate_params({"between": [None, NAMES], "law": [None, Options(tuple(LAWS))], "channels": [None, NAMES],
                   "n_pairs": [None, Interval(Whole, 1, 24)], "max_nfev": [Interval(Whole, 1)],
                   "driving_point": [None, str], "starts": [NAMES], "free_path": [bool]})
+@on_one_blas_thread
 def fit_structure(recordings, between=None, law: str | None = None, channels=None, n_pairs: int | None = None,
                   max_nfev: int = 40, files=None, driving_point: str | None = None, starts=STARTS,
                   free_path: bool = True, location=None, progress=None) -> StructureModel:
