@@ -143,6 +143,11 @@ def batched_least_squares(residuals, x0, bounds, max_nfev: int, steps=None, rel_
     return sol, jac
 
 
+#: threads `threaded_differences` takes at most by default: each holds a simulation of every record (the F-16's,
+#: some 200 MB), and a large machine's cores would multiply that
+MAX_THREADS = 8
+
+
 def threaded_differences(fun, rel_step: float, bounds=(-np.inf, np.inf), workers: int | None = None):
     """(fun, jac) for `scipy.optimize.least_squares`: ``fun`` remembering its last value, and its Jacobian by
     forward differences, the steps least squares' own ``'2-point'`` takes with ``diff_step=rel_step`` (each
@@ -156,7 +161,7 @@ def threaded_differences(fun, rel_step: float, bounds=(-np.inf, np.inf), workers
     fun : callable (p,) -> (n,), safe to call from several threads at once (it builds, never changes, what it shares)
     rel_step : relative step
     bounds : (lower, upper) of the parameters, as given to least squares
-    workers : threads (default: the cores this process may run on)
+    workers : threads (default: the cores this process may run on, at most `MAX_THREADS`)
 
     Returns
     -------
@@ -168,7 +173,8 @@ def threaded_differences(fun, rel_step: float, bounds=(-np.inf, np.inf), workers
 
     last: dict = {}
     if workers is None:
-        workers = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else (os.cpu_count() or 1)
+        cores = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else (os.cpu_count() or 1)
+        workers = min(cores, MAX_THREADS)
 
     def value(x):
         f = np.asarray(fun(x), float)
@@ -185,8 +191,9 @@ def threaded_differences(fun, rel_step: float, bounds=(-np.inf, np.inf), workers
         below, above = x - lower, upper - x
         fits = np.abs(h) <= np.maximum(below, above)
         h = np.where((x + h < lower) | (x + h > upper), np.where(fits, -h, np.where(above >= below, above, -below)), h)
-        shifted = [x + h[i] * np.eye(x.size)[i] for i in range(x.size)]
-        steps = np.array([s[i] - x[i] for i, s in enumerate(shifted)])  # the step as floating point takes it
+        shifted = np.tile(x, (x.size, 1))
+        shifted[np.diag_indices(x.size)] += h  # row i: x with its i-th parameter stepped
+        steps = np.diag(shifted) - x  # the step as floating point takes it
         threads = max(1, min(workers, x.size))
         with threadpool_limits(1 if threads > 1 else None), ThreadPoolExecutor(threads) as pool:
             columns = list(pool.map(lambda s: np.asarray(fun(s), float), shifted))
