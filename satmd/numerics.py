@@ -168,8 +168,7 @@ def threaded_differences(fun, rel_step: float, bounds=(-np.inf, np.inf), workers
     (callable, callable)
     """
     from concurrent.futures import ThreadPoolExecutor
-
-    from threadpoolctl import threadpool_limits
+    from contextlib import nullcontext
 
     last: dict = {}
     if workers is None:
@@ -195,11 +194,19 @@ def threaded_differences(fun, rel_step: float, bounds=(-np.inf, np.inf), workers
         shifted[np.diag_indices(x.size)] += h  # row i: x with its i-th parameter stepped
         steps = np.diag(shifted) - x  # the step as floating point takes it
         threads = max(1, min(workers, x.size))
-        with threadpool_limits(1 if threads > 1 else None), ThreadPoolExecutor(threads) as pool:
+        with one_blas_thread() if threads > 1 else nullcontext(), ThreadPoolExecutor(threads) as pool:
             columns = list(pool.map(lambda s: np.asarray(fun(s), float), shifted))
         return np.column_stack([(c - f0) / d for c, d in zip(columns, steps)]).reshape(f0.size, x.size)
 
     return value, jac
+
+
+def one_blas_thread():
+    """A context in which BLAS runs on one thread: tall, thin least-squares problems and many small products run
+    faster so than on many (`satmd.modal.fit_modal`, the structure fits)."""
+    from threadpoolctl import threadpool_limits
+
+    return threadpool_limits(limits=1, user_api="blas")
 
 
 def on_one_blas_thread(func):
@@ -211,9 +218,7 @@ def on_one_blas_thread(func):
 
     @functools.wraps(func)
     def wrapper(*args, **kwargs):
-        from threadpoolctl import threadpool_limits
-
-        with threadpool_limits(1):
+        with one_blas_thread():
             return func(*args, **kwargs)
 
     return wrapper

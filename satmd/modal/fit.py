@@ -19,7 +19,7 @@ import numpy as np
 
 from ..validation import Band, Interval, Whole, validate_params
 
-from ..numerics import jacobian_covariance, unit_columns
+from ..numerics import jacobian_covariance, one_blas_thread, unit_columns
 from .poles import stable_poles
 
 Z95 = 1.959963984540054  # two-sided 95 % normal quantile
@@ -131,24 +131,13 @@ def fit_modes(freq_hz, frf, std=None, band_hz=None, n_modes=None, max_order=None
     w = 2 * np.pi * freq
     band_hz = (float(freq[0]), float(freq[-1]))
     order = int(min(max_order or DEFAULT_MAX_ORDER, freq.size - 2))
-    with _one_blas_thread():
+    with one_blas_thread():
         found = sorted(stable_poles(w, H, S, order) if start is None else start, key=lambda c: c[0])
         x0 = np.array([c[0] for c in found] + [c[1] for c in found], float)
         x, cost, jac = _refine(w, H, S, x0, band_hz)
         if start is None:
             x, cost, jac = _prune(w, H, S, x, cost, jac, band_hz, weighted, n_modes)
         return _result(w, H, S, x, cost, jac, band_hz, names, weighted)
-
-
-def _one_blas_thread():
-    """Tall, thin least-squares problems run several times faster on one BLAS thread than on many."""
-    try:
-        from threadpoolctl import threadpool_limits  # installed with scikit-learn
-    except ImportError:  # pragma: no cover
-        from contextlib import nullcontext
-
-        return nullcontext()
-    return threadpool_limits(limits=1, user_api="blas")
 
 
 # --- inputs -------------------------------------------------------------------------------------------------
