@@ -24,10 +24,8 @@ from dataclasses import replace
 
 import numpy as np
 
-from ..numerics import threaded_differences
-from .output_error import half_widths
-from .outputs import Projection
-from .simulations import drives_of, oversampling
+from .output_error import ProjectedFit
+from .simulations import oversampling
 
 PAIRS = 2                       # modes added to the loop
 SHARES = (1.0, 0.3, 0.1)        # their static stroke flexibility at the start, over the in-band modes': the best kept
@@ -55,8 +53,6 @@ def with_loop_modes(model, poles, recordings, measured, span, max_nfev: int, fs_
     StructureModel (the added modes' shaker residues zero, their columns solved; intervals of the law's
     coefficients from this fit) or None
     """
-    from scipy.optimize import least_squares
-
     lin, j = model.linear, model.joint
     k, n_c, n_out = poles.size, j.coefficients.size, len(lin.channels)
     in_band = static_flexibility(lin.poles, j.stroke_of(lin) * j.coupling)
@@ -74,50 +70,35 @@ def with_loop_modes(model, poles, recordings, measured, span, max_nfev: int, fs_
                         column=np.hstack([column, np.zeros((n_out, k))]), stroke=np.concatenate([stroke, np.ones(k)]))
         return replace(model, linear=added, joint=joint, oversample=oversampling(added, fs_hz))
 
-    def projected(theta):
-        trial = build(theta)
-        return Projection(trial, drives_of(trial, recordings, measured, span), STEP), trial.joint
-
-    def solved(theta):
-        projection, joint = projected(theta)
-        return projection.solve(joint)
-
-    def residual(theta):
-        answer = solved(theta)
-        return failed if answer is None or not np.all(np.isfinite(answer[0])) else answer[0]
-
     f0 = np.abs(poles) / (2 * np.pi)
     zeta0 = np.clip(-poles.real / np.abs(poles), 1.01 * ZETA[0], 0.99 * ZETA[1])
-    starts = [np.concatenate([j.coefficients, np.log(f0), np.log(zeta0), np.full(k, s / k), np.zeros(k)])
-              for s in SHARES]
-    answers = [(solved(t), t) for t in starts]
-    finite = [(float(a[0] @ a[0]), t, a[0].size) for a, t in answers if a is not None and np.all(np.isfinite(a[0]))]
-    if not finite:
-        return None
-    start_cost, theta0, size = min(finite, key=lambda x: x[0])
-    failed = np.full(size, 1e3 / np.sqrt(size))
     top = np.log(TOP * fs_hz / 2)
     lower = np.concatenate([np.full(n_c, -np.inf), np.full(k, np.log(f0.min()) - 0.5), np.full(k, np.log(ZETA[0])),
                             np.full(2 * k, -np.inf)])
     upper = np.concatenate([np.full(n_c, np.inf), np.full(k, top), np.full(k, np.log(ZETA[1])), np.full(2 * k, np.inf)])
+    problem = ProjectedFit(build, (recordings, measured, span), STEP, (lower, upper), 1e-4)
+    starts = [np.concatenate([j.coefficients, np.log(f0), np.log(zeta0), np.full(k, s / k), np.zeros(k)])
+              for s in SHARES]
+    answers = [(problem.answer(t), t) for t in starts]
+    finite = [(float(a[0] @ a[0]), t) for a, t in answers if a is not None]
+    if not finite:
+        return None
+    start_cost, theta0 = min(finite, key=lambda x: x[0])
     theta0 = np.clip(theta0, lower + 1e-9, upper - 1e-9)
     scale = np.concatenate([np.maximum(np.abs(j.coefficients), 1e-3 * float(np.abs(j.coefficients).max() or 1.0)),
                             np.full(2 * k, 0.1), np.full(2 * k, 1.0 / k)])
-    fun, jac = threaded_differences(residual, 1e-4, (lower, upper))
-    sol = least_squares(fun, theta0, jac=jac, x_scale=scale, bounds=(lower, upper), max_nfev=min(max_nfev, FIRST_NFEV))
+    sol = problem.least_squares(theta0, scale, min(max_nfev, FIRST_NFEV))
     if not 2 * sol.cost < start_cost:
         return None
     if 2 * sol.cost < (1 - GAINING) * start_cost and max_nfev > FIRST_NFEV:  # it gains: let it go on ...
-        answer = solved(sol.x)
+        answer = problem.answer(sol.x)
         if answer is None or (promising is not None and not promising(answer[1])):
             return None  # ... where the caller finds it promising (the F-16's gained here and lost on the records)
-        sol = least_squares(fun, sol.x, jac=jac, x_scale=scale, bounds=(lower, upper), max_nfev=max_nfev - FIRST_NFEV)
-    projection, joint = projected(sol.x)
-    answer = projection.solve(joint)
-    if answer is None:
+        sol = problem.least_squares(sol.x, scale, max_nfev - FIRST_NFEV)
+    result = problem.result(sol)
+    if result is None:
         return None
-    fitted = answer[1]
-    half = half_widths(sol.jac, sol.fun, projection.runs)  # the residuals' runs, one per channel and recording
+    fitted, half = result
     names = list(fitted.joint.parameters())
     ci = dict(j.ci95)
     for i, c in enumerate(fitted.joint.coefficients):

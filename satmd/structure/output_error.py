@@ -184,8 +184,6 @@ def with_band_modes_refined(model, recordings, measured, span, band_hz, max_nfev
     -------
     StructureModel (the law's coefficients' intervals widened by the poles' uncertainty) or None
     """
-    from scipy.optimize import least_squares
-
     j, lin = model.joint, model.linear
     if j is None:
         return None
@@ -202,41 +200,82 @@ def with_band_modes_refined(model, recordings, measured, span, band_hz, max_nfev
         poles[idx] = 2 * np.pi * f * (-zeta + 1j * np.sqrt(1 - zeta ** 2))
         return replace(model, linear=replace(lin, poles=poles), joint=replace(j, coefficients=theta[:n_c]))
 
-    def projected(theta):
-        trial = build(theta)
-        return Projection(trial, drives_of(trial, recordings, measured, span), BAND_STEP), trial.joint
-
-    def residual(theta):
-        projection, joint = projected(theta)
-        answer = projection.solve(joint)
-        return failed if answer is None or not np.all(np.isfinite(answer[0])) else answer[0]
-
     log_f, log_zeta = np.log(np.abs(p0) / (2 * np.pi)), np.log(np.clip(-p0.real / np.abs(p0), *ZETA))
     theta0 = np.concatenate([j.coefficients, np.column_stack([log_f, log_zeta]).ravel()])
-    projection, joint = projected(theta0)
-    start = projection.solve(joint)
-    if start is None or not np.all(np.isfinite(start[0])):
-        return None
-    failed = np.full(start[0].size, 1e3 / np.sqrt(start[0].size))
     lower = np.concatenate([np.full(n_c, -np.inf), np.column_stack([log_f - FREQUENCY_SPAN,
                                                                     np.full(idx.size, np.log(ZETA[0]))]).ravel()])
     upper = np.concatenate([np.full(n_c, np.inf), np.column_stack([np.minimum(log_f + FREQUENCY_SPAN, top),
                                                                    np.full(idx.size, np.log(ZETA[1]))]).ravel()])
+    problem = ProjectedFit(build, (recordings, measured, span), BAND_STEP, (lower, upper), 1e-5)
+    start = problem.answer(theta0)
+    if start is None:
+        return None
     scale = np.concatenate([np.maximum(np.abs(j.coefficients), 1e-3 * float(np.abs(j.coefficients).max() or 1.0)),
                             np.tile([0.01, 0.3], idx.size)])
     steps = min(max_nfev, max(2, SAMPLE_EVALUATIONS // ((theta0.size + 1) * sum(span))))
-    fun, jac = threaded_differences(residual, 1e-5, (lower, upper))
-    sol = least_squares(fun, np.clip(theta0, lower + 1e-12, upper - 1e-12), jac=jac, x_scale=scale,
-                        bounds=(lower, upper), max_nfev=steps)
+    sol = problem.least_squares(np.clip(theta0, lower + 1e-12, upper - 1e-12), scale, steps)
     if not 2 * sol.cost < float(start[0] @ start[0]):
         return None
-    projection, joint = projected(sol.x)
-    answer = projection.solve(joint)
-    if answer is None:
+    result = problem.result(sol)
+    if result is None:
         return None
-    fitted = answer[1]
-    return replace(fitted, joint=replace(fitted.joint, ci95=_intervals(j, fitted.joint, half_widths(
-        sol.jac, sol.fun, projection.runs))))
+    fitted, half = result
+    return replace(fitted, joint=replace(fitted.joint, ci95=_intervals(j, fitted.joint, half)))
+
+
+class ProjectedFit:
+    """A bounded least squares over trial models ``build(θ)``, each with every channel's residues, joint's column
+    and feed-through solved inside (`outputs.Projection`): the shape `with_band_modes_refined` and
+    `loop.with_loop_modes` share (they move poles with the law's coefficients). Its Jacobian's columns run on
+    threads (`numerics.threaded_differences`, least squares' own steps of ``rel_step``); a trial whose joint runs
+    away answers a large constant misfit, so that least squares steps back.
+
+    Parameters
+    ----------
+    build : callable(θ) -> StructureModel
+    records : (recordings, measured, span) as `simulations.drives_of` takes them
+    step : every step-th sample of the residuals
+    bounds : (lower, upper) of θ
+    rel_step : the forward differences' relative step
+    """
+
+    def __init__(self, build, records, step: int, bounds, rel_step: float):
+        self.build, self.records, self.step, self.bounds = build, records, int(step), bounds
+        self.failed = None  # the misfit of a trial that ran away: sized by the first that did not
+        self.fun, self.jac = threaded_differences(self.residuals, rel_step, bounds)
+
+    def projection(self, theta):
+        """(`outputs.Projection` of the trial model at θ, its joint)."""
+        trial = self.build(theta)
+        return Projection(trial, drives_of(trial, *self.records), self.step), trial.joint
+
+    def answer(self, theta):
+        """(weighted residuals, the trial model with every channel solved) at θ; None where the joint ran away."""
+        projection, joint = self.projection(theta)
+        answer = projection.solve(joint)
+        if answer is None or not np.all(np.isfinite(answer[0])):
+            return None
+        if self.failed is None:
+            self.failed = np.full(answer[0].size, 1e3 / np.sqrt(answer[0].size))
+        return answer
+
+    def residuals(self, theta) -> np.ndarray:
+        answer = self.answer(theta)
+        return self.failed if answer is None else answer[0]
+
+    def least_squares(self, theta, x_scale, max_nfev: int):
+        """`scipy.optimize.least_squares` from θ (within the bounds), at most ``max_nfev`` steps."""
+        from scipy.optimize import least_squares
+
+        return least_squares(self.fun, theta, jac=self.jac, x_scale=x_scale, bounds=self.bounds, max_nfev=max_nfev)
+
+    def result(self, sol):
+        """(the model at the fit's θ, its parameters' 95 % half-widths or None); None where its joint ran away."""
+        projection, joint = self.projection(sol.x)
+        answer = projection.solve(joint)
+        if answer is None:
+            return None
+        return answer[1], half_widths(sol.jac, sol.fun, projection.runs)
 
 
 def _intervals(before, after, half) -> dict:
