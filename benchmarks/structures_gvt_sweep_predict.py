@@ -1,0 +1,127 @@
+"""Another excitation of the same structures (issue 47): models fitted on multisines, judged on sine sweeps.
+
+The issue asks a structure's model, fitted on four multisine levels, to predict other excitations of the same
+structure too (on the F-16, NRMSE <= 0.35 on every channel). A ground vibration test's classic is the sine sweep:
+it dwells on each resonance in turn, so the joint meets strokes a multisine of the same RMS spreads over the band.
+Each test here is one of `structures_gvt`'s (the independent simulator `benchmarks/_indep_gvt.py`, numpy/scipy
+only), run as a user would:
+
+    satmd discover L1.csv L3.csv L5.csv L7.csv --json --save-model model.json     (multisines)
+    satmd predict model.json S1.csv ... S7.csv --json                              (sweeps, every level)
+
+each sweep one linear sweep down the band (40 -> 5 Hz in 40 s) with 40 s of quiet after it, its RMS over the sweep
+the multisine's at that level. Scored per test at its worst sweep level and channel: within 3x the noise floor, at
+most 0.35 (the issue's bound for the F-16's other excitations), below the level-1 linear model's; and whether
+`satmd predict` flagged the sweep as driving the joint beyond the fitted recordings.
+
+    python benchmarks/structures_gvt_sweep_predict.py [--seeds 1,2,5] [--out PATH]
+
+Writes benchmarks/results/structures_gvt_sweep_predict.json and prints one line of figures.
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT / "benchmarks"))
+import _indep_gvt as sim  # noqa: E402
+from _machine import describe, load_after, machine  # noqa: E402
+from structures_gvt import FITTED, _finite, _satmd, plan  # noqa: E402
+
+OUT = ROOT / "benchmarks" / "results" / "structures_gvt_sweep_predict.json"
+SWEPT = tuple(range(1, 8))
+BOUND = 0.35  # the issue's NRMSE bound on the F-16's other excitations
+SEEDS = (1, 2, 5, 7, 8, 11, 12, 15, 17, 22)  # every law and structure, each predicted within 3x noise on multisines; a null
+
+
+def case(structure: str, law: str | None, seed: int) -> dict:
+    test = sim.make_test(seed, structure, law)
+    row = {**{k: v for k, v in test.describe().items() if k in ("structure", "seed", "law", "between", "noise")}}
+    multisines, sweeps = sim.simulate(test), sim.simulate(test, excitation="sweep")
+    with tempfile.TemporaryDirectory() as tmp:
+        for lv in FITTED:
+            sim.write_csv(multisines[lv - 1], Path(tmp) / f"L{lv}.csv")
+        for lv in SWEPT:
+            sim.write_csv(sweeps[lv - 1], Path(tmp) / f"S{lv}.csv")
+        t0 = time.perf_counter()
+        found = _satmd("discover", *(f"L{lv}.csv" for lv in FITTED), "--json", "--save-model", "model.json", cwd=tmp)
+        row["discover_s"] = round(time.perf_counter() - t0, 1)
+        if "error" in found:
+            row["error"] = found["error"]
+            return row
+        joint = next((f for f in (found.get("nonlinear") or {}).get("findings", []) if f.get("name") == "joint"), None)
+        row["found_between"], row["found_law"] = (joint["between"], joint["law"]) if joint else (None, None)
+        pred = _satmd("predict", "model.json", *(f"S{lv}.csv" for lv in SWEPT), "--json", cwd=tmp)
+        if "error" in pred:
+            row["error"] = pred["error"]
+            return row
+        row["swept"] = [{"level": lv, "nrmse": r["nrmse"], "linear_nrmse": r["linear_nrmse"],
+                         "extrapolated": r["extrapolated"], "joint_force_over_fitted": r.get("joint_force_over_fitted")}
+                        for lv, r in zip(SWEPT, pred["recordings"])]
+    return _score(row)
+
+
+def _score(row: dict) -> dict:
+    worst = [max(_finite(s["nrmse"])) for s in row["swept"]]
+    linear = [max(_finite(s["linear_nrmse"])) for s in row["swept"]]
+    row["worst_nrmse"], row["worst_linear_nrmse"] = round(max(worst), 4), round(max(linear), 4)
+    row["right"] = {"within_3x_noise": max(worst) <= 3 * row["noise"]["acc"], "within_bound": max(worst) <= BOUND,
+                    "better_than_linear": all(w < lin for w, lin in zip(worst, linear) if lin > 3 * row["noise"]["acc"])}
+    row["beyond_fitted"] = [s["level"] for s in row["swept"] if (s.get("joint_force_over_fitted") or 0) > 1]
+    return row
+
+
+def summarise(rows) -> dict:
+    done = [r for r in rows if "right" in r]
+    count = {k: {"n": len(done), "right": sum(r["right"][k] for r in done)}
+             for k in ("within_3x_noise", "within_bound", "better_than_linear")}
+    return {"tests": len(rows), "errors": len(rows) - len(done), **count,
+            "median_worst_over_noise": round(float(np.median([r["worst_nrmse"] / r["noise"]["acc"] for r in done])), 1)
+            if done else None,
+            "with_a_level_beyond_fitted": sum(bool(r["beyond_fitted"]) for r in done)}
+
+
+def line(result) -> str:
+    s = result["summary"]
+
+    def f(k):
+        return f"{s[k]['right']}/{s[k]['n']}"
+    return (f"structures_gvt_sweep_predict: {s['tests']} tests, sweeps at 7 levels from multisine-fitted models: "
+            f"within 3x noise {f('within_3x_noise')}, worst NRMSE <= {BOUND} {f('within_bound')}, better than the "
+            f"level-1 linear model {f('better_than_linear')}, median worst/noise {s['median_worst_over_noise']}, "
+            f"a level beyond the fitted joint force on {s['with_a_level_beyond_fitted']}, errors {s['errors']} | "
+            f"{describe(result['machine'])}")
+
+
+def main(argv=None) -> dict:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--seeds", default=",".join(map(str, SEEDS)), help="comma-separated test seeds of structures_gvt")
+    ap.add_argument("--out", type=Path, default=OUT)
+    args = ap.parse_args(argv)
+    info = machine()
+    t0 = time.perf_counter()
+    rows = []
+    tests = plan(0, 0, [int(s) for s in args.seeds.split(",")])
+    for i, (structure, law, seed) in enumerate(tests, 1):
+        rows.append(case(structure, law, seed))
+        r = rows[-1]
+        print(f"[{i}/{len(tests)}] {structure} {law} seed {seed}: {r.get('error') or r['right']} "
+              f"worst {r.get('worst_nrmse')} (noise {r['noise']['acc']:.4f}; linear {r.get('worst_linear_nrmse')}) "
+              f"({r.get('discover_s')} s)", file=sys.stderr, flush=True)
+    result = {"machine": load_after(info), "fitted_levels": list(FITTED), "swept_levels": list(SWEPT), "rows": rows,
+              "summary": summarise(rows), "benchmark_seconds": round(time.perf_counter() - t0, 1)}
+    args.out.parent.mkdir(parents=True, exist_ok=True)
+    args.out.write_text(json.dumps(result, indent=1))
+    print(line(result))
+    return result
+
+
+if __name__ == "__main__":
+    main()
