@@ -106,3 +106,32 @@ def test_the_load_cell_s_noise_lines_are_not_kept_as_force():
         kept += int(np.sum(line[off] > 1e-9 * line.max()))
         tones += int(line[tone] > 0.5 * 0.01 * np.std(clean) * PERIOD / 2)
     assert kept <= 1 and tones == 5
+
+
+def test_a_sweep_loses_the_load_cell_s_noise_outside_its_band():
+    """A sweep is not periodic: no mean period to take. What it holds outside its band (5-40 Hz of the 128 Hz a
+    record carries) is the load cell's noise alone, and goes; the sweep stays (what is left of the 2 % noise is its
+    share in the band, about half), and after the sweep the quiet is quieter by as much. A white random force
+    has no band of its own and stays as measured (the test above)."""
+    from tests.structure.chain import log_sweep
+
+    clean = np.concatenate([log_sweep(FS, 20.0, 40.0, 5.0), np.zeros(int(10 * FS))])
+    noise = 0.02 * np.std(clean[: int(20 * FS)]) * np.random.default_rng(11).standard_normal(clean.size)
+    rec = Recording(FS, {"force": clean + noise, "acc1": clean}, meta={"source": "test"})
+    driven = drive_force(rec)
+    scale, tail = np.std(clean), slice(int(22 * FS), None)
+    assert np.std(noise) / scale > 0.019 and np.std(driven - clean) / scale < 0.6 * np.std(noise) / scale
+    assert np.std(driven[tail]) < 0.6 * np.std(noise[tail])
+    spectrum = np.abs(np.fft.rfft(driven - clean))
+    f = np.fft.rfftfreq(clean.size, 1.0 / FS)
+    assert np.sqrt(np.mean(spectrum[f > 45.0] ** 2)) < 0.2 * np.sqrt(np.mean(spectrum[(f > 10) & (f < 35)] ** 2))
+
+
+def test_a_hammer_s_force_is_driven_as_measured():
+    """An impact fills the spectrum up to Nyquist: no band stands above a floor, nothing is taken out."""
+    force = np.zeros(PERIOD * 4)
+    for start in range(100, force.size, PERIOD):
+        force[start:start + 2] = (300.0, 120.0)
+    force += 0.5 * np.random.default_rng(12).standard_normal(force.size)
+    rec = Recording(FS, {"force": force, "acc1": force}, meta={"source": "test"})
+    assert np.array_equal(drive_force(rec), force)
