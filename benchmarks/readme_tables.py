@@ -565,6 +565,8 @@ MEASURES = {
     # Ctrl-C's handling (_interrupt.py) changes nothing in a run that is not interrupted
     "structures_gvt": ["satmd/structure", "satmd/modal", "satmd/signal", "satmd/discovery", "satmd/io", "satmd/cli",
                        ":(exclude)satmd/cli/_interrupt.py"],
+    "structures_gvt_sweep_predict": ["satmd/structure", "satmd/modal", "satmd/signal", "satmd/discovery", "satmd/io",
+                                     "satmd/cli", ":(exclude)satmd/cli/_interrupt.py"],
     "structures_gvt_locate": ["satmd/structure/locate.py", "satmd/structure/laws.py", "satmd/structure/spectra.py",
                               "satmd/modal/fit.py", "satmd/modal/poles.py", "satmd/io", "satmd/signal"],
     "structures_joint": ["satmd/structure/locate.py", "satmd/structure/laws.py", "satmd/structure/spectra.py",

@@ -17,7 +17,8 @@ each resonance, so its top levels drive the joint beyond them: `joint_force_over
 
     python benchmarks/structures_gvt_sweep_predict.py [--seeds 1,2,5] [--out PATH] [--models DIR]
 
-``--models DIR`` keeps each test's saved model (``DIR/model_SEED.json``) and its sweep files.
+``--models DIR`` keeps each test's saved model (``DIR/model_SEED.json``) and its sweep files (``S{level}_SEED.csv``);
+``--predict-only DIR`` predicts those again and scores them, without a fit (after a change to how a model is driven).
 
 Writes benchmarks/results/structures_gvt_sweep_predict.json and prints one line of figures.
 """
@@ -46,33 +47,42 @@ SEEDS = (1, 2, 5, 7, 8, 11, 12, 15, 17, 22)  # every law and structure, each pre
 
 def case(structure: str, law: str | None, seed: int, keep: Path | None = None) -> dict:
     test = sim.make_test(seed, structure, law)
-    row = {**{k: v for k, v in test.describe().items() if k in ("structure", "seed", "law", "between", "noise")}}
+    row = {k: v for k, v in test.describe().items() if k in ("structure", "seed", "law", "between", "noise")}
     multisines, sweeps = sim.simulate(test), sim.simulate(test, excitation="sweep")
     with tempfile.TemporaryDirectory() as tmp:
         for lv in FITTED:
             sim.write_csv(multisines[lv - 1], Path(tmp) / f"L{lv}.csv")
         for lv in SWEPT:
-            sim.write_csv(sweeps[lv - 1], Path(tmp) / f"S{lv}.csv")
+            sim.write_csv(sweeps[lv - 1], Path(tmp) / f"S{lv}_{seed}.csv")
         t0 = time.perf_counter()
-        found = _satmd("discover", *(f"L{lv}.csv" for lv in FITTED), "--json", "--save-model", "model.json", cwd=tmp)
+        found = _satmd("discover", *(f"L{lv}.csv" for lv in FITTED), "--json", "--save-model", f"model_{seed}.json",
+                       cwd=tmp)
         row["discover_s"] = round(time.perf_counter() - t0, 1)
         if "error" in found:
             row["error"] = found["error"]
             return row
-        joint = next((f for f in (found.get("nonlinear") or {}).get("findings", []) if f.get("name") == "joint"), None)
-        row["found_between"], row["found_law"] = (joint["between"], joint["law"]) if joint else (None, None)
-        pred = _satmd("predict", "model.json", *(f"S{lv}.csv" for lv in SWEPT), "--json", cwd=tmp)
-        if "error" in pred:
-            row["error"] = pred["error"]
-            return row
-        row["swept"] = [{"level": lv, "nrmse": r["nrmse"], "linear_nrmse": r["linear_nrmse"],
-                         "extrapolated": r["extrapolated"], "joint_force_over_fitted": r.get("joint_force_over_fitted")}
-                        for lv, r in zip(SWEPT, pred["recordings"])]
         if keep is not None:
             keep.mkdir(parents=True, exist_ok=True)
-            (keep / f"model_{seed}.json").write_bytes((Path(tmp) / "model.json").read_bytes())
-            for lv in SWEPT:
-                (keep / f"S{lv}_{seed}.csv").write_bytes((Path(tmp) / f"S{lv}.csv").read_bytes())
+            for name in (f"model_{seed}.json", *(f"S{lv}_{seed}.csv" for lv in SWEPT)):
+                (keep / name).write_bytes((Path(tmp) / name).read_bytes())
+        return judged(row, Path(tmp))
+
+
+def judged(row: dict, folder: Path) -> dict:
+    """``row`` with the sweeps in ``folder`` (``S{level}_{seed}.csv``) predicted by its model (``model_{seed}.json``)
+    through `satmd predict`, scored; the joint found is the model's."""
+    from satmd.structure import StructureModel
+
+    seed = row["seed"]
+    joint = StructureModel.load(folder / f"model_{seed}.json").joint
+    row["found_between"], row["found_law"] = (list(joint.between), joint.law) if joint else (None, None)
+    pred = _satmd("predict", f"model_{seed}.json", *(f"S{lv}_{seed}.csv" for lv in SWEPT), "--json", cwd=folder)
+    if "error" in pred:
+        row["error"] = pred["error"]
+        return row
+    row["swept"] = [{"level": lv, "nrmse": r["nrmse"], "linear_nrmse": r["linear_nrmse"],
+                     "extrapolated": r["extrapolated"], "joint_force_over_fitted": r.get("joint_force_over_fitted")}
+                    for lv, r in zip(SWEPT, pred["recordings"])]
     return _score(row)
 
 
@@ -136,19 +146,29 @@ def main(argv=None) -> dict:
     ap.add_argument("--seeds", default=",".join(map(str, SEEDS)), help="comma-separated test seeds of structures_gvt")
     ap.add_argument("--out", type=Path, default=OUT)
     ap.add_argument("--models", type=Path, default=None, help="keep each test's model and sweep files here")
+    ap.add_argument("--predict-only", type=Path, default=None, metavar="DIR",
+                    help="no fit: the models and sweeps kept in DIR by --models, predicted again and scored")
     args = ap.parse_args(argv)
     info = machine()
     t0 = time.perf_counter()
     rows = []
     tests = plan(0, 0, [int(s) for s in args.seeds.split(",")])
     for i, (structure, law, seed) in enumerate(tests, 1):
-        rows.append(case(structure, law, seed, args.models))
+        if args.predict_only:
+            test = sim.make_test(seed, structure, law)
+            rows.append(judged({k: v for k, v in test.describe().items()
+                                if k in ("structure", "seed", "law", "between", "noise")}, args.predict_only))
+        else:
+            rows.append(case(structure, law, seed, args.models))
         r = rows[-1]
         print(f"[{i}/{len(tests)}] {structure} {law} seed {seed}: {r.get('error') or r['right']} "
               f"worst {r.get('worst_nrmse')} (noise {r['noise']['acc']:.4f}; linear {r.get('worst_linear_nrmse')}) "
               f"({r.get('discover_s')} s)", file=sys.stderr, flush=True)
-    result = {"machine": load_after(info), "fitted_levels": list(FITTED), "swept_levels": list(SWEPT), "rows": rows,
+    result = {"machine": info, "fitted_levels": list(FITTED), "swept_levels": list(SWEPT), "rows": rows,
               "summary": summarise(rows), "benchmark_seconds": round(time.perf_counter() - t0, 1)}
+    if args.predict_only:
+        result["predicted_again_from"] = str(args.predict_only)
+    result["machine"].update(load_after())
     args.out.parent.mkdir(parents=True, exist_ok=True)
     args.out.write_text(json.dumps(result, indent=1))
     print(line(result))
