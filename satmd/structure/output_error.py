@@ -241,7 +241,7 @@ class ProjectedFit:
 
     def __init__(self, build, records, step: int, bounds, rel_step: float):
         self.build, self.records, self.step, self.bounds = build, records, int(step), bounds
-        self.failed = None  # the misfit of a trial that ran away: sized by the first that did not
+        self.failed: np.ndarray | None = None  # the misfit of a trial that ran away: sized by the first that did not
         self.fun, self.jac = threaded_differences(self.residuals, rel_step, bounds)
 
     def projection(self, theta):
@@ -261,7 +261,11 @@ class ProjectedFit:
 
     def residuals(self, theta) -> np.ndarray:
         answer = self.answer(theta)
-        return self.failed if answer is None else answer[0]
+        if answer is not None:
+            return answer[0]
+        if self.failed is None:  # the callers answer a start first: a fit never starts from a run-away
+            raise ValueError("no trial of this fit has answered yet: nothing to size a run-away's misfit by")
+        return self.failed
 
     def least_squares(self, theta, x_scale, max_nfev: int):
         """`scipy.optimize.least_squares` from θ (within the bounds), at most ``max_nfev`` steps."""
