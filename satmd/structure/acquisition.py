@@ -21,6 +21,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..conventions import TINY
+from .bands import mirrored
 
 BANDS = 16        # bands of frequency between the force's band edge and Nyquist
 MIN_SHARE = 1e-6  # of the joint's share's power above the band: a band with less says nothing
@@ -53,12 +54,10 @@ class Acquisition:
         its first and last samples (`EDGE`): over the record alone the FFT joins its end to its start, a step
         that a gain rolling off toward Nyquist rings at both ends (on an independent wing the last sample of a
         quiet channel was missed by 2.5 times its RMS, 0.024 of its held-out NRMSE of 0.035)."""
-        x = np.asarray(share, float)
-        n = x.shape[-1]
-        pad = min(EDGE, n - 1)
-        mirrored = np.concatenate([x[..., pad:0:-1], x, x[..., -2:-pad - 2:-1]], axis=-1)
-        m = mirrored.shape[-1]
-        out = np.fft.irfft(np.fft.rfft(mirrored, axis=-1) * self.at(np.fft.rfftfreq(m, 1.0 / fs_hz)), m, axis=-1)
+        n = np.shape(share)[-1]
+        extended, pad = mirrored(share, EDGE)
+        m = extended.shape[-1]
+        out = np.fft.irfft(np.fft.rfft(extended, axis=-1) * self.at(np.fft.rfftfreq(m, 1.0 / fs_hz)), m, axis=-1)
         return out[..., pad:pad + n]
 
     def cutoff_hz(self) -> float | None:

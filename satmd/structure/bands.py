@@ -73,6 +73,17 @@ def below_nyquist(x, oversample: int, pad: int = 4096) -> np.ndarray:
     return fft.irfft(fft.rfft(extended, size, axis=-1) * gain, size, axis=-1)[..., :n]
 
 
+def mirrored(x, edge: int) -> tuple[np.ndarray, int]:
+    """(``x`` (..., N) mirrored about its first and last samples over ``pad`` samples each, ``pad``): filtered by
+    FFT, a record alone joins its end to its start in a step that a filter rings at both ends; the record is
+    ``out[..., pad:pad + N]`` of the filtered mirror. ``pad`` is ``edge``, or N − 1 where the record is shorter."""
+    x = np.asarray(x, float)
+    pad = min(int(edge), x.shape[-1] - 1)
+    if pad < 1:
+        return x, 0
+    return np.concatenate([x[..., pad:0:-1], x, x[..., -2:-pad - 2:-1]], axis=-1), pad
+
+
 def share_outside(signal, fs_hz: float, band_hz, margin: float = 0.02) -> float:
     """The share of a signal's power (about its mean) outside ``band_hz`` (lo, hi), widened by ``margin`` of each
     end: for a force, how much of it drives the structure where a model fitted in that band was never shown it."""

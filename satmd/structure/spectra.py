@@ -23,6 +23,7 @@ from ..errors import DataError
 from ..numerics import force_level
 from ..signal.excitation import excitation_of, received
 from ..signal.periodic import periodic_spectra as signal_spectra
+from .bands import mirrored
 
 
 @dataclass(frozen=True)
@@ -281,12 +282,10 @@ def quiet_outside_band(force) -> np.ndarray:
     its start and end do not meet in a step. A force that fills its spectrum (an impact, a white random force)
     has no such contrast and is returned as it is."""
     x = np.asarray(force, float)
-    n = x.size
-    pad = min(EDGE, n - 1)
+    extended, pad = mirrored(x, EDGE)
     if pad < 1:
         return x
-    mirrored = np.concatenate([x[pad:0:-1], x, x[-2:-pad - 2:-1]])
-    X = np.fft.rfft(mirrored)
+    X = np.fft.rfft(extended)
     width = max(8, X.size // 256)
     power = np.convolve(np.abs(X) ** 2, np.ones(width) / width, mode="same")
     floor = float(np.quantile(power[1:], FLOOR_SHARE))
@@ -294,7 +293,7 @@ def quiet_outside_band(force) -> np.ndarray:
     if not (floor > 0 and np.any(keep[1:]) and np.median(power[1:][keep[1:]]) >= CONTRAST * floor):
         return x
     keep[0] = True  # the load cell's offset as it was
-    return np.fft.irfft(np.where(keep, X, 0.0), mirrored.size)[pad:pad + n]
+    return np.fft.irfft(np.where(keep, X, 0.0), extended.size)[pad:pad + x.size]
 
 
 def significant_lines(spectra) -> np.ndarray:
