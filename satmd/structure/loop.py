@@ -28,9 +28,13 @@ from .output_error import ProjectedFit
 from .simulations import oversampling
 
 PAIRS = 2                       # modes added to the loop
-SHARES = (1.0, 0.3, 0.1)        # their static stroke flexibility at the start, over the in-band modes': the best kept
+#: the added modes' static stroke flexibility at the start, over the in-band modes': the best kept. A law's force
+#: that takes back some of the joint's stiffness (a slip, a softening) is a negative spring on that flexibility and
+#: runs away above 1/k: on an independent beam with a friction support, three added modes ran away from 0.01 up
+SHARES = (1.0, 0.3, 0.1, 0.03, 0.01, 0.003, 0.001)
 ZETA = (1e-4, 0.3)              # the added modes' damping ratios are held within these
 TOP = 0.95                      # of the Nyquist frequency: the added modes stay below it
+RUNAWAY = 10.0                  # a start whose misfit is this many times the model's without the added modes: none
 STEP = 2                        # every STEP-th sample in the fit (the added modes lie below the record's Nyquist)
 FIRST_NFEV = 12                 # steps of the fit (each simulates every recording 2 + 4 × modes + coefficients times)
 GAINING = 0.1                   # ... and up to the caller's max_nfev where these first steps took this share off
@@ -80,7 +84,9 @@ def with_loop_modes(model, poles, recordings, measured, span, max_nfev: int, fs_
     starts = [np.concatenate([j.coefficients, np.log(f0), np.log(zeta0), np.full(k, s / k), np.zeros(k)])
               for s in SHARES]
     answers = [(problem.answer(t), t) for t in starts]
-    finite = [(float(a[0] @ a[0]), t) for a, t in answers if a is not None]
+    held = problem.answer(np.concatenate([j.coefficients, np.log(f0), np.log(zeta0), np.zeros(2 * k)]))
+    bound = np.inf if held is None else RUNAWAY * float(held[0] @ held[0])  # the added modes undriven: the model's
+    finite = [(c, t) for c, t in ((float(a[0] @ a[0]), t) for a, t in answers if a is not None) if c < bound]
     if not finite:
         return None
     start_cost, theta0 = min(finite, key=lambda x: x[0])

@@ -110,3 +110,22 @@ def test_a_model_holds_beyond_the_top_level_where_its_response_grows_as_the_forc
     assert fit.holds_beyond(model)
     fit.measured[1] = fit.measured[1] / 40
     assert not fit.holds_beyond(model)
+
+
+@pytest.mark.parametrize("mode_hz, rising", [(118.0, True), (70.0, False)])
+def test_a_response_rising_to_the_lines_top_points_beyond_them(mode_hz, rising):
+    """Above the band the lines stop at 0.8 of Nyquist (the anti-alias filter takes the rest): a mode at 118 Hz
+    (fs 256) shows only as a response that rises toward the last line, and the loop gets a start at 0.95 of
+    Nyquist for it; a mode at 70 Hz peaks among the lines, and its vector fit is what the loop starts from."""
+    from satmd.structure.outside import BEYOND_AT, _column, _rising
+
+    rng = np.random.default_rng(0)
+    f = np.arange(41.0, 102.4, 0.25)
+    G = (rng.standard_normal(f.size) + 1j * rng.standard_normal(f.size)) * np.exp(-f / 60.0)  # harmonics' roll-off
+    lam = 2 * np.pi * mode_hz * (-0.01 + 1j)
+    E = _column(np.array([lam]), np.array([[1e4 + 0j], [-3e3 + 0j]]), f) * G[None, :]
+    E += 1e-3 * np.abs(E).mean() * rng.standard_normal(E.shape)  # noise
+    blocks = [(f, G, E, np.ones(E.shape), np.arange(f.size))]
+    assert _rising(blocks, np.zeros(0, complex)) is rising
+    assert not _rising(blocks, np.array([lam]))  # the mode itself found: nothing left to rise
+    assert BEYOND_AT * 128.0 > 118.0  # the start lies beyond the mode, which the fit then moves down to
