@@ -28,13 +28,15 @@ from .output_error import ProjectedFit
 from .simulations import oversampling
 
 PAIRS = 2                       # modes added to the loop
-#: the added modes' static stroke flexibility at the start, over the in-band modes': the best kept. A law's force
-#: that takes back some of the joint's stiffness (a slip, a softening) is a negative spring on that flexibility and
-#: runs away above 1/k: on an independent beam with a friction support, three added modes ran away from 0.01 up
+#: the added modes' static stroke flexibility at the start, over the in-band modes': the best kept, of the first
+#: `LARGE`, or of the rest where none of those stays finite. A law's force that takes back some of the joint's
+#: stiffness (a slip, a softening) is a negative spring on that flexibility and runs away above 1/k: on an
+#: independent beam with a friction support, three added modes ran away from 0.01 up
 SHARES = (1.0, 0.3, 0.1, 0.03, 0.01, 0.003, 0.001)
+LARGE = 3
 ZETA = (1e-4, 0.3)              # the added modes' damping ratios are held within these
 TOP = 0.95                      # of the Nyquist frequency: the added modes stay below it
-RUNAWAY = 10.0                  # a start whose misfit is this many times the model's without the added modes: none
+RUNAWAY = 10.0                  # a smaller share's start this many times the misfit without the added modes: none
 STEP = 2                        # every STEP-th sample in the fit (the added modes lie below the record's Nyquist)
 FIRST_NFEV = 12                 # steps of the fit (each simulates every recording 2 + 4 × modes + coefficients times)
 GAINING = 0.1                   # ... and up to the caller's max_nfev where these first steps took this share off
@@ -43,6 +45,23 @@ GAINING = 0.1                   # ... and up to the caller's max_nfev where thes
 def static_flexibility(poles, stroke) -> float:
     """The stroke per unit joint force at rest of modes ``poles`` with stroke residues ``stroke`` (accelerance)."""
     return float(np.sum(2 * (stroke / (-poles ** 3)).real))
+
+
+def _starts(problem, starts, k: int) -> list:
+    """[(misfit, θ)] of the starts (one per `SHARES`) that stay finite: the first `LARGE`, and only where none of
+    them does the smaller ones, each under `RUNAWAY` times the misfit with the ``k`` added modes undriven (the
+    last 2k of θ zero): a share can answer a misfit of 1e254 without running past floating point."""
+    def answered(thetas):
+        return [(float(a[0] @ a[0]), t) for a, t in ((problem.answer(t), t) for t in thetas) if a is not None]
+
+    finite = answered(starts[:LARGE])
+    if finite or len(starts) <= LARGE:
+        return finite
+    undriven = starts[0].copy()
+    undriven[-2 * k:] = 0.0
+    held = problem.answer(undriven)
+    bound = np.inf if held is None else RUNAWAY * float(held[0] @ held[0])
+    return [(c, t) for c, t in answered(starts[LARGE:]) if c < bound]
 
 
 def with_loop_modes(model, poles, recordings, measured, span, max_nfev: int, fs_hz: float, promising=None):
@@ -81,12 +100,8 @@ def with_loop_modes(model, poles, recordings, measured, span, max_nfev: int, fs_
                             np.full(2 * k, -np.inf)])
     upper = np.concatenate([np.full(n_c, np.inf), np.full(k, top), np.full(k, np.log(ZETA[1])), np.full(2 * k, np.inf)])
     problem = ProjectedFit(build, (recordings, measured, span), STEP, (lower, upper), 1e-4)
-    starts = [np.concatenate([j.coefficients, np.log(f0), np.log(zeta0), np.full(k, s / k), np.zeros(k)])
-              for s in SHARES]
-    answers = [(problem.answer(t), t) for t in starts]
-    held = problem.answer(np.concatenate([j.coefficients, np.log(f0), np.log(zeta0), np.zeros(2 * k)]))
-    bound = np.inf if held is None else RUNAWAY * float(held[0] @ held[0])  # the added modes undriven: the model's
-    finite = [(c, t) for c, t in ((float(a[0] @ a[0]), t) for a, t in answers if a is not None) if c < bound]
+    finite = _starts(problem, [np.concatenate([j.coefficients, np.log(f0), np.log(zeta0), np.full(k, s / k),
+                                               np.zeros(k)]) for s in SHARES], k)
     if not finite:
         return None
     start_cost, theta0 = min(finite, key=lambda x: x[0])
