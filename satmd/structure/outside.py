@@ -99,11 +99,13 @@ def _rising(blocks, poles) -> bool:
     if not blocks:
         return False
     T = _residues(poles, blocks)[0] if poles.size else None
-    power = np.zeros(blocks[0][0].size)  # the levels share their lines (one period)
-    for f, G, E, W, _ in blocks:
-        left = E if T is None else E - _column(poles, T, f) * G[None, :]
-        power = power + np.sum(np.abs(left * W) ** 2, axis=0)
     f = blocks[0][0]
+    power = np.zeros(f.size)
+    for g, G, E, W, _ in blocks:
+        if g.size != f.size:  # a level of another period: its lines are not these
+            continue
+        left = E if T is None else E - _column(poles, T, g) * G[None, :]
+        power = power + np.sum(np.abs(left * W) ** 2, axis=0)
     top = f >= f[0] + 0.875 * (f[-1] - f[0])
     return bool(np.any(top) and np.any(~top) and power[top].mean() > RISING * np.median(power[~top]))
 
