@@ -21,10 +21,21 @@ def levels(tmp_path_factory):
     return d
 
 
-def test_discover_saves_the_model_and_predict_judges_a_level_it_never_saw(capsys, levels, tmp_path):
-    model = tmp_path / "structure.json"
-    rc, out, err = run(capsys, "discover", levels / "L1.csv", levels / "L8.csv", "--save-model", model, "--json")
+def test_discover_saves_the_model_and_predict_judges_a_level_it_never_saw(capsys, levels, tmp_path, monkeypatch):
+    """The whole path: located, fitted, saved, drawn (the sensors, the evidence and the fit's panel), each level's
+    force read once however many stages (locate, fit, simulate) follow; then a level it never saw predicted."""
+    from matplotlib.image import imread
+
+    from tests.signal.test_memo import count_detections
+
+    model, figure = tmp_path / "structure.json", tmp_path / "discover.png"
+    calls = count_detections(monkeypatch)
+    rc, out, err = run(capsys, "discover", levels / "L1.csv", levels / "L8.csv", "--save-model", model, "--json",
+                       "--plot", figure)
     assert rc == 0, err
+    assert len(calls) == 2
+    height, width = imread(figure).shape[:2]
+    assert width > 3.5 * height  # three panels side by side (two without a fitted model)
     assert "locating the joint" in err and "output-error fit of the" in err  # minutes of work, told stage by stage
     joint = json.loads(out)["nonlinear"]["findings"][0]
     assert joint["name"] == "joint" and joint["between"] == ["acc3", "acc4"]

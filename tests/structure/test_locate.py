@@ -109,31 +109,23 @@ def test_f16_joint_is_between_the_wing_and_the_payload():
 def test_discover_says_where_the_joint_acts(cubic_between_3_and_4, monkeypatch):
     """`discover` on the levels of a structure with five accelerometers: the SATMD model is not adequate, the
     change with level is told per resonance and placed between the two sensors the joint joins (SPEC §11).
-    Each level's force is read once, at the door, however many stages (locate, fit, simulate) follow."""
+    ``fit_joint=False`` (the CLI's ``--locate-only``) places and names it without a model, and claims none; each
+    level's force is read once, at the door. The fitted path: `tests/cli/test_cli_predict.py`."""
     from satmd import discover
     from tests.signal.test_memo import count_detections
 
     calls = count_detections(monkeypatch)
-    rep = discover(cubic_between_3_and_4)
+    rep = discover(cubic_between_3_and_4, fit_joint=False)
     assert len(calls) == len(cubic_between_3_and_4)
     d = rep.to_dict()["nonlinear"]
     assert d["detected"] and [f["name"] for f in d["findings"]] == ["joint"]
     joint = d["findings"][0]
-    assert joint["between"] == ["acc3", "acc4"] and joint["law"] == "cubic"
+    assert joint["between"] == ["acc3", "acc4"] and joint["law"] == "cubic" and "fit" not in joint
     assert joint["location"][0]["between"] == ["acc3", "acc4"] and "modes" in joint
     assert "joint between acc3 and acc4" in rep.report()
-    fig = rep.figure()  # the structure's figure, not the SATMD rig's FRF panels
-    assert len(fig.axes) == 3 and "a joint between acc3 and acc4 (cubic)" in fig.texts[0].get_text()
-
-
-def test_discover_can_place_the_joint_without_fitting_it(cubic_between_3_and_4):
-    """``fit_joint=False`` (the CLI's ``--locate-only``): the same place and law, no model fitted or claimed."""
-    from satmd import discover
-
-    rep = discover(cubic_between_3_and_4, fit_joint=False)
-    joint = rep.to_dict()["nonlinear"]["findings"][0]
-    assert joint["between"] == ["acc3", "acc4"] and joint["law"] == "cubic" and "fit" not in joint
     assert rep.model is None and "modelled" not in rep.report()
+    fig = rep.figure()  # the structure's figure, not the SATMD rig's FRF panels; no fit, no fit panel
+    assert len(fig.axes) == 2 and "a joint between acc3 and acc4 (cubic)" in fig.texts[0].get_text()
     with pytest.raises(SatmdError, match="fit_joint=False .* two or more levels"):
         discover(cubic_between_3_and_4[0], fit_joint=False)  # one recording: no joint to place
 
