@@ -35,7 +35,7 @@ from .kernel import joint_states
 from .laws import law as law_named
 from .linear import LinearStructure, as_pairs, discretise, from_pairs, modal_states, response
 from .prediction import PREDICTION_SCHEMA, RAN_AWAY, Prediction, finite_nrmse, nrmse  # noqa: F401  (the model's API)
-from .spectra import drive_force, warmup_of
+from .spectra import at_the_door, drive_force, warmup_of
 
 SCHEMA = "satmd-structure-model/2"
 #: the schemas a model may be read from: /1 had no ``stroke`` (the pair's residues were never re-solved), so a
@@ -197,6 +197,7 @@ class StructureModel:
         measured = np.array([np.asarray(recording[c], float) for c in self.channels])
         if not (np.all(np.isfinite(force)) and np.all(np.isfinite(measured))):
             raise DataError(f"{name}: NaN or inf in the force or a response")
+        recording = at_the_door(recording)
         warm = warmup_of(recording)
         drive = Drive(self, drive_force(recording), float(recording.fs_hz), warm)
         lin = drive.outputs(None)

@@ -228,6 +228,15 @@ POOL = 16           # lines each side whose spread over the periods gives a line
 MIN_STEADY = 3      # steady periods needed to tell a line's mean from its noise
 
 
+def at_the_door(recording):
+    """The recording carrying its excitation (`signal.excitation.received`), read once for every simulation that
+    follows (`drive_force`, `warmup_of`), or as it came where none is read (its force is then driven as measured)."""
+    try:
+        return received(recording)
+    except DataError:
+        return recording
+
+
 def drive_force(recording) -> np.ndarray:
     """The force a model of the structure is driven by: as measured, except over the steady periods of a periodic
     force, where it is the mean period at the lines whose mean stands above its noise (`significant_lines`),
