@@ -70,6 +70,16 @@ def _satmd(*args, cwd) -> dict:
     return json.loads(run.stdout)
 
 
+def discovered(recs, folder: Path, model: str) -> tuple:
+    """(`satmd discover`'s JSON, or {"error": its last line}; seconds) on the levels `FITTED` of ``recs``, written
+    to ``folder`` as a user's files (``L{level}.csv``), the model saved as ``folder/model``."""
+    for lv in FITTED:
+        sim.write_csv(recs[lv - 1], folder / f"L{lv}.csv")
+    t0 = time.perf_counter()
+    found = _satmd("discover", *(f"L{lv}.csv" for lv in FITTED), "--json", "--save-model", model, cwd=folder)
+    return found, round(time.perf_counter() - t0, 1)
+
+
 def case(structure: str, law: str | None, seed: int) -> dict:
     test = sim.make_test(seed, structure, law)
     t0 = time.perf_counter()
@@ -78,11 +88,9 @@ def case(structure: str, law: str | None, seed: int) -> dict:
            "outside_band": {str(lv): outside_band(recs[lv - 1], test.sensors) for lv in HELD},
            "truth_moved": truth_sensitivity(test, recs)}
     with tempfile.TemporaryDirectory() as tmp:
-        for lv, rec in enumerate(recs, 1):
-            sim.write_csv(rec, Path(tmp) / f"L{lv}.csv")
-        t0 = time.perf_counter()
-        found = _satmd("discover", *(f"L{lv}.csv" for lv in FITTED), "--json", "--save-model", "model.json", cwd=tmp)
-        row["discover_s"] = round(time.perf_counter() - t0, 1)
+        for lv in HELD:
+            sim.write_csv(recs[lv - 1], Path(tmp) / f"L{lv}.csv")
+        found, row["discover_s"] = discovered(recs, Path(tmp), "model.json")
         if "error" in found:
             row["error"] = found["error"]
             return row
