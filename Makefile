@@ -21,10 +21,12 @@ demo: $(STAMP)
 	$(VENV)/bin/satmd reproduce --out report
 
 # The suite on every core (pytest-xdist: the tests are independent), one BLAS thread a worker: two
-# workers of two BLAS threads each would fight over two cores.
+# workers of two BLAS threads each would fight over two cores. A module's tests on one worker (loadscope):
+# spread test by test, both workers built the same module fixtures (simulations, fits): 500 s → 358 s.
 TEST_ENV := OMP_NUM_THREADS=1 OPENBLAS_NUM_THREADS=1 MKL_NUM_THREADS=1
+PYTEST_XDIST := -n auto --dist loadscope
 test: $(STAMP)
-	$(TEST_ENV) $(PY) -m pytest -q -n auto
+	$(TEST_ENV) $(PY) -m pytest -q $(PYTEST_XDIST)
 
 bench: $(STAMP)
 	@for b in benchmarks/*.py; do case $$b in */readme_tables.py|*/_*.py) continue;; esac; \
@@ -56,7 +58,7 @@ docs-check: $(STAMP)
 test-latest:
 	@test -x .venv-latest/bin/python || $(PYTHON) -m venv .venv-latest
 	.venv-latest/bin/pip install -q --disable-pip-version-check --upgrade -c constraints.txt -e '.[all,dev]'
-	$(TEST_ENV) .venv-latest/bin/python -m pytest -q -n auto
+	$(TEST_ENV) .venv-latest/bin/python -m pytest -q $(PYTEST_XDIST)
 
 clean:
 	rm -rf $(VENV) .venv-lock .venv-latest report .pytest_cache .hypothesis build docs/api/generated docs/auto_examples \
