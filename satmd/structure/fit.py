@@ -9,7 +9,7 @@ from ..errors import DataError
 from ..numerics import on_one_blas_thread
 from ..validation import NAMES, Interval, Options, Whole, validate_params
 from .acquisition import acquisition_of
-from .choice import PLACE_LAWS, best_fitting, best_place, contradicts, ranked_laws, score
+from .choice import PLACE_LAWS, best_fitting, best_place, close_rivals, contradicts, ranked_laws
 from .laws import LAWS
 from .laws import law as law_named
 from .linear import fit_linear
@@ -204,21 +204,18 @@ class _Fit:
         return model
 
     def finished_choice(self, model, free_path, files) -> StructureModel:
-        """``model`` `finished`; where it is the sparse library, the best named law fitted at its place is finished
-        too, and the sparse library kept only where it still beats it by `SPARSE_MARGIN` (`best_fitting`). As
-        first fitted, their paths the start's, the library's extra terms take up what a named law's path leaves:
-        on independent ground vibration tests a beam's clearance to the ground fitted its levels at mean NRMSE
-        0.150 against the library's 0.133, finished at 0.041 against 0.121."""
+        """``model`` `finished`, and the laws at its place that came close to it as first fitted (`close_rivals`:
+        for the sparse library, the best named law), each finished too; the best finished kept (`best_fitting`: the
+        sparse library only where it still beats the named laws by `SPARSE_MARGIN`). As first fitted, their paths
+        the start's, the library's extra terms take up what a named law's path leaves: on independent ground
+        vibration tests a beam's clearance to the ground fitted its levels at mean NRMSE 0.150 against the
+        library's 0.133, finished at 0.041 against 0.121."""
         finished = self.finished(model, free_path, files)
-        if model.joint is None or model.joint.law != "sparse":
+        rivals = close_rivals(model, self.tried)
+        if not rivals:
             return finished
-        named = [m for m in self.tried if m.joint is not None and m.joint.between == model.joint.between
-                 and m.joint.law != "sparse" and not contradicts(m)]
-        if not named:
-            return finished
-        rival = min(named, key=score)
-        self.say(f"the sparse library against {rival.joint.law}, each finished ...")
-        return best_fitting([finished, self.finished(rival, free_path, files)])
+        self.say(f"{', '.join(m.joint.law for m in rivals)} against {model.joint.law}, each finished ...")
+        return best_fitting([finished, *[self.finished(m, free_path, files) for m in rivals]])
 
     def finished(self, model, free_path, files) -> StructureModel:
         """``model`` finished: more modes above the band where its fitted law's harmonics ask for them (`widened`),

@@ -87,6 +87,40 @@ def test_the_sparse_library_is_weighed_against_the_best_named_law_once_both_are_
     assert fit_with([sparse, elsewhere], done).finished_choice(sparse, True, []) is done[id(sparse)]
     assert fit_with([sparse, clearance], done).finished_choice(clearance, True, []) is done[id(clearance)]
 
+
+def test_named_laws_close_to_the_chosen_one_as_first_fitted_are_finished_and_weighed_too():
+    """`close_rivals`: first fits follow the start's path, which suits some laws better (an independent wing's
+    stick-slip joint: cubic 0.032, softening 0.034, friction 0.036 first fitted; finished, friction 0.011 against
+    0.016). Laws within `FINISH_MARGIN` at the same place, not contradicting their names, are finished too."""
+    from types import SimpleNamespace
+
+    from satmd.structure.choice import FINISH_MARGIN, FINISHED_RIVALS, close_rivals
+    from satmd.structure.fit import _Fit
+
+    def model(law, nrmse, between=("acc4", "acc6"), sign=1.0):
+        values = {"k_stick": sign, "f_slip": sign, "k_sat": sign}
+        return SimpleNamespace(joint=SimpleNamespace(law=law, units="N", parameters=lambda: values, between=between),
+                               fit={"nonlinear": [[nrmse]]})
+
+    cubic, softening, friction = model("cubic", 0.032), model("softening", 0.034), model("friction", 0.036)
+    damping = model("quadratic_damping", 0.032 * (1 + 2 * FINISH_MARGIN))
+    backwards = model("friction", 0.033, sign=-1.0)  # a friction that feeds energy: not friction
+    elsewhere = model("softening", 0.01, between=("acc5", "acc6"))
+    tried = [cubic, damping, friction, backwards, softening, elsewhere]
+    assert close_rivals(cubic, tried) == [softening, friction]
+    assert len(close_rivals(cubic, [*tried, model("clearance", 0.0321)])) == FINISHED_RIVALS
+    assert close_rivals(model("sparse", 0.02), tried) == [cubic]  # the library: the best named law, however far
+    assert close_rivals(SimpleNamespace(joint=None), tried) == []
+
+    fit = _Fit.__new__(_Fit)
+    fit.tried, fit.say = tried, lambda _: None
+    done = {id(cubic): model("cubic", 0.016), id(softening): model("softening", 0.018),
+            id(friction): model("friction", 0.011)}
+    fit.finished = lambda m, free_path, files: done[id(m)]
+    assert fit.finished_choice(cubic, True, []) is done[id(friction)]
+    done[id(friction)] = model("friction", 0.02)
+    assert fit.finished_choice(cubic, True, []) is done[id(cubic)]
+
 def _two_modes(kappa_scale):
     """A mass-normalised two-mode structure (channels a, b; the force at a) with a joint from b to the ground whose
     path is ``kappa_scale`` times reciprocity's, and that path's law fitted in relative units."""
