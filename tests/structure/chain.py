@@ -72,54 +72,55 @@ def simulate_chain(n=5, joint=(2, 3), law=lambda d, v: 3e9 * d ** 3, levels=(1.0
     rng = np.random.default_rng(seed)
     u = multisine(period, fs, *band, seed=seed) if force is None else np.asarray(force, float)
     periods = periods if force is None else 1
+    # every level at once (rows): the levels are independent, and a step costs Python the same for one or many;
+    # the state y = (x, v), its linear part one product with [[0, I], [-K/M, -C/M]]
+    f = np.array([np.tile(level * u, periods) for level in levels])
+    sub = 8
+    h = 1.0 / (fs * sub)
+    A = np.block([[np.zeros((n, n)), np.eye(n)], [-K / M[:, None], -C / M[:, None]]]).T
+    y = np.zeros((len(levels), 2 * n))
+    acc = np.zeros((f.shape[1], len(levels), n))
+    fine = np.zeros((f.shape[1] * sub, len(levels), n))
+
+    def rhs(y, fk):
+        d = y[:, i] - (y[:, j] if j is not None else 0.0)
+        dv = y[:, n + i] - (y[:, n + j] if j is not None else 0.0)
+        g = law(d, dv)
+        dy = y @ A
+        dy[:, n] += fk / M[0]
+        dy[:, n + i] -= g / M[i]
+        if j is not None:
+            dy[:, n + j] += g / M[j]
+        return dy
+
+    if anti_alias:  # the force band-limited between its samples too (the record's periods: exact)
+        smooth = np.fft.irfft(np.fft.rfft(f, axis=1), f.shape[1] * 2 * sub, axis=1) * 2 * sub
+        smooth = np.concatenate([smooth, smooth[:, :1]], axis=1)
+    for s in range(f.shape[1]):
+        f0, f1 = f[:, s], f[:, s + 1] if s + 1 < f.shape[1] else f[:, s]
+        acc[s] = rhs(y, f0)[:, n:]
+        for q in range(sub):
+            fa = f0 + (f1 - f0) * q / sub
+            fm = f0 + (f1 - f0) * (q + 0.5) / sub
+            fb = f0 + (f1 - f0) * (q + 1) / sub
+            if anti_alias:
+                fa, fm, fb = smooth[:, 2 * (s * sub + q):2 * (s * sub + q) + 3].T
+            k1 = rhs(y, fa)
+            fine[s * sub + q] = k1[:, n:]
+            k2 = rhs(y + 0.5 * h * k1, fm)
+            k3 = rhs(y + 0.5 * h * k2, fm)
+            k4 = rhs(y + h * k3, fb)
+            y = y + h / 6 * (k1 + 2 * k2 + 2 * k3 + k4)
+    if anti_alias:
+        mirrored = np.concatenate([fine, fine[::-1]])
+        spectrum = np.fft.rfft(mirrored, axis=0)
+        spectrum[np.fft.rfftfreq(mirrored.shape[0], 1.0 / (fs * sub)) >= fs / 2] = 0.0
+        acc = np.fft.irfft(spectrum, mirrored.shape[0], axis=0)[:fine.shape[0]:sub]
     out = []
-    for level in levels:
-        f = np.tile(level * u, periods)
-        sub = 8
-        h = 1.0 / (fs * sub)
-        x, v = np.zeros(n), np.zeros(n)
-        acc = np.zeros((f.size, n))
-        fine = np.zeros((f.size * sub, n))
-
-        def rhs(x, v, fk):
-            d = x[i] - (x[j] if j is not None else 0.0)
-            dv = v[i] - (v[j] if j is not None else 0.0)
-            g = law(d, dv)
-            force = -K @ x - C @ v
-            force[0] += fk
-            force[i] -= g
-            if j is not None:
-                force[j] += g
-            return force / M
-
-        if anti_alias:  # the force band-limited between its samples too (the record's periods: exact)
-            spectrum = np.fft.rfft(f)
-            smooth = np.fft.irfft(spectrum, f.size * 2 * sub) * 2 * sub
-            smooth = np.append(smooth, smooth[0])
-        for s in range(f.size):
-            f0, f1 = f[s], f[(s + 1) % f.size] if s + 1 < f.size else f[s]
-            acc[s] = rhs(x, v, f0)
-            for q in range(sub):
-                fa = f0 + (f1 - f0) * q / sub
-                fm = f0 + (f1 - f0) * (q + 0.5) / sub
-                fb = f0 + (f1 - f0) * (q + 1) / sub
-                if anti_alias:
-                    fa, fm, fb = smooth[2 * (s * sub + q):2 * (s * sub + q) + 3]
-                k1x, k1v = v, rhs(x, v, fa)
-                fine[s * sub + q] = k1v
-                k2x, k2v = v + 0.5 * h * k1v, rhs(x + 0.5 * h * k1x, v + 0.5 * h * k1v, fm)
-                k3x, k3v = v + 0.5 * h * k2v, rhs(x + 0.5 * h * k2x, v + 0.5 * h * k2v, fm)
-                k4x, k4v = v + h * k3v, rhs(x + h * k3x, v + h * k3v, fb)
-                x = x + h / 6 * (k1x + 2 * k2x + 2 * k3x + k4x)
-                v = v + h / 6 * (k1v + 2 * k2v + 2 * k3v + k4v)
-        if anti_alias:
-            mirrored = np.concatenate([fine, fine[::-1]])
-            spectrum = np.fft.rfft(mirrored, axis=0)
-            spectrum[np.fft.rfftfreq(mirrored.shape[0], 1.0 / (fs * sub)) >= fs / 2] = 0.0
-            acc = np.fft.irfft(spectrum, mirrored.shape[0], axis=0)[:fine.shape[0]:sub]
-        chans = {"force": f + noise * 0.5 * np.std(f) * rng.standard_normal(f.size)}
+    for r, level in enumerate(levels):
+        chans = {"force": f[r] + noise * 0.5 * np.std(f[r]) * rng.standard_normal(f.shape[1])}
         for q in range(n):
-            a = acc[:, q]
+            a = acc[:, r, q]
             chans[f"acc{q + 1}"] = a + noise * np.std(a) * rng.standard_normal(a.size)
         out.append(Recording(fs, chans, meta={"source": f"level {level:g}"}))
     return out

@@ -6,6 +6,7 @@ recording (random force: distortion regressors in local windows; multisine: its 
 """
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -41,6 +42,7 @@ class NonlinearReport:
     levels : one level figure per recording (force RMS), in the order given
     set_aside : linear effects a one-recording fit named while distortion is present (not physics)
     model : a structure's `satmd.structure.StructureModel` (its linear part and joint), when one was fitted
+    deferred : the named finding with its time-domain strength, left to be made (`findings.with_strength`)
     """
 
     detected: bool
@@ -50,6 +52,7 @@ class NonlinearReport:
     levels: list = field(default_factory=list)
     set_aside: list = field(default_factory=list)
     model: object = field(default=None, repr=False, compare=False)
+    deferred: Callable | None = field(default=None, repr=False, compare=False)
 
     def to_dict(self) -> dict:
         """The SPEC §9 ``nonlinear`` block (plus ``experiments``)."""

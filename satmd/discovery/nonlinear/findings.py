@@ -102,7 +102,8 @@ def _hint(test: NonlinearTest) -> str:
     return text
 
 
-def analyse_recordings(recordings, rig=None, free=DEFAULT_FREE, alpha: float = 1e-3, datas=None) -> NonlinearReport:
+def analyse_recordings(recordings, rig=None, free=DEFAULT_FREE, alpha: float = 1e-3, datas=None,
+                       strength: bool = True) -> NonlinearReport:
     """Detect, locate and name nonlinearity in SATMD recordings of one rig (see the module docstring).
 
     Parameters
@@ -112,11 +113,16 @@ def analyse_recordings(recordings, rig=None, free=DEFAULT_FREE, alpha: float = 1
     free : free parameters of the linear model
     alpha : overall level (half for the distortion tests, half for the level test)
     datas : their FRFData on one grid, if already estimated (`common_frfs`)
+    strength : fit a named element's strength in the time domain now (`fit_nonlinear`); False leaves it to
+        `with_strength`, for a caller that first asks whether the recordings are a SATMD rig at all (a structure
+        with many sensors is not, and the fit would be thrown away: 12 s of a 32 s `discover`)
 
     Returns
     -------
     NonlinearReport
     """
+    from functools import partial
+
     from ...physics import Rig
 
     rig = Rig() if rig is None else rig
@@ -147,8 +153,11 @@ def analyse_recordings(recordings, rig=None, free=DEFAULT_FREE, alpha: float = 1
     detected = any(t.significant for t in tests)
     spread = max(levels) / max(min(levels), TINY)
     moved = level_test is not None and (level_test.significant or tests[-1].significant)
+    deferred = None
     if detected and moved and spread > 1.5:
-        findings.append(_name_from_levels(datas, rig, free, levels, recordings, cmp))
+        findings.append(_name_from_levels(datas, rig, free, levels, recordings, cmp, strength))
+        if not strength:
+            deferred = partial(_name_from_levels, datas, rig, free, levels, recordings, cmp)
     elif detected:
         worst = min(tests, key=lambda t: t.p_value)
         findings.append(NonlinearFinding(UNEXPLAINED_NL, explanation=_hint(worst) + "; one level cannot say which "
@@ -156,7 +165,16 @@ def analyse_recordings(recordings, rig=None, free=DEFAULT_FREE, alpha: float = 1
         experiments.append(EXPERIMENT_LEVEL)
     if detected and not any(t.name.startswith("distortion_lines") for t in tests):
         experiments.append(EXPERIMENT_MULTISINE)
-    return NonlinearReport(detected, tests, findings, experiments, levels)
+    return NonlinearReport(detected, tests, findings, experiments, levels, deferred=deferred)
+
+
+def with_strength(report: NonlinearReport) -> NonlinearReport:
+    """``report`` with the strength `analyse_recordings` left for later (``strength=False``) fitted now."""
+    from dataclasses import replace
+
+    if report.deferred is None:
+        return report
+    return replace(report, findings=[report.deferred(), *report.findings[1:]], deferred=None)
 
 
 def _hypotheses(datas, rig, free, levels) -> dict:
@@ -170,7 +188,7 @@ def _hypotheses(datas, rig, free, levels) -> dict:
     return compare_hypotheses(datas, rig, tuple(free), channels, dict(fit0.values), levels)
 
 
-def _name_from_levels(datas, rig, free, levels, recordings, cmp=None) -> NonlinearFinding:
+def _name_from_levels(datas, rig, free, levels, recordings, cmp=None, strength: bool = True) -> NonlinearFinding:
     """The finding for a significant level dependence: moving parameter, direction, element, strength.
 
     The element is the one whose equivalent linearisation's trend with level fits best (BIC over every
@@ -210,9 +228,9 @@ def _name_from_levels(datas, rig, free, levels, recordings, cmp=None) -> Nonline
     else:  # the name stands even when the strength cannot be fitted
         params, ci = {}, {}
         text = f"{cls.description}; measured: {moved} (strength not fitted)"
-    strength = _time_domain_strength(recordings, cls.name, rig)
-    if strength is not None:  # the time-domain fit's coefficient and interval: they cover (issue 36 item 7)
-        params, ci, fitted = strength
+    fitted_in_time = _time_domain_strength(recordings, cls.name, rig) if strength else None
+    if fitted_in_time is not None:  # the time-domain fit's coefficient and interval: they cover (issue 36 item 7)
+        params, ci, fitted = fitted_in_time
         text = f"{fitted.explain(rig.replace(**{p: nominal}))}; measured: {moved}" if params else text
     elif params:
         text += " (strength from the equivalent linearisation, whose own error the interval does not carry)"

@@ -29,7 +29,7 @@ import numpy as np
 
 from ...identification.adequacy import Reason
 from ...signal.several import common_frfs, is_forced_recording, on_common_grid, pooled, repeated_hits
-from .findings import analyse_recordings
+from .findings import analyse_recordings, with_strength
 
 _UNEXPLAINED = "unexplained"
 
@@ -60,7 +60,7 @@ def discover_recordings(items, linear, rig=None, free=None, alpha: float = 1e-3,
         _same_sensors(items)
         unit: str | None = "N RMS"  # the levels are the recordings' force RMS
         datas = common_frfs(items)
-        nl = analyse_recordings(items, rig, free, alpha, datas=datas)
+        nl = analyse_recordings(items, rig, free, alpha, datas=datas, strength=False)  # a rig's, once it is one
         grid = on_common_grid(datas)
         datas = grid[1] if grid is not None else datas
         levels = nl.levels
@@ -76,7 +76,7 @@ def discover_recordings(items, linear, rig=None, free=None, alpha: float = 1e-3,
         levels = nl.levels
     finding = nl.findings[0] if nl.findings else {}
     moving = finding.get("moving")
-    if not nl.detected:
+    if not nl.detected:  # (nothing named: no strength left to fit)
         # one linear system: its FRFs pooled where they share a grid, else the lowest level's alone
         one = pooled(datas) if grid is not None else datas[int(np.argmin(levels))] if levels else datas[0]
         rep = linear(one, rig=rig, free=free, alpha=alpha, **kwargs)
@@ -87,10 +87,11 @@ def discover_recordings(items, linear, rig=None, free=None, alpha: float = 1e-3,
     if not rep.model_adequate:  # another structure: its level dependence is told per resonance, no element named
         from .modes import unexplained_by_modes, with_joint
 
-        told = unexplained_by_modes(nl, datas, unit)
+        told = unexplained_by_modes(replace(nl, deferred=None), datas, unit)  # no rig's strength to fit
         if all(is_forced_recording(x) for x in items):  # many sensors: where the joint acts (SPEC §11)
             told = with_joint(told, items, fit_joint)
         return replace(rep, nonlinear=told)
+    nl = with_strength(nl)  # a SATMD rig: the named element's strength fitted in time
     # with the moving parameter free, an effect that restates it (or what is left unexplained) is the
     # nonlinearity seen at one level; without one, every linear effect may be
     picked = [j.name for j in rep.judged if j.status == "named" and _stands_in(j, moving, rig)]
