@@ -23,9 +23,8 @@ demo: $(STAMP)
 # The suite on every core (pytest-xdist: the tests are independent), one BLAS thread a worker: two
 # workers of two BLAS threads each would fight over two cores. A module's tests on one worker (loadscope):
 # spread test by test, both workers built the same module fixtures (simulations, fits): 500 s → 358 s.
-# The long modules first (tests/conftest.py's LONG_MODULES), not the modules with the most tests.
 TEST_ENV := OMP_NUM_THREADS=1 OPENBLAS_NUM_THREADS=1 MKL_NUM_THREADS=1
-PYTEST_XDIST := -n auto --dist loadscope --no-loadscope-reorder
+PYTEST_XDIST := -n auto --dist loadscope
 test: $(STAMP)
 	$(TEST_ENV) $(PY) -m pytest -q $(PYTEST_XDIST)
 

@@ -28,22 +28,6 @@ def pytest_configure(config):
                                        "a failure under CI")
 
 
-#: modules whose tests take a minute or more together (``--durations=0`` on a 2-core AMD EPYC), handed to the workers
-#: first (`pytest_collection_modifyitems`, with ``--no-loadscope-reorder``): xdist hands modules out by their number
-#: of tests otherwise, and a module of two long tests (the F-16 report's, 43 s) came last and ran alone while the
-#: other worker sat idle. A module missing here only runs later.
-LONG_MODULES = ("tests/explain/test_skeletons.py", "tests/structure/test_model.py", "tests/discovery/test_discover.py",
-                "tests/test_docs.py", "tests/structure/test_locate.py", "tests/cli/test_cli_predict.py",
-                "tests/report/test_sec_f16.py", "tests/discovery/test_adequacy.py", "tests/structure/test_loop.py",
-                "tests/cli/test_cli_fuzz.py")
-
-
-def pytest_collection_modifyitems(config, items):
-    """The `LONG_MODULES` first, longest first; every module's tests kept together and in their order."""
-    rank = {name: i for i, name in enumerate(LONG_MODULES)}
-    items.sort(key=lambda item: rank.get(item.nodeid.split("::")[0], len(rank)))  # stable: the rest as collected
-
-
 def pytest_runtest_setup(item):
     for mark in item.iter_markers("real_data"):
         if not mark.kwargs.get("present", False):
