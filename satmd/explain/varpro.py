@@ -14,7 +14,7 @@ converges like the full Jacobian (Ruhe & Wedin 1980).
 from __future__ import annotations
 
 import numpy as np
-from scipy.linalg import cho_solve
+from scipy.linalg.lapack import dpotrs
 from scipy.optimize import least_squares
 
 from .skeletons import Skeleton, initial
@@ -38,7 +38,7 @@ def _solve(C: np.ndarray, V: np.ndarray) -> np.ndarray:
         except np.linalg.LinAlgError:
             chol = None
         if chol is not None and np.min(np.diag(chol)) ** 2 > _PIVOT:
-            return cho_solve((chol, True), Cs.T @ V, check_finite=False) / norms[:, None]
+            return dpotrs(chol, Cs.T @ V, lower=1)[0] / norms[:, None]  # cho_solve's LAPACK call, without its checks
     return np.linalg.lstsq(C, V, rcond=None)[0]
 
 
@@ -127,9 +127,14 @@ def fit(sk: Skeleton, Zt: np.ndarray, y: np.ndarray, starts: int = 2, seed: int 
     sst = float(np.sum((y - y.mean()) ** 2)) or 1.0
     bad = np.full(y.shape, 1e3)
 
+    last: list = [None, None]  # the last constants and their parts: the Jacobian follows the residual at one point
+
     def parts(p):
+        if last[0] is not None and np.array_equal(p, last[0]):
+            return last[1]
         cols, target = sk.columns(p, Zt), y - sk.offset(p, Zt)
         ok = all(np.isfinite(c.sum()) for c in cols) and np.isfinite(np.sum(target))
+        last[:] = [np.array(p, copy=True), (cols, target, ok)]
         return cols, target, ok
 
     def residual(p):

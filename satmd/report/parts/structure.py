@@ -22,7 +22,7 @@ def build(ctx) -> str:
     fitted = [recs[i] for i in levels]
     loc = locate_joint(fitted)
     model = fit_structure(fitted, location=loc, files=[f"level {i}" for i in levels],
-                          max_nfev=5 if ctx.quick else 40)
+                          max_nfev=5 if ctx.quick else 40, polish=not ctx.quick)
     held = model.predict(recs[HELD], file=f"level {HELD}")
     joint = model.joint
     # the model's law: the weighing can keep another than the spectra's (`fit_structure`), both said
