@@ -171,9 +171,7 @@ def threaded_differences(fun, rel_step: float, bounds=(-np.inf, np.inf), workers
     from contextlib import nullcontext
 
     last: dict = {}
-    if workers is None:
-        cores = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else (os.cpu_count() or 1)
-        workers = min(cores, MAX_THREADS)
+    workers = workers or cores()
 
     def value(x):
         f = np.asarray(fun(x), float)
@@ -199,6 +197,37 @@ def threaded_differences(fun, rel_step: float, bounds=(-np.inf, np.inf), workers
         return np.column_stack([(c - f0) / d for c, d in zip(columns, steps)]).reshape(f0.size, x.size)
 
     return value, jac
+
+
+def cores() -> int:
+    """The cores this process may run on, at most `MAX_THREADS`."""
+    n = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else (os.cpu_count() or 1)
+    return min(n, MAX_THREADS)
+
+
+def side_by_side(calls) -> list:
+    """Each of ``calls`` (callables of no argument) called, on the cores' threads, their results in order. For
+    whole fits that are independent of each other (a structure's laws at one place): each one's Jacobian columns
+    already run side by side (`threaded_differences`), its residuals, its least squares' steps and its checks
+    between the fits do not. Each call runs in a copy of the caller's context (its progress listener).
+
+    Parameters
+    ----------
+    calls : callables, safe to run at once (each builds what it changes)
+
+    Returns
+    -------
+    list
+    """
+    import contextvars
+    from concurrent.futures import ThreadPoolExecutor
+
+    calls = list(calls)
+    if len(calls) < 2 or cores() < 2:
+        return [call() for call in calls]
+    with ThreadPoolExecutor(min(cores(), len(calls))) as pool:
+        futures = [pool.submit(contextvars.copy_context().run, call) for call in calls]
+        return [f.result() for f in futures]
 
 
 def one_blas_thread():

@@ -12,7 +12,7 @@ from hypothesis.extra.numpy import arrays
 
 from satmd.conventions import ACCEL_CHANNELS, DEFAULT_FREE, RECORDING_CHANNELS, SPEC_RANGES, TINY
 from satmd.errors import DataWarning, PinnedParameterWarning, PoorFitWarning, WarningRecord
-from satmd.numerics import distinct_best, lag1_autocorrelation, threaded_differences
+from satmd.numerics import distinct_best, lag1_autocorrelation, side_by_side, threaded_differences
 
 
 def test_conventions_agree_with_each_other_and_the_rig():
@@ -87,6 +87,29 @@ def test_threaded_differences_take_least_squares_own_steps(bounds):
     assert np.array_equal(jac(x), serial)
     exact = np.array([[-20 * x[0], 10, 0], [-1, 0, 0], [0.5 * x[2], 0, 0.5 * x[0]], [0, 0, np.cos(x[2])]])
     assert np.allclose(serial, exact, atol=1e-4)
+
+
+def test_side_by_side_runs_the_calls_at_once_in_the_caller_s_context(monkeypatch):
+    """A structure's law fits on threads: their results in the order given, each call at once with the others (a
+    barrier two must reach breaks if they run one after the other), the caller's progress listener heard by each."""
+    import threading
+
+    from satmd._progress import stage, stages
+
+    monkeypatch.setattr("satmd.numerics.cores", lambda: 2)
+    met = threading.Barrier(2, timeout=10)
+    told: list = []
+
+    def call(i):
+        met.wait()
+        stage(f"call {i}")
+        return i * i
+
+    with stages(told.append):
+        assert side_by_side([lambda: call(3), lambda: call(4)]) == [9, 16]
+    assert sorted(told) == ["call 3", "call 4"]
+    monkeypatch.setattr("satmd.numerics.cores", lambda: 1)  # one core: one after the other, in the caller's thread
+    assert side_by_side([lambda: threading.get_ident()] * 2) == [threading.get_ident()] * 2
 
 
 def test_lag1_of_white_noise_and_of_a_smooth_curve():

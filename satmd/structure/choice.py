@@ -35,7 +35,7 @@ def best_place(fit, loc, model, laws, others, files):
         return model
     fit.say(f"the next {len(rivals)} place(s) by the spectra ({', '.join(' and '.join(p) for p in rivals)}), "
             f"{' and '.join(laws)} fitted at each on every level ...")
-    tried = [model, *[fit.law(p, w, files) for p in rivals for w in laws]]
+    tried = [model, *fit.laws([(p, w) for p in rivals for w in laws], files)]
     fit.say("; ".join(f"{' and '.join(m.joint.between)} ({m.joint.law}): mean NRMSE {score(m):.4f}"
                       for m in tried if m.joint is not None))
     best = best_fitting(tried)
@@ -43,7 +43,7 @@ def best_place(fit, loc, model, laws, others, files):
         return best
     fit.say(f"{', '.join(others)} between {best.joint.between[0]} and {best.joint.between[1]}: each fitted ...")
     here = [m for m in tried if m.joint is not None and m.joint.between == best.joint.between]
-    return best_fitting([*here, *[fit.law(best.joint.between, w, files) for w in others]])
+    return best_fitting([*here, *fit.laws([(best.joint.between, w) for w in others], files)])
 
 
 def close_rivals(model, tried) -> list:

@@ -2,11 +2,12 @@
 from __future__ import annotations
 
 from dataclasses import replace
+from functools import partial
 
 import numpy as np
 
 from ..errors import DataError
-from ..numerics import on_one_blas_thread
+from ..numerics import on_one_blas_thread, side_by_side
 from ..validation import NAMES, Interval, Options, Whole, validate_params
 from .acquisition import acquisition_of
 from .choice import PLACE_LAWS, best_fitting, best_place, close_rivals, contradicts, ranked_laws
@@ -110,7 +111,7 @@ def fit_structure(recordings, between=None, law: str | None = None, channels=Non
         weighed = ["sparse", *weighed] if law == "sparse" else weighed
         if not law_given and len(recordings) >= 3 and tuple(between) == loc.between and len(weighed) > 1:
             say(f"{', '.join(weighed)}: each fitted on every level, the best kept ...")
-            fitted = [fit.law(between, w, files) for w in weighed]
+            fitted = fit.laws([(between, w) for w in weighed], files)
         else:
             fitted = [fit.law(between, law, files, shape, form)]
             for other in ([] if law_given else [w for w in weighed if w != law]):
@@ -208,6 +209,15 @@ class _Fit:
             self.tried.append(model)
         return model
 
+    def laws(self, tries, files) -> list:
+        """`law` of each (place, law) of ``tries``, side by side (`side_by_side`), in their order (in `tried` too)."""
+        for between in dict.fromkeys(tuple(b) for b, _ in tries):
+            self.reference(between)  # once a place, before the fits share it
+        n = len(self.tried)
+        fitted = side_by_side([partial(self.law, b, w, files) for b, w in tries])
+        self.tried[n:] = [m for m in fitted if any(m is t for t in self.tried[n:])]
+        return fitted
+
     def finished_choice(self, model, free_path, files) -> StructureModel:
         """``model`` `finished`, and the laws at its place that came close to it as first fitted (`close_rivals`:
         for the sparse library, the best named law), each finished too; the best finished kept (`best_fitting`: the
@@ -215,12 +225,11 @@ class _Fit:
         the start's, the library's extra terms take up what a named law's path leaves: on independent ground
         vibration tests a beam's clearance to the ground fitted its levels at mean NRMSE 0.150 against the
         library's 0.133, finished at 0.041 against 0.121."""
-        finished = self.finished(model, free_path, files)
         rivals = close_rivals(model, self.tried)
-        if not rivals:
-            return finished
-        self.say(f"{', '.join(m.joint.law for m in rivals)} against {model.joint.law}, each finished ...")
-        return best_fitting([finished, *[self.finished(m, free_path, files) for m in rivals]])
+        if rivals:
+            self.say(f"{', '.join(m.joint.law for m in rivals)} against {model.joint.law}, each finished ...")
+        finished = side_by_side([partial(self.finished, m, free_path, files) for m in [model, *rivals]])
+        return best_fitting(finished) if rivals else finished[0]
 
     def finished(self, model, free_path, files) -> StructureModel:
         """``model`` finished: more modes above the band where its fitted law's harmonics ask for them (`widened`),

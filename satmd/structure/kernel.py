@@ -133,6 +133,13 @@ _STATE: dict = {}
 
 def _compiled():
     """The numba-compiled pass, or None without numba (the NumPy pass is the same arithmetic, ~100x slower)."""
+    from .laws import COMPILING
+
+    with COMPILING:
+        return _compile()
+
+
+def _compile():
     if "pass" not in _STATE:
         try:
             import numba

@@ -21,6 +21,7 @@ period (the regression's columns).
 from __future__ import annotations
 
 import math
+import threading
 from dataclasses import dataclass, replace
 
 import numpy as np
@@ -129,10 +130,16 @@ def periodic_value(code, d, v, aux):
 
 
 _PLAY: dict = {}
+COMPILING = threading.RLock()  # fits run side by side: one thread compiles (`slide` once), the others wait
 
 
 def play_compiled():
     """`play`, compiled with numba where it is there (its pure-Python loop is ~100x slower)."""
+    with COMPILING:
+        return _compile_play()
+
+
+def _compile_play():
     if "play" not in _PLAY:
         _PLAY["play"] = play
         try:
