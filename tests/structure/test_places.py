@@ -25,6 +25,9 @@ class _Fits:
         joint = Joint(tuple(between), law, np.array([1.0, 0.0, 0.0]), np.ones(3), np.ones(1, complex), "N")
         return StructureModel(LINEAR, joint, (1.0, 8.0), fit={"nonlinear": [[self.scores[(tuple(between), law)]]]})
 
+    def laws(self, tries, files):
+        return [self.law(b, w, files) for b, w in tries]
+
 
 def _located(next_gap):
     places = [("acc1", "acc2"), ("acc2", "acc3"), ("acc1", "ground")]
