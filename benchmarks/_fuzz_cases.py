@@ -97,6 +97,10 @@ def make_structure_base(folder):
     save_recording(fewer, f"{folder}/s8_no_acc3.csv")
     more = Recording(high.fs_hz, {**{c: high[c] for c in high.channels}, "acc5": high["acc4"]}, meta={})
     save_recording(more, f"{folder}/s8_acc5.csv")
+    still = Recording(high.fs_hz, {**{c: high[c] for c in high.channels}, "force": 0.0 * high["force"]}, meta={})
+    save_recording(still, f"{folder}/s8_still.csv")
+    cut = Recording(high.fs_hz, {c: high[c][:300] for c in high.channels}, meta={})
+    save_recording(cut, f"{folder}/s8_cut.csv")
     quiet = io.StringIO()
     with contextlib.redirect_stdout(quiet), contextlib.redirect_stderr(quiet):
         assert main(["discover", f"{folder}/s1.csv", f"{folder}/s8.csv", "--save-model", f"{folder}/structure.json"]) == 0
@@ -110,6 +114,10 @@ def structure_cases(base) -> list[dict]:
              argv=["discover", "{base}/s1.csv", "{base}/s8_no_acc3.csv"]))
     add(case("structure levels", "cli", "refuse", ["s8_acc5.csv", "acc5"],
              argv=["discover", "{base}/s1.csv", "{base}/s8_acc5.csv"]))
+    add(case("structure levels", "cli", "refuse", ["s8_still.csv", "constant"],  # the level at fault, not the first
+             argv=["discover", "{base}/s1.csv", "{base}/s8_still.csv"]))
+    add(case("structure levels", "cli", "refuse", ["s8_cut.csv", "300 samples"],
+             argv=["discover", "{base}/s1.csv", "{base}/s8_cut.csv", "--save-model", "{work}/m.json"]))
     add(case("structure levels", "cli", "refuse", ["--driving-point", "acc9"],
              argv=["discover", "{base}/s1.csv", "{base}/s8.csv", "--save-model", "{work}/m.json",
                    "--driving-point", "acc9"]))

@@ -100,7 +100,7 @@ def _blame(args, message: str) -> str:
     from pathlib import Path
 
     inputs = []
-    for key in ("data", "recording", "model"):
+    for key in ("data", "more", "recording", "model"):  # more: the other levels of `discover DATA MORE...`
         value = getattr(args, key, None)
         inputs += value if isinstance(value, list) else [value] if value else []
     if not inputs or "--" in message or any(str(p) in message or Path(str(p)).name in message for p in inputs):

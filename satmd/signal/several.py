@@ -107,21 +107,38 @@ def common_frfs(recordings) -> list:
 
     if all(is_multisine(r) and (int(r.meta.get("realisations", 1)) > 1
                                 or not {"acc1", "acc2"} & set(r.channels)) for r in recordings):
-        return [multisine_frf(r) for r in recordings]  # several realisations in each file, or a generic output
+        return each_named(recordings, multisine_frf)  # several realisations in each file, or a generic output
     if all(is_multisine(r) for r in recordings):  # periodic: the estimator of the excitation, at its lines
-        return [estimate_frf(r) for r in recordings]
-    bands = [excited_band(r["force"], r.fs_hz)[:2] for r in recordings]
+        return each_named(recordings, estimate_frf)
+    bands = each_named(recordings, lambda r: excited_band(r["force"], r.fs_hz)[:2])
     band = (max(b[0] for b in bands), min(b[1] for b in bands))
     band = _within_sweeps(recordings, band)
-    first = estimate_frf(recordings[0], band_hz=band)
+    first = each_named(recordings[:1], lambda r: estimate_frf(r, band_hz=band))[0]
     swept = any(excitation_of(r).kind == "sweep" for r in recordings)
     # sweeps: the first level's exact window (its rounded width lays the others' on another grid); random
     # forces keep the rounded width their level test was calibrated with (exact windows raised its false
     # alarms on linear structures from 0 to 2 in 104 in benchmarks/structures_levels.py)
     width = _window_of(first) if swept else first.estimator.get("window_hz")
-    out = [first] + [estimate_frf(r, band_hz=band, width_hz=width) for r in recordings[1:]]  # the first: as is
+    out = [first, *each_named(recordings[1:], lambda r: estimate_frf(r, band_hz=band, width_hz=width))]
     return [_with_model_error(d, r, band, width) if d.estimator.get("method") == "lpm" else d
             for d, r in zip(out, recordings)]
+
+
+def each_named(recordings, call) -> list:
+    """``call(r)`` of each recording; a `DataError` about one of several recordings names its file (its source)
+    where the message does not: "the force is constant" alone does not say which level's."""
+    from ..errors import DataError
+
+    out = []
+    for i, r in enumerate(recordings, start=1):
+        try:
+            out.append(call(r))
+        except DataError as exc:
+            source = str(r.meta.get("source") or f"recording {i}")
+            if type(exc) is not DataError or source in str(exc):  # a subclass may be caught by its type: as it is
+                raise
+            raise DataError(f"{source}: {exc}") from None
+    return out
 
 
 def _window_of(data):

@@ -127,9 +127,11 @@ def periodic_spectra(recording) -> PeriodicSpectra:
                         "ground vibration test uses) at every level: from one sweep a level the place "
                         "came out right on 7 of 10 independent tests and no law was named (a multisine: 9 and 9); "
                         "`structure.transient_spectra` tries it all the same")
-    if exc.kind != "periodic":
-        raise DataError(f"{source}: the force is {exc.kind}, not periodic; locating a joint needs a periodic force "
-                        "(a multisine, as a ground vibration test uses) at every level")
+    if exc.kind != "periodic":  # its length said: a record cut short of two periods reads as random
+        n = np.asarray(rec["force"]).size
+        raise DataError(f"{source}: the force is {exc.kind}, not periodic ({n} samples, {n / rec.fs_hz:.3g} s); "
+                        "locating a joint needs a periodic force (a multisine, as a ground vibration test uses), two "
+                        "or more whole periods, at every level")
     n = exc.period_samples
     lines = np.asarray(exc.lines, int)
     force = signal_spectra(rec, exc, "force").mean(axis=0)  # (steady periods, lines) of the periodic estimator

@@ -61,6 +61,21 @@ def test_predict_refuses_what_it_cannot_use(capsys, levels, tmp_path):
     refused(capsys, "predict", levels / "missing.json", levels / "L3.csv", says=("missing.json",))
 
 
+def test_a_refusal_names_the_level_at_fault_not_the_first(capsys, levels, tmp_path):
+    """Of several levels, the one whose force is constant, or holds a NaN, is named; the first level is not."""
+    lines = (levels / "L8.csv").read_text().splitlines()
+    head, rows = lines[:2], [row.split(",") for row in lines[2:]]
+    still = tmp_path / "still.csv"
+    still.write_text("\n".join([*head, *(",".join([r[0], "0", *r[2:]]) for r in rows)]) + "\n")
+    line = refused(capsys, "discover", levels / "L1.csv", still, says=("still.csv: the force is constant",))
+    assert "L1.csv" not in line
+    rows[40][3] = "nan"
+    holed = tmp_path / "holed.csv"
+    holed.write_text("\n".join([*head, *(",".join(r) for r in rows)]) + "\n")
+    line = refused(capsys, "discover", levels / "L1.csv", holed, says=("holed.csv, line 43",))
+    assert "L1.csv" not in line
+
+
 def test_save_model_needs_a_structure(capsys, levels, tmp_path):
     """One recording of one level: no structure model to save; said in one line, nothing written."""
     out = tmp_path / "m.json"

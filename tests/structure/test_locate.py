@@ -82,6 +82,9 @@ def test_refusals_name_what_is_wrong(cubic_between_3_and_4):
                                   "acc1": low["acc1"]}, meta={"source": "random.csv"})
     with pytest.raises(DataError, match="random.csv: the force is random, not periodic"):
         periodic_spectra(noise)
+    cut = Recording(low.fs_hz, {c: low[c][:300] for c in low.channels}, meta={"source": "cut.csv"})
+    with pytest.raises(DataError, match=r"cut.csv: the force is \w+, not periodic \(300 samples"):
+        periodic_spectra(cut)  # a level cut short of its periods: its length said, the cut seen
     with pytest.raises(DataError, match="unknown joint law"):
         from satmd.structure import law
         law("glue")
