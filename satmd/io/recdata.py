@@ -244,11 +244,15 @@ def clipped_channels(rec: Recording, extremes: dict | None = None) -> dict:
 
 
 def warn_clipping(path, rec, extremes=None):
-    """A `DataWarning` per channel that `clipped_channels` finds, or that holds a glitch (every reader calls this)."""
+    """A `DataWarning` per channel that `clipped_channels` finds, that is constant, or that holds a glitch (every
+    reader calls this)."""
     for name, count in clipped_channels(rec, extremes).items():
         warn(path, f"channel {name} looks clipped: {count} samples sit at its extremes "
                    f"({100 * count / rec.n_samples:.2g} %); FRFs near those peaks are unreliable")
     for name, v in rec.channels.items():
+        if v.size > 1 and np.ptp(v) == 0:
+            warn(path, f"channel {name} is constant ({v[0]:.3g} throughout): a sensor that recorded nothing?")
+            continue
         mag = np.abs(v)
         typical = np.percentile(mag, 99.9) if mag.size >= 1000 else np.median(mag)
         k = int(np.argmax(mag))

@@ -80,6 +80,9 @@ def test_output_only_csv_and_clipping_warning(tmp_path):
     with pytest.warns(DataWarning, match="acc1 looks clipped"):
         r = load_recording(p)
     assert not r.has_force and r.fs_hz == 1000.0
+    p.write_text("time_s,acc1,acc2\n" + "".join(f"{a:.6f},{b:.17g},0\n" for a, b in zip(t, np.cos(t))))
+    with pytest.warns(DataWarning, match="channel acc2 is constant .0 throughout.: a sensor that recorded nothing"):
+        load_recording(p)  # a dead sensor, said
     with pytest.raises(DataError, match="no force channel"):
         estimate_frf(r)
 

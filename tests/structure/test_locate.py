@@ -137,6 +137,34 @@ def test_discover_says_where_the_joint_acts(cubic_between_3_and_4, monkeypatch):
         discover(cubic_between_3_and_4[0], fit_joint=False)  # one recording: no joint to place
 
 
+def _clipped(recording, channel, share=0.6):
+    """``recording`` with ``channel`` clipped at ``share`` of its peak, as a sensor past its range reads."""
+    v = np.asarray(recording[channel], float)
+    top = share * np.abs(v).max()
+    return Recording(recording.fs_hz, {**{c: recording[c] for c in recording.channels}, channel: np.clip(v, -top, top)},
+                     meta={"source": "top.csv"})
+
+
+def test_a_clipped_sensor_is_the_measurement_chain_not_a_joint(cubic_between_3_and_4):
+    """A sensor clipped at the top level changes with level as a joint does, harmonics and all. On a linear chain
+    it was placed as a joint (acc3 and acc4, quadratic damping); it is left out and said to be the measurement
+    chain's, and no joint is claimed. With a joint, the joint is still placed among the others."""
+    from satmd import discover
+    from satmd.discovery.nonlinear.modes import untrusted_channels
+
+    low, high = simulate_chain(joint=(2, 3), law=lambda d, v: 0.0 * d, levels=(1.0, 8.0), seed=1)
+    rep = discover([low, _clipped(high, "acc2")], fit_joint=False)
+    d = rep.to_dict()["nonlinear"]
+    assert [f["name"] for f in d["findings"]] == ["nonlinear_unexplained"]
+    assert "acc2 left out (clipped in top.csv" in d["findings"][0]["explanation"]
+    levels = [*cubic_between_3_and_4[:2], _clipped(cubic_between_3_and_4[2], "acc1")]
+    joint = discover(levels, fit_joint=False).to_dict()["nonlinear"]["findings"][0]
+    assert joint["between"] == ["acc3", "acc4"] and "acc1 left out (clipped" in joint["explanation"]
+    dead = Recording(low.fs_hz, {**{c: low[c] for c in low.channels}, "acc5": 0.0 * low["acc5"]}, meta={})
+    assert untrusted_channels([high, dead], ["acc1", "acc5"]) == {
+        "acc5": "constant in recording 2: the sensor recorded nothing"}
+
+
 def test_discover_refuses_a_sensor_missing_at_one_level(cubic_between_3_and_4):
     from satmd import discover
 

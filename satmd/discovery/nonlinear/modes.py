@@ -11,6 +11,8 @@ from __future__ import annotations
 
 from dataclasses import replace
 
+import numpy as np
+
 from ...modal import follow_modes
 from ..findings import NonlinearFinding
 from .distortion import UNEXPLAINED_NL
@@ -164,19 +166,29 @@ def with_joint(report, recordings, fit_joint: bool = True):
         return report
     from ..._progress import stage
 
-    stage(f"locating the joint among every pair of {len(responses)} sensors and the ground ...")
-    try:
-        loc = locate_joint(recordings)
-    except DataError as err:  # not tests a joint can be located from: the account per resonance stands, and why
+    untrusted = untrusted_channels(recordings, responses)
+    trusted = [c for c in responses if c not in untrusted]
+    left_out = "; ".join(f"{c} left out ({why}: the measurement chain's, not the structure's)"
+                         for c, why in untrusted.items())
+
+    def told(why):  # the account per resonance stands, and why no joint is told
         old = report.findings[0]
-        why = f"the joint is not located among the sensors: {err}"
         return replace(report, findings=[replace(old, explanation=f"{old.explanation}; {why}" if old.explanation
                                                  else why[:1].upper() + why[1:]), *report.findings[1:]])
+
+    if len(trusted) < 2:
+        return told(f"the joint is not located among the sensors: {left_out}; fewer than two sensors remain")
+    stage(f"locating the joint among every pair of {len(trusted)} sensors and the ground ...")
+    try:
+        loc = locate_joint(recordings, channels=trusted)
+    except DataError as err:  # not tests a joint can be located from
+        return told(f"the joint is not located among the sensors: {err}")
     if not loc.detected:
-        return report
+        return told(f"no joint among {', '.join(trusted)} explains the change between the levels; {left_out}") \
+            if untrusted else report
     a, b = loc.between
     near = [e for e in loc.location[1:] if e["delta_bic"] <= 10.0]
-    model = _structure_model(recordings, loc) if fit_joint else None
+    model = _structure_model(recordings, loc, trusted) if fit_joint else None
     named = model.joint.law if model is not None and model.joint is not None else loc.law
     explanation = (f"a joint between {a} and {b} ({named}): its relative motion explains the change between "
                    f"the levels (ΔBIC {loc.location[1]['delta_bic']:.0f} to the next place, "
@@ -189,6 +201,8 @@ def with_joint(report, recordings, fit_joint: bool = True):
                        f"(ΔBIC {gap:.0f} ahead)")
     if near:
         explanation += "; as well supported: " + "; ".join(" and ".join(e["between"]) for e in near)
+    if untrusted:
+        explanation += f"; {left_out}"
     fit = parameters = None
     if model is not None and model.joint is not None:
         fit = {k: model.fit[k] for k in ("metric", "channels", "linear", "nonlinear")}
@@ -226,12 +240,32 @@ def with_joint(report, recordings, fit_joint: bool = True):
     return replace(report, findings=[joint], model=model)
 
 
-def _structure_model(recordings, loc):
+def untrusted_channels(recordings, responses) -> dict:
+    """{channel: why} for the response channels a structure's joint must not be located from: clipped at some
+    level (a sensor on its range's stops changes with level as a joint does, harmonics and all), or constant (a
+    sensor that recorded nothing)."""
+    from ...io.recdata import clipped_channels
+
+    out: dict = {}
+    for i, r in enumerate(recordings, start=1):
+        name = r.meta.get("source", f"recording {i}")
+        clipped = clipped_channels(r)
+        for c in responses:
+            if c in out:
+                continue
+            if c in clipped:
+                out[c] = f"clipped in {name}: {clipped[c]} samples at its extremes"
+            elif np.ptp(np.asarray(r[c], float)) == 0:
+                out[c] = f"constant in {name}: the sensor recorded nothing"
+    return out
+
+
+def _structure_model(recordings, loc, channels=None):
     """The joint's model fitted on every level (`satmd.structure.fit_structure`), or None where it cannot be."""
     from ...errors import DataError
     from ...structure import fit_structure
 
     try:
-        return fit_structure(recordings, location=loc)
+        return fit_structure(recordings, location=loc, channels=channels)
     except DataError:
         return None
