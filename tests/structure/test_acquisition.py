@@ -137,8 +137,8 @@ def test_discover_says_the_chain_s_filter_apart_from_the_joint(monkeypatch, chai
                                                       "linear": [[0.3] * 4], "nonlinear": [[0.02] * 4]})
     located = JointLocation(("acc3", "acc4"), [{"between": ["acc3", "acc4"], "delta_bic": 0.0, "law": "cubic"}],
                             "cubic", [{"law": "cubic", "delta_bic": 0.0}], [], [], "L1", [1.0, 8.0], evidence=1e3)
-    monkeypatch.setattr("satmd.structure.locate_joint", lambda recordings: located)
-    monkeypatch.setattr(modes, "_structure_model", lambda recordings, loc: fitted)
+    monkeypatch.setattr("satmd.structure.locate_joint", lambda recordings, channels=None: located)
+    monkeypatch.setattr(modes, "_structure_model", lambda recordings, loc, channels=None: fitted)
     report = NonlinearReport(True, [], [NonlinearFinding("nonlinear_unexplained", explanation="")])
     recordings = simulate_chain(n=4, joint=(2, 3), levels=(1.0, 8.0), period=256, periods=2, seed=1)
     text = modes.with_joint(report, recordings).findings[0].explanation
