@@ -1,6 +1,8 @@
 """satmd predict: simulate recordings' forces through a saved structure model (SPEC §11)."""
 from __future__ import annotations
 
+import sys
+
 from ._recording import add_recording_options
 
 
@@ -34,6 +36,10 @@ def run(args):
     out = []
     for path in args.recordings:
         rec = load_recording_args(args, path)
+        other = [c for c in rec.channels if c != "force" and c not in model.channels]
+        if other:  # a sensor the model was not fitted with: said, not predicted (and not refused)
+            print(f"satmd predict: note: {path}: {', '.join(other)} not in the model (it predicts "
+                  f"{', '.join(model.channels)}): not predicted", file=sys.stderr)
         try:
             out.append(model.predict(rec, file=str(path)))
         except SatmdError as err:

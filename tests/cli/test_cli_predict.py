@@ -51,7 +51,12 @@ def test_discover_saves_the_model_and_predict_judges_a_level_it_never_saw(capsys
     assert max(p["nrmse"]) < 0.016 and np.isfinite(p["linear_nrmse"]).all()
     assert (tmp_path / "L3.png").stat().st_size > 0
     rc, out, err = run(capsys, "predict", model, levels / "L3.csv")
-    assert rc == 0 and "NRMSE acc1" in out
+    assert rc == 0 and "NRMSE acc1" in out and "note" not in err
+    lines = (levels / "L3.csv").read_text().splitlines()  # a sensor more than the model's: said, not refused
+    more = tmp_path / "more.csv"
+    more.write_text("\n".join([lines[0], lines[1] + ",acc9", *(r + "," + r.split(",")[2] for r in lines[2:])]) + "\n")
+    rc, out, err = run(capsys, "predict", model, more)
+    assert rc == 0 and "more.csv: acc9 not in the model" in err and "acc5 0.0" in out and "acc9" not in out
 
 
 def test_predict_refuses_what_it_cannot_use(capsys, levels, tmp_path):
