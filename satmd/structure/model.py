@@ -197,7 +197,8 @@ class StructureModel:
         measured = np.array([np.asarray(recording[c], float) for c in self.channels])
         if not (np.all(np.isfinite(force)) and np.all(np.isfinite(measured))):
             raise DataError(f"{name}: NaN or inf in the force or a response")
-        recording = at_the_door(recording)
+        recording = at_the_door(recording)  # each response about its mean (`centred`): an offset is the sensor's
+        measured = np.array([np.asarray(recording[c], float) for c in self.channels])
         warm = warmup_of(recording)
         drive = Drive(self, drive_force(recording), float(recording.fs_hz), warm)
         lin = drive.outputs(None)

@@ -268,6 +268,16 @@ def test_the_band_s_modes_are_refitted_with_the_law(cubic_levels, cubic_model):
     assert with_band_modes_refined(replace(m, joint=None), recs, measured, span, m.band_hz) is None
 
 
+def test_a_sensor_s_offset_is_not_the_structure_s(cubic_model, cubic_levels):
+    """A response's mean is its sensor's offset (a structure held in place has no mean acceleration): half its RMS
+    added to one channel leaves the prediction's NRMSE as it was (it was 0.5 on that channel)."""
+    level = cubic_levels[1]
+    v = np.asarray(level["acc3"], float)
+    offset = Recording(level.fs_hz, {**{c: level[c] for c in level.channels}, "acc3": v + 0.5 * v.std()},
+                       meta=dict(level.meta))
+    assert np.allclose(cubic_model.predict(offset).nrmse, cubic_model.predict(level).nrmse, atol=1e-9)
+
+
 def test_a_path_off_the_modes_is_fitted_back(cubic_levels):
     """The output-error fit with the path free (`fit_structure`'s last stage) puts back a path that the start
     found 40 % off on every other mode; the law's coefficients alone cannot. With the path free, every channel is
