@@ -107,8 +107,14 @@ def ratio_of_means(U, Y):
 
 
 def excitation_findings(excitation) -> list[MeasurementFinding]:
-    """What was left out of the estimate (transient periods, a glitch, double or clipped hits), in words."""
+    """What was left out of the estimate (transient periods, a glitch, double or clipped hits), or could not be
+    (the first of two periods), in words."""
     out = []
+    if excitation.kind == "periodic" and excitation.periods == 2:
+        out.append(MeasurementFinding(
+            "two_periods", "two periods, both averaged: a start-up transient in the first cannot be told from the "
+            "noise, so it is averaged in and counted as noise (2 degrees of freedom)",
+            "record 3 or more periods (the first is then left out where it still holds the start-up)"))
     for what, why in excitation.dropped:
         if "transient" in why:
             out.append(MeasurementFinding(

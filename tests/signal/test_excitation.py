@@ -73,6 +73,21 @@ def test_multisine_from_rest_is_detected_and_estimated_at_its_lines():
     assert 0.75 < _calibration(data) < 1.35
 
 
+def test_two_periods_are_said_to_hide_a_start_up_transient():
+    """Two periods of a multisine from rest: both averaged (the first cannot be told from the noise with no third
+    to compare), said as a measurement finding and, among levels, as the next experiment."""
+    from satmd.discovery.nonlinear.findings import two_periods
+    from satmd.signal.excitation import received
+    from satmd.signal.periodic import excitation_findings
+
+    two, five = (received(_record(_multisine(2000, n), noise=0.02)) for n in (2, 5))
+    exc = detect_excitation(two)
+    assert exc.kind == "periodic" and exc.periods == 2 and exc.transient_periods == 0
+    assert [f.name for f in excitation_findings(exc)] == ["two_periods"]
+    assert "two_periods" not in [f.name for f in excitation_findings(detect_excitation(five))]
+    assert two_periods([five, two]) == ["test"]
+
+
 def test_pseudo_random_and_a_given_period_agree():
     rng = np.random.default_rng(4)
     one = rng.standard_normal(1000)
