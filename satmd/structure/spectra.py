@@ -274,8 +274,7 @@ def drive_force(recording) -> np.ndarray:
     if exc.kind != "periodic" or len(steady) < MIN_STEADY:
         return quiet_outside_band(force)
     n = int(exc.period_samples)
-    # a periodic force's mean over its steady periods is the load cell's offset (or a preload the structure sat
-    # under before the record): no drive, and no step at the start (it had made a chain's prediction 20 % worse)
+    # its mean is the load cell's offset, or a preload met before the record: no drive, no step at the start
     force = force - force[steady[0] * n:(steady[-1] + 1) * n].mean()
     steady_periods = force[: exc.periods * n].reshape(exc.periods, n)[steady]
     X = np.fft.rfft(steady_periods, axis=1)
