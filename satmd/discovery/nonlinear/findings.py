@@ -177,14 +177,15 @@ def two_periods(recordings) -> list:
     in the first cannot be told from the noise; a shorter top level, cut to spare the structure, had a chain's
     cubic joint found at 1 and 8 N RMS with five periods each and not with two at 8 N)."""
     from ...signal.excitation import excitation_of
+    from ...signal.periodic import excitation_findings
 
     out = []
     for i, r in enumerate(recordings, start=1):
         try:
-            exc = excitation_of(r)
+            found = excitation_findings(excitation_of(r))  # its ``two_periods`` finding: the one definition
         except SatmdError:
             continue
-        if exc.kind == "periodic" and exc.periods == 2:
+        if any(f.name == "two_periods" for f in found):
             out.append(str(r.meta.get("source", f"recording {i}")))
     return out
 
