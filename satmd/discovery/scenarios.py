@@ -75,7 +75,6 @@ def concealed_case(seed: int, names=None, n_effects: int = 1, std_given: bool = 
     yet still looks right to the eye (relative error ≤ 4 × the 1 % noise):
     concealed, but present in the data. Without it, magnitudes are as drawn.
     """
-
     rng = np.random.default_rng(seed)
     grid = str(rng.choice(list(GRIDS)))
     lo, hi, n = GRIDS[grid]
