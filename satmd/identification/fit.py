@@ -129,7 +129,7 @@ def identify(
         starts = starts + _search(coarse, n_search, n_refine, seed, starts)
     best: Any = None  # the best local fit (a least-squares result)
     nfev = 0
-    explore = max(tol, EXPLORE_TOL)
+    explore = max(tol, EXPLORE_TOL) if len(starts) > 1 else tol  # one start: finished where it stops
     for s in starts:
         fit = _local_fit(coarse, s, nominal, reg, max_nfev, explore)
         nfev += fit.nfev
@@ -143,9 +143,9 @@ def identify(
             nfev += fit.nfev
             if fit.cost < best.cost:
                 best = fit
-    # polish the best start to ``tol``, on every point
-    best = _local_fit(problem, coarse.values_from_x(best.x, nominal), nominal, reg, max_nfev, tol)
-    nfev += best.nfev
+    if coarse is not problem or explore != tol:  # the best start finished to ``tol``, on every point
+        best = _local_fit(problem, coarse.values_from_x(best.x, nominal), nominal, reg, max_nfev, tol)
+        nfev += best.nfev
     theta = problem.values_from_x(best.x, nominal)
     result = build_result(problem, theta, nominal, nfev, time.perf_counter() - t0, best, reg)
     result = replace(result, _assessor=partial(assess_fit, refit=identify))  # FitResult.adequacy, on first use
