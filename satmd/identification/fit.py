@@ -95,7 +95,8 @@ def identify(
         per channel ("channel", default) or over all fitted channels
         together ("global", paper eq. 13 as the paper's code has it).
     max_nfev : most function evaluations of each least-squares run (None: SciPy's default).
-    tol : ftol, xtol and gtol of least squares.
+    tol : ftol, xtol and gtol of the least squares that finishes the best start (the starts of a
+        multi-start stop at `EXPLORE_TOL` when it is looser: they are compared, not finished).
     seed : seed of the scrambled Sobol design.
     warn : also emit the result's poor-fit and pinned-parameter warnings
         (`satmd.errors.PoorFitWarning`, `PinnedParameterWarning`, both
