@@ -15,7 +15,7 @@ from ._cli import refused, run
 @pytest.fixture(scope="module")
 def levels(tmp_path_factory):
     d = tmp_path_factory.mktemp("structure")
-    recs = simulate_chain(joint=(2, 3), law=lambda dd, v: 3e9 * dd ** 3, levels=(1.0, 3.0, 8.0), seed=1)
+    recs = simulate_chain(joint=(2, 3), law=lambda dd, v: 3e9 * dd ** 3, levels=(1.0, 3.0, 8.0), seed=1, period=512)
     for r, name in zip(recs, ("L1", "L3", "L8")):
         save_recording(r, d / f"{name}.csv")
     return d
@@ -104,7 +104,7 @@ def test_locate_only_places_the_joint_in_seconds_and_refuses_what_needs_a_model(
 def test_a_structure_with_no_joint_saves_its_linear_model(capsys, tmp_path):
     """SPEC §11: no joint, no joint finding, and the linear model predicts every level within the noise; its
     model is saved as asked, not refused (a ground vibration test of a linear structure is a result too)."""
-    recs = simulate_chain(joint=(2, 3), law=lambda dd, v: 0.0 * dd, levels=(1.0, 3.0, 8.0), seed=2)
+    recs = simulate_chain(joint=(2, 3), law=lambda dd, v: 0.0 * dd, levels=(1.0, 3.0, 8.0), seed=2, period=512)
     for r, name in zip(recs, ("L1", "L3", "L8")):
         save_recording(r, tmp_path / f"{name}.csv")
     model = tmp_path / "linear.json"
