@@ -89,7 +89,8 @@ def files(seed: int = 38) -> dict:
     out["lab.mat"] = _mat(Force=force[None], Acceleration=np.stack([a1, a2, a1]), Fs=np.array([[FS]]))
     out["columns.mat"] = _mat(F=force[:, None], A=np.column_stack([a1, a2]), sample_rate=FS)
     out["nofs.mat"] = _mat(force=force, acc1=a1, acc2=a2)
-    out["cube.mat"] = _mat(Force=force[None], Acceleration=np.stack([a1, a2])[None], Fs=FS)
+    out["cube.mat"] = _mat(Force=force[None], Acceleration=np.stack([a1, a2])[None], Fs=FS)  # 1×2×N: axes of one dropped
+    out["realizations.mat"] = _mat(Force=np.stack([force, force]), Acceleration=np.stack([np.stack([a1, a2])] * 2), Fs=FS)
     out["textfs.mat"] = _mat(force=force, acc1=a1, acc2=a2, fs="1000")
     out["time.mat"] = _mat(force=force, acc1=a1, acc2=a2, t=np.arange(force.size) / FS)
     return out
@@ -127,7 +128,11 @@ def cases(case) -> list[dict]:
         add("refuse", ["--fs"], "nofs.mat", command=command)
         add("answer", [], "nofs.mat", "--fs", "1000", command=command)
         add("refuse", ["--fs"], "nofs.mat", "--fs", "-3", command=command)
-        add("refuse", ["cube.mat"], "cube.mat", "--map", "force=Force,a1=Acceleration[1]", command=command)
+        add("answer", [], "cube.mat", "--map", "force=Force,a1=Acceleration[1]", command=command)  # read as 2×N
+        add("refuse", ["one index per axis"], "realizations.mat", "--map", "force=Force[1],a1=Acceleration[1]",
+            command=command)  # realization × channel × time: which realization is not guessed
+        add("answer", [], "realizations.mat", "--map", "force=Force[1],a1=Acceleration[1,1],a2=Acceleration[1,2]",
+            command=command)
         add("refuse", ["textfs.mat"], "textfs.mat", command=command)
         add("answer", [], "time.mat", command=command)
         add("refuse", ["--fs"], "glitch.csv", "--fs", "1000", command=command)
