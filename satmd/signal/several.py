@@ -119,18 +119,19 @@ def common_frfs(recordings) -> list:
     # forces keep the rounded width their level test was calibrated with (exact windows raised its false
     # alarms on linear structures from 0 to 2 in 104 in benchmarks/structures_levels.py)
     width = _window_of(first) if swept else first.estimator.get("window_hz")
-    out = [first, *each_named(recordings[1:], lambda r: estimate_frf(r, band_hz=band, width_hz=width))]
+    out = [first, *each_named(recordings[1:], lambda r: estimate_frf(r, band_hz=band, width_hz=width), start=2)]
     return [_with_model_error(d, r, band, width) if d.estimator.get("method") == "lpm" else d
             for d, r in zip(out, recordings)]
 
 
-def each_named(recordings, call) -> list:
-    """``call(r)`` of each recording; a `DataError` about one of several recordings names its file (its source)
-    where the message does not: "the force is constant" alone does not say which level's."""
+def each_named(recordings, call, start: int = 1) -> list:
+    """``call(r)`` of each recording; a `DataError` about one of several recordings names its file (its source,
+    else its place among them counted from ``start``) where the message does not: "the force is constant" alone
+    does not say which level's."""
     from ..errors import DataError
 
     out = []
-    for i, r in enumerate(recordings, start=1):
+    for i, r in enumerate(recordings, start=start):
         try:
             out.append(call(r))
         except DataError as exc:

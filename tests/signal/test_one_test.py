@@ -104,3 +104,18 @@ def test_estimate_frf_refuses_levels_in_one_line(tmp_path, capsys):
     err = capsys.readouterr().err.strip().splitlines()
     assert rc == 2 and len(err) == 1 and "levels, not repeats" in err[0] and "satmd discover" in err[0]
     assert not (tmp_path / "H.csv").exists()
+
+
+def test_a_refusal_about_one_of_several_unnamed_recordings_counts_it_from_the_first():
+    """Without a source, the level at fault is named by its place among all the recordings given, also when a
+    stage looks at the levels after the first alone."""
+    from satmd.signal.several import each_named
+
+    def refuse(r):
+        raise DataError("the force is constant")
+
+    rec = Recording(100.0, {"force": np.ones(32), "acc1": np.zeros(32)}, meta={})
+    with pytest.raises(DataError, match="^recording 2: the force is constant$"):
+        each_named([rec, rec][1:], refuse, start=2)
+    with pytest.raises(DataError, match="^recording 1: "):
+        each_named([rec], refuse)
