@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from satmd.structure import Joint, JointLocation, LinearStructure, StructureModel
-from satmd.structure.choice import best_place, ranked_laws
+from satmd.structure.choice import PLACES, best_place, ranked_laws
 
 LINEAR = LinearStructure(("acc1", "acc2", "acc3"), np.array([-1.0 + 60j]), np.ones((3, 1), complex), np.zeros(3))
 
@@ -57,6 +57,21 @@ def test_the_best_place_stays_where_no_next_place_simulates_better_or_none_is_ne
     given = _Fits({(("acc2", "acc3"), "friction"): 0.01})  # a law given: the next place fitted with it, none weighed
     chosen = best_place(given, _located(50.0), model, ["friction"], [], None)
     assert chosen.joint.between == ("acc2", "acc3") and given.calls == [(("acc2", "acc3"), "friction")]
+
+
+def test_places_down_to_the_fifth_are_simulated_where_near_and_none_beyond():
+    places = [("acc1", "acc2"), ("acc2", "acc3"), ("acc1", "acc3"), ("acc1", "ground"), ("acc2", "ground"),
+              ("acc3", "ground")]
+    loc = JointLocation(("acc1", "acc2"), [{"between": list(p), "delta_bic": 10.0 * i, "law": "cubic"}
+                                           for i, p in enumerate(places)],
+                        "cubic", [{"law": "cubic", "delta_bic": 0.0}], [], [], "L1", [1.0, 8.0], evidence=1000.0)
+    scores = {(p, "cubic"): 0.05 for p in places} | {(("acc1", "ground"), "cubic"): 0.01}
+    fits = _Fits(scores)
+    model = fits.law(("acc1", "acc2"), "cubic", None)
+    chosen = best_place(fits, loc, model, ["cubic"], [], None)
+    # a root's spring to the ground ranked fourth by the spectra (on independent wings) is found by simulation
+    assert chosen.joint.between == ("acc1", "ground")
+    assert [b for b, _ in fits.calls[1:]] == places[1:PLACES] and PLACES == 5  # the sixth is not simulated
 
 
 def test_the_laws_tried_at_a_next_place_are_the_best_simulated_named_ones():
