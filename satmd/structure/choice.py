@@ -31,7 +31,7 @@ def best_place(fit, loc, model, laws, others, files):
     next place and named a beam's cubic a saturating spring that stiffened (its sign open in relative units):
     placed 32/36 and named 31/36, against 33 and 33. Judged with the path held, the chain stayed misplaced.
 
-    Five places, not three: on the same tests a beam's support and two wings' roots to the ground (clearance 82,
+    Five places, not three: on the tests after 39 a beam's support and two wings' roots to the ground (clearance 82,
     cubic 75 and 99) were fourth or fifth by the spectra, within `RIVAL` of the evidence; simulated, two of the
     three fitted the levels best at their true place (the beam 0.177 against 0.202, its held-out levels
     0.012-0.052 against 0.034-0.73)."""
