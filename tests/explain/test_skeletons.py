@@ -151,7 +151,7 @@ def test_distill_skeleton_backend_chooses_on_validation_and_never_sees_test():
 
     Z, y = planted(800)
     options = dict(backend="skeleton", zscore=False, max_complexity=15, validation=0.25, time_limit=None,
-                   subsample=300, keep=6)
+                   subsample=300, keep=4)
     res = distill(Z, y, **options)
     assert res.info["chosen_on"] == "r2_cv" and res.complexity <= 15  # finalists by K-fold CV
     assert all("r2_val" in p for p in res.pareto)

@@ -482,7 +482,7 @@ def test_the_joint_pass_is_the_ode_of_the_same_model(law, form, coefficients, au
     joint = Joint(names, law, np.array(coefficients), np.array(aux), np.array([0.8 + 0.0j, 0.5 + 0.0j]), form=form)
     model = StructureModel(linear, joint, (1.0, 1.0), oversample=4)
     rng = np.random.default_rng(3)
-    force = band_limited(rng.standard_normal(256), fs) * 60.0  # a second: the kink crossed many times
+    force = band_limited(rng.standard_normal(128), fs) * 60.0  # half a second: the kink crossed many times
     drive = Drive(model, force, fs, 0)
     pair = drive.pair * joint.coupling
     rd, rv = 2 * pair / lam ** 2, 2 * pair / lam
