@@ -41,9 +41,14 @@ def best_place(fit, loc, model, laws, others, files):
     fit.say(f"the next {len(rivals)} place(s) by the spectra ({', '.join(' and '.join(p) for p in rivals)}), "
             f"{' and '.join(laws)} fitted at each on every level ...")
     tried = [model, *fit.laws([(p, w) for p in rivals for w in laws], files)]
-    fit.say("; ".join(f"{' and '.join(m.joint.between)} ({m.joint.law}): mean NRMSE {score(m):.4f}"
-                      for m in tried if m.joint is not None))
-    best = best_fitting(tried)
+    at: dict = {}  # place -> its best law (`best_fitting`)
+    for m in tried:
+        if m.joint is not None:
+            at.setdefault(m.joint.between, []).append(m)
+    kept = [(fit.misfit(m), m) for m in (best_fitting(models) for models in at.values())]
+    fit.say("; ".join(f"{' and '.join(m.joint.between)} ({m.joint.law}): mean NRMSE {score(m):.4f}, misfit {c:.4g}"
+                      for c, m in kept))
+    best = min(kept, key=lambda pair: pair[0])[1]
     if best.joint is None or best.joint.between == model.joint.between or not others:
         return best
     fit.say(f"{', '.join(others)} between {best.joint.between[0]} and {best.joint.between[1]}: each fitted ...")

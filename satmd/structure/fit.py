@@ -18,7 +18,7 @@ from .locate import shape_of
 from .model import Drive, Joint, StructureModel
 from .newtons import in_newtons
 from .loop import PAIRS, with_loop_modes
-from .outside import above_band, loop_poles
+from .outside import above_band, loop_poles, same_modes
 from .output_error import BAND_STEPS, TOP, in_band, output_error, with_band_modes_refined
 from .outputs import resolved_outputs
 from .simulations import cost, drives_of, fit_span, oversampling, stable, with_table
@@ -191,7 +191,7 @@ class _Fit:
             joint = Joint(between, law, c, aux, kappa, form=lw.term_names)
             model = StructureModel(linear, joint, self.levels, reference=reference)
             wider = above_band(model, spectra, apart)
-            if apart and _same_modes(wider, above_band(model, spectra)):
+            if apart and same_modes(wider, above_band(model, spectra)):
                 continue  # this start's fit is the one made without ``apart``
             model, drives = with_modes_above(model, wider, spectra[0].fs_hz, recordings, self.measured, self.span)
             say(f"output-error fit of the {law} joint between {between[0]} and {between[1]} on "
@@ -242,12 +242,12 @@ class _Fit:
         if free_path:
             a, b = model.joint.between
             self.say(f"output-error fit of the {model.joint.law} joint between {a} and {b} with its path free ...")
-            drives, before = drives_of(model, self.recordings, self.measured, self.span), cost(model, self.whole(model))
+            drives, before = drives_of(model, self.recordings, self.measured, self.span), self.misfit(model)
             holds = self.holds_beyond(model)
             for solved in (True, False):  # the channels solved inside the fit, else tied to the path (`output_error`)
                 freed = output_error(model, drives, self.ref, self.max_nfev, fixed_path=False, solved=solved)
                 # fitted on the first periods, kept where the whole records say so too (a slow run-away shows there)
-                if cost(freed, self.whole(freed)) <= before and (self.holds_beyond(freed) or not holds):
+                if self.misfit(freed) <= before and (self.holds_beyond(freed) or not holds):
                     model = freed
                     break
         model = in_newtons(model, self.driving_point)
@@ -268,13 +268,13 @@ class _Fit:
             return model
         hz = ", ".join(f"{f:.1f}" for f in np.abs(poles) / (2 * np.pi))
         self.say(f"modes above the band in the joint's loop, from {hz} Hz ...")
-        before, top_hz = cost(model, self.whole(model)), band_top_hz(self.spectra)
+        before, top_hz = self.misfit(model), band_top_hz(self.spectra)
 
         def with_chain(candidate):  # its acquisition's low-pass found again on the whole records
             return replace(candidate, acquisition=acquisition_of(candidate, self.whole(candidate), top_hz))
 
         def better(candidate) -> bool:
-            return cost(candidate, self.whole(candidate)) < before
+            return self.misfit(candidate) < before
 
         looped = with_loop_modes(bare, poles, self.recordings, self.measured, self.span, self.max_nfev,
                                  self.ref.fs_hz, lambda c: better(with_chain(c)))
@@ -295,14 +295,14 @@ class _Fit:
         if model.joint is None:
             return model
         band, top = fitted_band(self.spectra), TOP * float(self.recordings[0].fs_hz) / 2
-        current, holds = cost(model, self.whole(model)), self.holds_beyond(model)
+        current, holds = self.misfit(model), self.holds_beyond(model)
         for stage, (free, which) in enumerate(((band, "in the band"), ((band[0], top), "in and above the band"))):
             if stage and in_band(model.linear.poles, (band[1], top)).size == 0:
                 break  # no mode above the band: the second fit would repeat the first
             self.say(f"the modes {which} refined with the joint's law ...")
             refined = with_band_modes_refined(model, self.recordings, self.measured, self.span, free,
                                               min(self.max_nfev, BAND_STEPS))
-            trial = np.inf if refined is None else cost(refined, self.whole(refined))
+            trial = np.inf if refined is None else self.misfit(refined)
             if trial >= current:
                 continue
             held = self.holds_beyond(refined)
@@ -370,7 +370,7 @@ class _Fit:
         other = self.finished(other, free_path, files)
         if contradicts(other):
             return model
-        return other if cost(other, self.whole(other)) < cost(model, self.whole(model)) else model
+        return other if self.misfit(other) < self.misfit(model) else model
 
     def widened(self, model) -> StructureModel:
         """``model`` with more modes above the band (`above_band`), found through its fitted law and its
@@ -386,14 +386,13 @@ class _Fit:
         wider = replace(wider, oversample=oversampling(wider.linear, self.ref.fs_hz))
         wider = output_error(wider, drives_of(wider, self.recordings, self.measured, self.span), self.ref,
                              self.max_nfev, fixed_path=True)
-        return wider if cost(wider, self.whole(wider)) < cost(model, self.whole(model)) else model
+        return wider if self.misfit(wider) < self.misfit(model) else model
+
+    def misfit(self, model) -> float:
+        """`cost` of ``model`` on the whole records: what every stage's choice weighs (a slow run-away shows there)."""
+        return cost(model, self.whole(model))
 
     def whole(self, model) -> list:
         """(Drive, measured responses) of every recording, whole, through ``model``."""
         return [(Drive(model, drive_force(r), float(r.fs_hz), warmup_of(r)),
                  np.array([np.asarray(r[ch], float) for ch in self.names])) for r in self.recordings]
-
-
-def _same_modes(a, b) -> bool:
-    """Whether two models have the same poles."""
-    return a.linear.poles.shape == b.linear.poles.shape and bool(np.allclose(a.linear.poles, b.linear.poles))

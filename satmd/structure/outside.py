@@ -223,3 +223,8 @@ def _residues(poles, blocks):
         T[o] = coef[:poles.size] + 1j * coef[poles.size:]
         rss += float(np.sum((yr - Xr @ coef) ** 2))
     return T, rss
+
+
+def same_modes(a, b) -> bool:
+    """Whether two models have the same poles."""
+    return a.linear.poles.shape == b.linear.poles.shape and bool(np.allclose(a.linear.poles, b.linear.poles))
