@@ -58,7 +58,7 @@ def best_place(fit, loc, model, laws, others, files):
     fit.say("; ".join(f"{' and '.join(m.joint.between)} ({m.joint.law}): mean NRMSE {score(m):.4f}, misfit {c:.4g}"
                       for c, m in kept))
     best = min(kept, key=lambda pair: pair[0])[1]
-    if best.joint is None or best.joint.between == model.joint.between or not others:
+    if best.joint.between == model.joint.between or not others:
         return best
     fit.say(f"{', '.join(others)} between {best.joint.between[0]} and {best.joint.between[1]}: each fitted ...")
     here = [m for m in tried if m.joint is not None and m.joint.between == best.joint.between]
