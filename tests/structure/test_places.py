@@ -60,7 +60,7 @@ def test_places_are_weighed_on_the_misfit_their_fits_minimise_and_laws_on_the_me
                  {(true, "cubic"): 0.20, (true, "softening"): 0.25, (rival, "cubic"): 0.27})
     model = fits.law(true, "softening", None)
     chosen = best_place(fits, _located(50.0), model, ["cubic"], [], None)
-    # the rival's 0.15 mean NRMSE beats both laws here; by misfit the place's best law (softening, 0.25) beats it
+    # the rival's 0.15 mean NRMSE beats the softening's 0.17 here; by misfit the softening (0.25) beats it (0.27)
     assert chosen is model
     swapped = _Fits(fits.scores, {**fits.misfits, (rival, "cubic"): 0.24})
     assert best_place(swapped, _located(50.0), model, ["cubic"], [], None).joint.between == rival
