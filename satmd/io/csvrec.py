@@ -57,8 +57,10 @@ def _check_header(path, header, lineno, ours=False):
     seen = set()
     for j, name in enumerate(header[1:], start=2):
         if not (is_role(name) or (ours and name and name != "time_s")):
-            raise FormatError(path, f"unknown column {name!r} (known: force, acc1, acc2, acc3, ...)",
-                              line=lineno, column=j)
+            free = 1 + max((int(h[3:]) for h in header if is_role(h) and h.startswith("acc")), default=0)
+            raise FormatError(path, f"unknown column {name!r} (known: force, acc1, acc2, acc3, ...): a lab's names "
+                                    f"are read with a channel map that names every column, e.g. force=force,a1=acc1,"
+                                    f"...,a{free}={name}", line=lineno, column=j)
         if name in seen:
             raise FormatError(path, f"duplicate column {name!r}", line=lineno, column=j)
         seen.add(name)

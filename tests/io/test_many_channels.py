@@ -81,8 +81,13 @@ def test_csv_writer_writes_other_channels_last_and_reads_them_back(tmp_path):
         save_recording(Recording(FS, {"acc1": chans["acc2"], "a,b": chans["mic"]}), tmp_path / "bad.csv")
     q = tmp_path / "typo.csv"  # without satmd's comment line a name that is no role is a typo
     q.write_text("time_s,force,acc_3\n0,1,2\n0.001,1,2\n")
-    with pytest.raises(FormatError, match="unknown column 'acc_3'"):
+    with pytest.raises(FormatError, match="unknown column 'acc_3'.*a channel map that names every column.*a1=acc_3"):
         load_recording(q)
+    q.write_text("time_s,force,acc1,acc2,tip\n0,1,2,3,4\n0.001,1,2,3,4\n")  # the map said, with the next number
+    with pytest.raises(FormatError, match="unknown column 'tip'.*a3=tip"):
+        load_recording(q)
+    assert list(load_recording(q, channel_map="force=force,a1=acc1,a2=acc2,a3=tip").channels) == [
+        "force", "acc1", "acc2", "acc3"]
 
 
 def test_lab_csv_with_acc3_to_acc5(tmp_path):
