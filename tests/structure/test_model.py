@@ -237,6 +237,37 @@ def test_a_fitted_model_predicts_a_level_it_never_saw(cubic_levels, cubic_model)
     assert lo < CUBIC < hi < 2 * lo and lo < k3 < hi and set(m.joint.ci95) == {"k3", "k", "c"}
 
 
+def test_where_the_joint_s_model_misses_is_told_inside_or_above_the_band(cubic_levels, cubic_model):
+    """`discover`'s explanation says where the joint's model misses most, inside the force's band or above it
+    (where only the joint's harmonics reach), and says nothing of a model within twice the level-1 linear floor."""
+    from dataclasses import replace
+    from types import SimpleNamespace
+
+    from satmd.discovery.nonlinear.modes import where_it_misses
+
+    fitted = [cubic_levels[0], cubic_levels[2]]
+    assert where_it_misses(cubic_model, fitted) == ""
+    j = cubic_model.joint
+    no_law = replace(cubic_model, joint=replace(j, coefficients=np.r_[0.0, j.coefficients[1:]]),
+                     fit={**cubic_model.fit, "nonlinear": cubic_model.fit["linear"]})
+    told = where_it_misses(no_law, fitted)
+    worst = max(no_law.predict(fitted[1]).nrmse)
+    assert told.startswith("; its worst channel, acc") and " at 8 N RMS" in told and f"misses {worst:.2f}" in told
+    assert "most of it inside the force's band" in told
+
+    class Harmonics:  # a model whose top level misses above the band: 0.30 there of 0.32
+        fit = {"linear": [[0.01, 0.012], [0.2, 0.3]], "nonlinear": [[0.01, 0.012], [0.1, 0.32]]}
+
+        def predict(self, recording):
+            return SimpleNamespace(nrmse=[0.1, 0.32], channels=["acc1", "acc2"], level=8.0, band_top_hz=40.0,
+                                   above_band={"nrmse": [0.05, 0.30], "measured": [0.1, 0.45]})
+
+    told = where_it_misses(Harmonics(), fitted)
+    assert told == ("; its worst channel, acc2 at 8 N RMS, misses 0.32 of its RMS, most of it above the force's "
+                    "band (40 Hz: 0.30, where 0.45 of the response lies and only the joint's harmonics reach, so "
+                    "modes there are known from them alone; 0.11 inside it)")
+
+
 def test_the_band_s_modes_are_refitted_with_the_law(cubic_levels, cubic_model):
     """In-band poles 1 % off in frequency and 50 % in damping (as a lowest level that holds its joint linearised
     gives them) are put back by `with_band_modes_refined`, which fits them in time with the law's coefficients: the fitted

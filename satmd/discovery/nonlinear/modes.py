@@ -19,6 +19,7 @@ from .distortion import UNEXPLAINED_NL
 
 MODES_ALPHA = 0.05  # family-wise level of the trend tests once a test has detected a level dependence
 NOT_SATMD = "the SATMD model does not describe these data, so no SATMD element is named"
+WELL = 2.0  # a joint's model within this many times the floor (`where_it_misses`): where it misses is not told
 
 
 def level_modes(freq_hz, frfs, stds, levels, alpha: float = 0.05, dof=None) -> list:
@@ -220,6 +221,7 @@ def with_joint(report, recordings, fit_joint: bool = True):
                             f"{worst_nl:.2f}")
             if model.acquisition is not None:  # the measurement chain's, not the structure's: said apart
                 explanation += f"; {model.acquisition.describe()}"
+            explanation += where_it_misses(model, recordings)
         else:  # said, not hidden: the place or the law the levels point to does not make a better simulation
             explanation += (f"; its model ({model.joint.formula()}{unit}) does not simulate the recordings better than "
                             f"the linear one (worst NRMSE {worst_lin:.2f} linear, {worst_nl:.2f} with the joint): the "
@@ -258,6 +260,31 @@ def untrusted_channels(recordings, responses) -> dict:
             elif np.ptp(np.asarray(r[c], float)) == 0:
                 out[c] = f"constant in {name}: the sensor recorded nothing"
     return out
+
+
+def where_it_misses(model, recordings) -> str:
+    """A clause on the joint's model's worst recording and channel: how much of its miss lies above the force's
+    band (the joint's harmonics and the modes they reach, which the force never showed the linear part) and how
+    much inside it; empty where its worst miss is within `WELL` times the lowest level's linear model's on its
+    own level (the noise and what a linear model leaves there)."""
+    fits = [max(row) for row in model.fit["nonlinear"]]
+    floor = min(max(row) for row in model.fit["linear"])
+    i = int(np.argmax(fits))
+    if not np.isfinite(fits[i]) or fits[i] <= WELL * floor:
+        return ""
+    p = model.predict(recordings[i])
+    c = int(np.argmax(p.nrmse))
+    total, above, there = p.nrmse[c], p.above_band["nrmse"][c], p.above_band["measured"][c]
+    if not np.isfinite(total):
+        return ""
+    inside = float(np.sqrt(max(total ** 2 - above ** 2, 0.0)))
+    head = f"; its worst channel, {p.channels[c]} at {p.level:.3g} N RMS, misses {total:.2f} of its RMS, most of it "
+    if above > inside:
+        return head + (f"above the force's band ({p.band_top_hz:.3g} Hz: {above:.2f}, where {there:.2f} of the "
+                       f"response lies and only the joint's harmonics reach, so modes there are known from them "
+                       f"alone; {inside:.2f} inside it)")
+    return head + (f"inside the force's band ({inside:.2f}; {above:.2f} above {p.band_top_hz:.3g} Hz, where "
+                   f"{there:.2f} of the response lies)")
 
 
 def _structure_model(recordings, loc, channels=None):
