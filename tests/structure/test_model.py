@@ -243,15 +243,18 @@ def test_where_the_joint_s_model_misses_is_told_inside_or_above_the_band(cubic_l
     from dataclasses import replace
     from types import SimpleNamespace
 
-    from satmd.discovery.nonlinear.modes import where_it_misses
+    from satmd.discovery.nonlinear.modes import told_miss, where_it_misses
 
     fitted = [cubic_levels[0], cubic_levels[2]]
-    assert where_it_misses(cubic_model, fitted) == ""
+    assert where_it_misses(cubic_model, fitted) is None
     j = cubic_model.joint
     no_law = replace(cubic_model, joint=replace(j, coefficients=np.r_[0.0, j.coefficients[1:]]),
                      fit={**cubic_model.fit, "nonlinear": cubic_model.fit["linear"]})
-    told = where_it_misses(no_law, fitted)
+    found = where_it_misses(no_law, fitted)
     worst = max(no_law.predict(fitted[1]).nrmse)
+    assert found["recording"] == 1 and found["nrmse"] == pytest.approx(worst, abs=1e-4)
+    assert found["above_band"] ** 2 + found["inside_band"] ** 2 == pytest.approx(worst ** 2, rel=1e-3)
+    told = told_miss(found)
     assert told.startswith("; its worst channel, acc") and " at 8 N RMS" in told and f"misses {worst:.2f}" in told
     assert "most of it inside the force's band" in told
 
@@ -262,7 +265,7 @@ def test_where_the_joint_s_model_misses_is_told_inside_or_above_the_band(cubic_l
             return SimpleNamespace(nrmse=[0.1, 0.32], channels=["acc1", "acc2"], level=8.0, band_top_hz=40.0,
                                    above_band={"nrmse": [0.05, 0.30], "measured": [0.1, 0.45]})
 
-    told = where_it_misses(Harmonics(), fitted)
+    told = told_miss(where_it_misses(Harmonics(), fitted))
     assert told == ("; its worst channel, acc2 at 8 N RMS, misses 0.32 of its RMS, most of it above the force's "
                     "band (40 Hz: 0.30, where 0.45 of the response lies and only the joint's harmonics reach, so "
                     "modes there are known from them alone; 0.11 inside it)")

@@ -221,7 +221,10 @@ def with_joint(report, recordings, fit_joint: bool = True):
                             f"{worst_nl:.2f}")
             if model.acquisition is not None:  # the measurement chain's, not the structure's: said apart
                 explanation += f"; {model.acquisition.describe()}"
-            explanation += where_it_misses(model, recordings)
+            worst = where_it_misses(model, recordings)
+            if worst is not None:
+                fit["worst"] = worst
+                explanation += told_miss(worst)
         else:  # said, not hidden: the place or the law the levels point to does not make a better simulation
             explanation += (f"; its model ({model.joint.formula()}{unit}) does not simulate the recordings better than "
                             f"the linear one (worst NRMSE {worst_lin:.2f} linear, {worst_nl:.2f} with the joint): the "
@@ -262,29 +265,50 @@ def untrusted_channels(recordings, responses) -> dict:
     return out
 
 
-def where_it_misses(model, recordings) -> str:
-    """A clause on the joint's model's worst recording and channel: how much of its miss lies above the force's
-    band (the joint's harmonics and the modes they reach, which the force never showed the linear part) and how
-    much inside it; empty where its worst miss is within `WELL` times the lowest level's linear model's on its
-    own level (the noise and what a linear model leaves there)."""
+def where_it_misses(model, recordings) -> dict | None:
+    """The joint's model's worst recording and channel, and how much of its miss lies above the force's band (the
+    joint's harmonics and the modes they reach, which the force never showed the linear part) and how much inside
+    it; None where that miss is within `WELL` times what the lowest level's linear model leaves on its own level
+    (the noise, and what a linear model leaves there).
+
+    Parameters
+    ----------
+    model : StructureModel with its fit table (`fit["nonlinear"]`, one row per recording)
+    recordings : the Recordings it was fitted on, in the table's order
+
+    Returns
+    -------
+    dict or None
+        ``recording`` (its index), ``channel``, ``level`` (force RMS), ``nrmse``, ``above_band`` and
+        ``inside_band`` (the NRMSE's two parts: their squares add up to its square), ``measured_above_band``
+        (the response there over the channel's RMS) and ``band_top_hz``.
+    """
     fits = [max(row) for row in model.fit["nonlinear"]]
     floor = min(max(row) for row in model.fit["linear"])
     i = int(np.argmax(fits))
     if not np.isfinite(fits[i]) or fits[i] <= WELL * floor:
-        return ""
+        return None
     p = model.predict(recordings[i])
     c = int(np.argmax(p.nrmse))
-    total, above, there = p.nrmse[c], p.above_band["nrmse"][c], p.above_band["measured"][c]
+    total, above = float(p.nrmse[c]), float(p.above_band["nrmse"][c])
     if not np.isfinite(total):
-        return ""
-    inside = float(np.sqrt(max(total ** 2 - above ** 2, 0.0)))
-    head = f"; its worst channel, {p.channels[c]} at {p.level:.3g} N RMS, misses {total:.2f} of its RMS, most of it "
+        return None
+    return {"recording": i, "channel": p.channels[c], "level": round(float(p.level), 6), "nrmse": round(total, 4),
+            "above_band": round(above, 4), "inside_band": round(float(np.sqrt(max(total ** 2 - above ** 2, 0.0))), 4),
+            "measured_above_band": round(float(p.above_band["measured"][c]), 4),
+            "band_top_hz": round(float(p.band_top_hz), 4)}
+
+
+def told_miss(worst: dict) -> str:
+    """`where_it_misses`'s finding as a clause of the joint's explanation."""
+    head = (f"; its worst channel, {worst['channel']} at {worst['level']:.3g} N RMS, misses {worst['nrmse']:.2f} "
+            "of its RMS, most of it ")
+    top, above, inside, there = (worst[k] for k in ("band_top_hz", "above_band", "inside_band", "measured_above_band"))
     if above > inside:
-        return head + (f"above the force's band ({p.band_top_hz:.3g} Hz: {above:.2f}, where {there:.2f} of the "
-                       f"response lies and only the joint's harmonics reach, so modes there are known from them "
-                       f"alone; {inside:.2f} inside it)")
-    return head + (f"inside the force's band ({inside:.2f}; {above:.2f} above {p.band_top_hz:.3g} Hz, where "
-                   f"{there:.2f} of the response lies)")
+        return head + (f"above the force's band ({top:.3g} Hz: {above:.2f}, where {there:.2f} of the response lies "
+                       f"and only the joint's harmonics reach, so modes there are known from them alone; "
+                       f"{inside:.2f} inside it)")
+    return head + f"inside the force's band ({inside:.2f}; {above:.2f} above {top:.3g} Hz, where {there:.2f} of the response lies)"
 
 
 def _structure_model(recordings, loc, channels=None):
