@@ -6,6 +6,8 @@ sharply at the band edge.
 """
 from __future__ import annotations
 
+import functools
+
 import numpy as np
 import pytest
 import scipy.signal as sg
@@ -152,6 +154,7 @@ def test_lab_conditions_are_reproducible_and_varied():
         ForceSpectrum(rolloff_order=-1)
 
 
+@functools.cache
 def _random_chain(seconds=60.0, seed=3):
     """A linear 5-mass chain (ζ = 1 % at its 9.1 Hz first mode) driven by band-limited random noise, 1 % noise."""
     from scipy import signal
