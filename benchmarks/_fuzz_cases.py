@@ -137,8 +137,9 @@ def structure_cases(base) -> list[dict]:
     # a lab's realizations (the F-16's odd multisines: Acceleration channel × realization × time)
     rng = np.random.default_rng(5)
     real = _npz(Force=rng.normal(size=(3, 2048)), Acceleration=rng.normal(size=(2, 3, 2048)), Fs=np.float64(256.0))
-    add(case("structure levels", "cli", "refuse", ["real.npz", "Force", "3×2048", "Force[1]"],
-             argv=["discover", "{work}/real.npz"], files={"real.npz": real}, label="realizations, no index"))
+    odd = _npz(Force=rng.normal(size=(3, 2048)), Acceleration=rng.normal(size=(2, 5, 2048)), Fs=np.float64(256.0))
+    add(case("structure levels", "cli", "refuse", ["odd.npz", "Acceleration", "2×5×2048", "3×2048"],
+             argv=["discover", "{work}/odd.npz"], files={"odd.npz": odd}, label="realizations the force has not"))
     add(case("structure levels", "cli", "refuse", ["real.npz", "Acceleration[1,9]", "1..2, 1..3"],
              argv=["discover", "{work}/real.npz", "--map", "force=Force[1],a1=Acceleration[1,9],a2=Acceleration[2,1]"],
              files={"real.npz": real}, label="a realization that is not there"))

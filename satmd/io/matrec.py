@@ -7,7 +7,8 @@ a channel map says
 variable, or one row of a matrix of signals, counted from 1; the long axis of a
 matrix is time; any number of accelerometers ``a<N>``). An array of more axes (a lab's realizations: the
 F-16 benchmark's odd multisines hold ``Acceleration`` 3×9×49152, channel × realization × time) takes one index
-per axis but time, ``Acceleration[1,5]``; axes of length one are dropped (3×1×N reads as 3×N). The sample rate
+per axis but time, ``Acceleration[1,5]``; without a map every realization is read, one after another (the
+recording's `Recording.realisations`); axes of length one are dropped (3×1×N reads as 3×N). The sample rate
 is given, or a variable (`FS_NAMES`, any case), or a uniform time vector (`TIME_NAMES`).
 """
 from __future__ import annotations
@@ -27,6 +28,7 @@ FS_NAMES = ("fs_hz", "fs", "sample_rate", "samplerate", "sampling_rate", "sampli
 TIME_NAMES = ("time_s", "time", "t")
 ACCELERATION_PREFIX = "acc"  # a matrix called Acceleration, Accel, acc, ...: one accelerometer a row
 MAX_MATRIX_ROWS = 64  # more rows than a test has accelerometers: not a matrix of signals
+MAX_REALISATIONS = 1000  # a force matrix with more rows than this is not a lab's realisations
 
 
 def _lookup(variables, name):
@@ -169,6 +171,50 @@ def _response_matrix(path, v):
     return found[0], {f"acc{i + 1}": vector_variable(path, f"{found[0]}[{i + 1}]", r) for i, r in enumerate(rows)}
 
 
+def _realisations(path, v):
+    """(signals, used, meta) where the force is a matrix of realisations (realisation × time, `MAX_REALISATIONS`
+    at most): each channel is its realisations one after another, and ``meta`` says where each starts
+    (``realisations``, ``realisation_samples``: `Recording.realisations` splits them again). The responses are
+    ``acc<N>`` variables of the force's shape, or the one matrix of accelerations beside it, channel ×
+    realisation × time (the F-16 benchmark's odd multisines: 3×9×49152; realisation × channel read as well).
+    None when the force is one signal."""
+    key = _lookup(v, "force")
+    if key is None or np.asarray(v[key]).dtype.kind not in "biuf":
+        return None
+    force = _squeezed(np.asarray(v[key]))
+    if force.ndim != 2 or min(force.shape) < 2 or min(force.shape) > MAX_REALISATIONS:
+        return None
+    force = _signal_rows(force)
+    r, n = force.shape
+    signals, used = {"force": force}, {key}
+    for name in ordered({k.lower() for k in v if is_role(k.lower()) and k.lower() != "force"}):
+        k = _lookup(v, name)
+        a = _squeezed(np.asarray(v[k]))
+        if a.ndim != 2 or _signal_rows(a).shape != (r, n):
+            raise FormatError(path, f"{k!r} has shape {_shape(a)}, the force {r}×{n} (realisation × time): "
+                                    "each response needs the force's realisations")
+        signals[name], used = _signal_rows(a), used | {k}
+    if len(signals) == 1:
+        found = [k for k, a in v.items() if k.lower().startswith(ACCELERATION_PREFIX)
+                 and np.asarray(a).dtype.kind in "biuf" and np.asarray(a).size >= r * n and np.asarray(a).ndim >= 2]
+        if len(found) != 1:
+            return None
+        a = _squeezed(np.asarray(v[found[0]]))
+        a = np.moveaxis(a, int(np.argmax(a.shape)), -1)
+        if a.ndim == 2 and a.shape == (r, n):
+            a = a[None]  # one accelerometer's realisations
+        if a.ndim != 3 or a.shape[-1] != n or r not in a.shape[:2]:
+            raise FormatError(path, f"{found[0]!r} has shape {_shape(np.asarray(v[found[0]]))}, the force {r}×{n} "
+                                    "(realisation × time): give channel × realisation × time, or a channel map "
+                                    f"that picks one realisation, e.g. force={key}[1],a1={found[0]}[1,1]")
+        channels_first = a.shape[1] == r  # F-16's order; realisation × channel where only that fits
+        a = a if channels_first else a.transpose(1, 0, 2)
+        signals.update({f"acc{i + 1}": a[i] for i in range(a.shape[0])})
+        used.add(found[0])
+    flat = {name: vector_variable(path, name, x.reshape(-1)) for name, x in signals.items()}
+    return flat, used, {"realisations": str(r), "realisation_samples": str(n)}
+
+
 def read_recording_variables(path, channel_map=None, fs_hz=None):
     """(fs_hz, {name: series}) from a .mat / .npz recording.
 
@@ -176,14 +222,23 @@ def read_recording_variables(path, channel_map=None, fs_hz=None):
     case; beside a force, one matrix called ``Acceleration``, ``acc``, ... is read a row an accelerometer,
     ``acc1`` from row 1), or as ``channel_map`` says (``"force=Force,a1=Acceleration[2],a3=Acceleration[1]"``:
     a variable, or one row of a matrix of signals, counted from 1; any ``a<N>``).
-    The sample rate is ``fs_hz``, or a variable (`FS_NAMES`, any case), or a time vector.
+    The sample rate is ``fs_hz``, or a variable (`FS_NAMES`, any case), or a time vector. A force of several
+    realisations (realisation × time) is read whole, its realisations one after another (`_realisations`).
+
+    Returns
+    -------
+    (fs_hz, {name: series}, meta): ``meta`` says where realisations start (empty for one signal per channel)
     """
     path = Path(path)
     v = load_variables(path)
     if _lookup(v, "freq_hz") is not None and _lookup(v, "fs_hz") is None and fs_hz is None:
         raise FormatError(path, "it holds 'freq_hz' (it looks like FRFs), no sample rate")
     fs, fs_key = _sample_rate(path, v, fs_hz)
-    if channel_map:
+    meta: dict = {}
+    several = None if channel_map else _realisations(path, v)
+    if several is not None:
+        signals, used, meta = several
+    elif channel_map:
         roles = _parse_variable_map(path, channel_map)
         signals = {role: _signal(path, v, spec, role) for role, spec in roles.items()}
         used = {_lookup(v, _source(path, spec, role)[0]) for role, spec in roles.items()}
@@ -213,7 +268,7 @@ def read_recording_variables(path, channel_map=None, fs_hz=None):
     if len(set(lengths.values())) > 1:
         raise FormatError(path, "signals have different lengths: " + ", ".join(f"{n} {k}" for n, k in lengths.items()))
     warn_unused(path, v, used | {fs_key, "time_s", "meta"})
-    return fs, signals
+    return fs, signals, meta
 
 
 def is_recording_file(path) -> bool:

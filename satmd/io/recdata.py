@@ -195,6 +195,20 @@ class Recording:
         except KeyError:
             raise DataError(f"no channel {name!r} in the recording (has {', '.join(self.channels)})") from None
 
+    def realisations(self) -> list:
+        """The recording's realisations, each a recording of its own (a lab's matrix of realisations read whole,
+        meta ``realisations`` and ``realisation_samples``); ``[self]`` for one. Each starts from whatever the
+        excitation left before it, so each is simulated on its own."""
+        try:
+            count, n = int(self.meta.get("realisations", 1)), int(self.meta.get("realisation_samples", 0))
+        except ValueError:
+            return [self]
+        if count < 2 or n < 2 or count * n != self.n_samples:
+            return [self]
+        meta = {k: v for k, v in self.meta.items() if k not in ("realisations", "realisation_samples")}
+        return [Recording(self.fs_hz, {c: v[i * n:(i + 1) * n] for c, v in self.channels.items()}, self.units,
+                          {**meta, "realisation": str(i + 1)}, self.labels) for i in range(count)]
+
     def rename(self, mapping: dict) -> "Recording":
         """New names for some channels: {old: new}."""
         new = {mapping.get(k, k): v for k, v in self.channels.items()}

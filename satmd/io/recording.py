@@ -53,10 +53,10 @@ def read_recording_variables(path, channel_map=None, fs_hz=None) -> Recording:
     from .matrec import read_recording_variables as _read
 
     path = Path(path)
-    fs, signals = _read(path, channel_map, fs_hz)
+    fs, signals, meta = _read(path, channel_map, fs_hz)
     try:
         rec = Recording(fs, signals, {n: si_unit(n) for n in signals},
-                        {"source": str(path), "format": path.suffix.lower().lstrip(".")})
+                        {"source": str(path), "format": path.suffix.lower().lstrip("."), **meta})
     except DataError as exc:
         raise FormatError(path, str(exc)) from None
     warn_clipping(path, rec)

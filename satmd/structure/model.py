@@ -187,7 +187,9 @@ class StructureModel:
         return drive.outputs(self.joint if joint else None)
 
     def predict(self, recording, file: str | None = None) -> Prediction:
-        """Simulate a recording's force through the model and compare with its responses (SPEC §11)."""
+        """Simulate a recording's force through the model and compare with its responses (SPEC §11). A recording
+        of several realisations (`Recording.realisations`) is simulated one realisation at a time, each from its
+        own start, and judged over all of them."""
         name = file or str(recording.meta.get("source", "recording"))
         missing = [c for c in self.channels if c not in recording.channels]
         if missing or "force" not in recording.channels:
@@ -197,13 +199,10 @@ class StructureModel:
         measured = np.array([np.asarray(recording[c], float) for c in self.channels])
         if not (np.all(np.isfinite(force)) and np.all(np.isfinite(measured))):
             raise DataError(f"{name}: NaN or inf in the force or a response")
-        recording = at_the_door(recording)  # each response about its mean (`centred`): an offset is the sensor's
-        measured = np.array([np.asarray(recording[c], float) for c in self.channels])
-        warm = warmup_of(recording)
-        drive = Drive(self, drive_force(recording), float(recording.fs_hz), warm)
-        lin = drive.outputs(None)
-        nl = drive.outputs(self.joint) if self.joint is not None else lin
-        peak = drive.joint_peak
+        parts = [self._simulated(part) for part in recording.realisations()]
+        measured, lin, nl = (np.concatenate([p[i] for p in parts], axis=1) for i in range(3))
+        peaks = [p[3] for p in parts if p[3] is not None]
+        peak = max(peaks) if peaks else None
         level = force_level(force)
         lo, hi = self.levels
         fs = float(recording.fs_hz)
@@ -215,7 +214,17 @@ class StructureModel:
                           fs, {c: np.array([m, a, b]) for c, m, a, b in zip(self.channels, measured, lin, nl)},
                           top, {"nrmse": [e for e, _ in split], "measured": [t for _, t in split]},
                           self.band_hz, None if self.band_hz is None else share_outside(force, fs, self.band_hz),
-                          None if not self.reach or peak is None else peak / self.reach)
+                          None if not self.reach or peak is None else peak / self.reach, len(parts))
+
+    def _simulated(self, recording):
+        """(measured, linear, nonlinear, the joint's peak force) of one realisation: responses (C, N) about
+        their means (`centred`: an offset is the sensor's)."""
+        recording = at_the_door(recording)
+        measured = np.array([np.asarray(recording[c], float) for c in self.channels])
+        drive = Drive(self, drive_force(recording), float(recording.fs_hz), warmup_of(recording))
+        lin = drive.outputs(None)
+        nl = drive.outputs(self.joint) if self.joint is not None else lin
+        return measured, lin, nl, drive.joint_peak
 
     def to_dict(self) -> dict:
         return {"schema": SCHEMA, "channels": list(self.channels), "units": dict(self.units),

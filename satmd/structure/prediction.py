@@ -31,6 +31,7 @@ class Prediction:
     fitted_band_hz: tuple | None = None  # the band the model's recordings excited (`StructureModel.band_hz`)
     outside_band: float | None = None  # the share of this force's power outside it: there the model extrapolates
     joint_reach: float | None = None  # the joint's largest force here over the largest in the fitted recordings
+    realisations: int = 1  # a lab's realisations in one file, each simulated from its own start
 
     def to_dict(self) -> dict:
         out = {"file": self.file, "level": round(self.level, 6), "extrapolated": self.extrapolated,
@@ -44,6 +45,8 @@ class Prediction:
             out["force_outside_fitted_band"] = round(self.outside_band, 4)
         if self.joint_reach is not None:
             out["joint_force_over_fitted"] = round(self.joint_reach, 4)
+        if self.realisations > 1:
+            out["realisations"] = self.realisations
         return out
 
     def plot(self, path, title: str = ""):
@@ -55,7 +58,8 @@ class Prediction:
     def report(self) -> str:
         flag = " (extrapolated: outside the fitted levels)" if self.extrapolated else ""
         rows = ", ".join(f"{c} {n:.3f} (linear {ln:.3f})" for c, n, ln in zip(self.channels, self.nrmse, self.linear_nrmse))
-        text = f"{self.file}: force {self.level:.4g} N RMS{flag}; NRMSE {rows}"
+        several = f" over {self.realisations} realisations, each simulated from its start" if self.realisations > 1 else ""
+        text = f"{self.file}: force {self.level:.4g} N RMS{flag}; NRMSE{several} {rows}"
         if self.outside_band is not None and self.fitted_band_hz is not None and self.outside_band >= SHOWN_OUTSIDE:
             lo, hi = self.fitted_band_hz
             text += (f"; {100 * self.outside_band:.0f} % of the force's power lies outside the band the model was "

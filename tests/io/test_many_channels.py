@@ -160,13 +160,36 @@ def test_realizations_are_read_one_at_a_time(tmp_path, suffix):
                                                                         "a2=Acceleration[2],a3=Acceleration[3]")):
         assert list(val.channels) == ["force", "acc1", "acc2", "acc3"]
         np.testing.assert_array_equal(val["acc2"], accel[1, 1])
-    with pytest.raises(FormatError, match=r"'Force' has shape 4×400, several signals: say which, e\.g\. Force\[1\]"):
-        load_recording(every)
+    whole = load_recording(every)  # without a map: every realisation, one after another
+    assert list(whole.channels) == ["force", "acc1", "acc2", "acc3"] and whole.n_samples == 4 * N
+    assert (whole.meta["realisations"], whole.meta["realisation_samples"]) == ("4", str(N))
+    parts = whole.realisations()
+    assert len(parts) == 4 and parts[1].meta["realisation"] == "2"
+    np.testing.assert_array_equal(parts[1]["force"], force[1])
+    np.testing.assert_array_equal(parts[3]["acc3"], accel[2, 3])
     with pytest.raises(FormatError, match=r"shape 3×4×400: give one index per axis but time \(2\), e\.g\. "
                                           r"Acceleration\[1,1\]"):
         load_recording(every, channel_map="force=Force[1],a1=Acceleration[1]")
     with pytest.raises(FormatError, match=r"acc1=Acceleration\[1,5\]: .* indices run 1\.\.3, 1\.\.4"):
         load_recording(every, channel_map="force=Force[1],a1=Acceleration[1,5]")
+
+
+def test_realisations_are_read_in_either_axis_order_and_a_mismatch_is_named(tmp_path):
+    """Realisation × channel × time reads as channel × realisation × time does; responses with another number of
+    realisations than the force are refused, naming both shapes."""
+    rng = np.random.default_rng(4)
+    force, accel = rng.normal(size=(3, N)), rng.normal(size=(2, 3, N))
+    p = tmp_path / "swapped.npz"
+    np.savez(p, Force=force, Acceleration=accel.transpose(1, 0, 2), Fs=np.float64(FS))
+    rec = load_recording(p)
+    assert list(rec.channels) == ["force", "acc1", "acc2"] and rec.meta["realisations"] == "3"
+    np.testing.assert_array_equal(rec.realisations()[2]["acc2"], accel[1, 2])
+    np.savez(p, Force=force, acc1=accel[0], acc2=accel[1, :2], Fs=np.float64(FS))
+    with pytest.raises(FormatError, match=r"'acc2' has shape 2×400, the force 3×400 \(realisation × time\)"):
+        load_recording(p)
+    np.savez(p, Force=force, Acceleration=rng.normal(size=(2, 5, N)), Fs=np.float64(FS))
+    with pytest.raises(FormatError, match=r"'Acceleration' has shape 2×5×400, the force 3×400"):
+        load_recording(p)
 
 
 def test_two_acceleration_matrices_are_asked_about(tmp_path):
