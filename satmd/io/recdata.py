@@ -122,6 +122,11 @@ def role_of(key: str) -> str:
     raise ValueError(f"unknown channel {name!r} (use force, a1, a2, a3, ... or acc1, acc2, ...)")
 
 
+# what describes the whole record, not one realisation of it: the layout and the excitation read from it
+WHOLE_RECORD_KEYS = ("realisations", "realisation_samples", "excitation_layout", "period_samples", "periods",
+                     "transient_periods", "steady_periods", "lines")
+
+
 @dataclass(frozen=True)
 class Recording:
     """Uniformly sampled channels.
@@ -205,9 +210,11 @@ class Recording:
             return [self]
         if count < 2 or n < 2 or count * n != self.n_samples:
             return [self]
-        meta = {k: v for k, v in self.meta.items() if k not in ("realisations", "realisation_samples")}
+        meta = {k: v for k, v in self.meta.items() if k not in WHOLE_RECORD_KEYS}  # read again for each
+        source = meta.get("source", "recording")
         return [Recording(self.fs_hz, {c: v[i * n:(i + 1) * n] for c, v in self.channels.items()}, self.units,
-                          {**meta, "realisation": str(i + 1)}, self.labels) for i in range(count)]
+                          {**meta, "source": f"{source} (realisation {i + 1})", "realisation": str(i + 1)},
+                          self.labels) for i in range(count)]
 
     def rename(self, mapping: dict) -> "Recording":
         """New names for some channels: {old: new}."""

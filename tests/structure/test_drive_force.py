@@ -158,3 +158,19 @@ def test_each_realisation_is_simulated_from_its_own_start():
     assert "over 2 realisations" in prediction.report()
     through = model.simulate(np.concatenate(forces), FS)[0]
     assert plain_nrmse(through, np.concatenate(responses)) > 0.05
+
+
+def test_a_realisation_is_read_again_as_the_periodic_test_it_is():
+    """Each realisation given back (`each_realisation`) is read again, a periodic test of its own with its own
+    periods, whatever was read from the whole (two random-phase multisines one after another: six periods of
+    which the first realisation's three were taken for a start-up)."""
+    from satmd.signal.excitation import excitation_of, received
+    from satmd.structure.spectra import each_realisation
+
+    forces = [np.tile(multisine(PERIOD, FS, 5.0, 40.0, seed), 3) for seed in (5, 6)]
+    meta = {"source": "lab.mat", "realisations": "2", "realisation_samples": str(forces[0].size)}
+    whole = received(Recording(FS, {"force": np.concatenate(forces), "acc1": np.concatenate(forces)}, meta=meta))
+    parts = each_realisation([whole])
+    assert [p.meta["source"] for p in parts] == ["lab.mat (realisation 1)", "lab.mat (realisation 2)"]
+    assert all(excitation_of(p).kind == "periodic" and excitation_of(p).period_samples == PERIOD
+               and excitation_of(p).periods == 3 for p in parts)
