@@ -63,7 +63,7 @@ def _findings(value):
 
 
 MAX_HZ = 1e9
-METHODS = ("lpm", "welch-H1", "welch-H2", "periodic", "impact", "sweep")
+METHODS = ("lpm", "welch-H1", "welch-H2", "periodic", "impact", "sweep", "realisations")
 EXCITATIONS = ("random", "periodic", "impact", "sweep")
 SCHEMA = {
     "method": lambda v: None if v in METHODS else f"must be one of {', '.join(METHODS)}",

@@ -85,7 +85,10 @@ def estimate_frf(recording: Recording, nperseg: int | None = None, window=None, 
     band_hz = renamed_keyword(band, band_hz, "estimate_frf")
     source, responses = _check_force(recording)
     welch_given = any(v is not None for v in (nperseg, window, overlap))
-    exc = excitation_of(received(recording, excitation, period_s))
+    at_door = received(recording, excitation, period_s)
+    exc = excitation_of(at_door)
+    if estimator is None and not welch_given and width_hz is None and _periodic_realisations(at_door):
+        return _estimate_realisations(at_door, band_hz)
     designed = exc.kind in ("periodic", "impact")
     if exc.kind == "sweep":  # whole transients in the record: no leakage term, however fast the sweep
         from .sweepfrf import at_rest_at_the_end
@@ -134,6 +137,11 @@ def describe_estimate(data) -> str:
                 if e["method"] == "periodic" else
                 f"H1 over {how.get('hits')} hits ({how.get('source')} impacts), {e['points']} lines")
         return f"{what} {lo:.4g}–{hi:.4g} Hz, noise from {e['noise_dof']:.0f} degrees of freedom"
+    if e["method"] == "realisations":
+        lo, hi = e["band_hz"]
+        return (f"the best linear approximation over {e['realisations']} realisations ({e['steady_periods']} steady "
+                f"periods each), at the {e['points']} lines excited in every one {lo:.4g}–{hi:.4g} Hz, noise and "
+                f"nonlinear distortion from their spread, {e['noise_dof']:.0f} degrees of freedom")
     if e["method"] == "lpm":
         lo, hi = e["band_hz"]
         return (f"local polynomial method on the full {e['record_s']:g} s record, {e['points']} independent points "
@@ -246,6 +254,53 @@ def _estimate_designed(recording: Recording, exc, band_hz) -> FRFData:
     # beyond its noise, an estimate carries its model's and the chain's small systematic error: an effect whose
     # whole signature stays within it is reported as measurement, not physics (`satmd.discovery.budget`)
     return FRFData(f, frf, std, meta, coherence=coh, estimator=info, bias_bound=np.full(f.size, ESTIMATE_REL_FLOOR))
+
+
+def _periodic_realisations(recording) -> bool:
+    """A lab's realisations, each periodic with one layout (`excitation.with_realisations`)."""
+    from .periodic import is_multisine
+
+    return "realisation_samples" in recording.meta and is_multisine(recording) and \
+        int(recording.meta.get("realisations", 1)) > 1
+
+
+def _estimate_realisations(recording: Recording, band_hz) -> FRFData:
+    """The best linear approximation over a lab's random-phase realisations (`periodic.multisine_frf`), its std
+    from their spread: noise and the nonlinear distortion that changes with the phases (Pintelon & Schoukens)."""
+    from .chain import clipping_findings
+    from .periodic import multisine_arrays, multisine_frf
+
+    source, responses = _check_force(recording)
+    _check_constant(recording, source, responses)
+    bla = multisine_frf(recording)
+    u, ys, lines = multisine_arrays(recording)
+    U = np.fft.rfft(u, axis=-1)[..., lines]
+    coherence = {}  # over every steady period of every realisation
+    for c, y in ys.items():
+        Y = np.fft.rfft(y, axis=-1)[..., lines]
+        coherence[c] = np.abs(np.sum(Y * np.conj(U), axis=(0, 1))) ** 2 / np.maximum(
+            np.sum(np.abs(U) ** 2, axis=(0, 1)) * np.sum(np.abs(Y) ** 2, axis=(0, 1)), 1e-300)
+    f = bla.freq_hz
+    lo = -np.inf if not band_hz or band_hz[0] is None else band_hz[0]
+    hi = np.inf if not band_hz or band_hz[1] is None else band_hz[1]
+    keep = (f >= lo) & (f <= hi)
+    if keep.sum() < 4:
+        raise DataError(f"band {band_hz[0]}:{band_hz[1]} Hz holds {int(keep.sum())} of the excited lines "
+                        f"({f[0]:.4g}–{f[-1]:.4g} Hz)")
+    f = f[keep]
+    m, p = int(bla.meta["realisations"]), int(bla.meta["periods"])
+    frf = {c: v[keep] for c, v in bla.channels.items()}
+    floor = 1e-10 * max(np.max(np.abs(h)) for h in frf.values())
+    std = {c: np.maximum(v[keep], floor) for c, v in bla.std.items()}
+    info = {"method": "realisations", "reference": "Pintelon & Schoukens 2012 ch. 3-4: the best linear "
+            "approximation over random-phase realisations", "record_s": round(recording.duration_s, 6),
+            "band_hz": [round(float(f[0]), 6), round(float(f[-1]), 6)], "points": int(f.size),
+            "noise_dof": float(2 * (m - 1)), "realisations": m, "steady_periods": p,
+            "measurement": [x.to_dict() for x in clipping_findings(recording)]}
+    meta = {"source": str(source), "estimator": "realisations", "band_hz": f"{f[0]:.6g}:{f[-1]:.6g}",
+            "noise_dof": f"{2 * (m - 1)}", "noise": f"spread over {m} realisations (noise and nonlinear distortion)"}
+    return FRFData(f, frf, std, meta, coherence={c: v[keep] for c, v in coherence.items()}, estimator=info,
+                   bias_bound=np.full(f.size, ESTIMATE_REL_FLOOR))
 
 
 def _estimate_welch(recording: Recording, nperseg, window, overlap, estimator, band_hz) -> FRFData:

@@ -219,7 +219,30 @@ def received(recording, kind: str = "auto", period_s: float | None = None):
     carried = (recording.meta or {}).get("excitation_layout")
     if carried and str(kind).lower() == "auto" and period_s is None:
         return recording
-    return with_excitation(recording, detect_excitation(recording, kind, period_s))
+    return with_realisations(with_excitation(recording, detect_excitation(recording, kind, period_s)))
+
+
+def with_realisations(recording):
+    """A lab's realisations (`Recording.realisations`) that are each periodic with one period, one count of
+    periods and one start-up, laid out as satmd's own multisine records of several realisations are
+    (``period_samples``, ``periods`` of each, ``transient_periods``, ``lines`` excited in every one): the best
+    linear approximation over them (`satmd.signal.periodic.multisine_frf`) and the detection-line test read
+    them. Otherwise as it came, with no periodic layout claimed for the whole (its realisations differ)."""
+    parts = recording.realisations() if hasattr(recording, "realisations") else [recording]
+    if len(parts) < 2:
+        return recording
+    from dataclasses import replace
+
+    found = [detect_excitation(p) for p in parts]
+    meta = {k: v for k, v in recording.meta.items()
+            if k not in ("period_samples", "periods", "transient_periods", "steady_periods", "lines")}
+    one = {(e.kind, e.period_samples, e.periods) for e in found}
+    lines = set.intersection(*(set(e.lines) for e in found))
+    if len(one) == 1 and found[0].kind == "periodic" and found[0].periods >= 2 and lines:
+        meta |= {"period_samples": str(found[0].period_samples), "periods": str(found[0].periods),
+                 "transient_periods": str(max(e.transient_periods for e in found)),
+                 "lines": ",".join(str(k) for k in sorted(lines))}
+    return replace(recording, meta=meta)
 
 
 def excitation_of(recording) -> Excitation:
@@ -284,4 +307,5 @@ def _random_evidence(x) -> str:
     return f"no period (autocorrelation ≤ {r:.2f} beyond the first lags), no pulses, no sweep"
 
 
-__all__ = ["Excitation", "KINDS", "detect_excitation", "excited_lines", "find_period", "with_excitation"]
+__all__ = ["Excitation", "KINDS", "detect_excitation", "excited_lines", "find_period", "with_excitation",
+           "with_realisations"]

@@ -71,7 +71,8 @@ def _distortion_tests(recordings, alpha):
 
 def _few_dof(datas):
     """The noise dof of periodic or impact estimates (few periods or hits: F, not χ², tests); None otherwise."""
-    if all(d.estimator.get("method") in ("periodic", "impact") and d.estimator.get("noise_dof") for d in datas):
+    if all(d.estimator.get("method") in ("periodic", "impact", "realisations") and d.estimator.get("noise_dof")
+           for d in datas):
         return float(min(d.estimator["noise_dof"] for d in datas))
     return None
 
