@@ -229,6 +229,12 @@ class Recording:
                 f"{self.n_samples} samples = {self.duration_s:g} s)")
 
 
+def each_realisation(recordings) -> list:
+    """The recordings with a lab's realisations apart (`Recording.realisations`): each a periodic test of its
+    own, at its level (the F-16's odd multisines: ten random-phase realisations of three periods in one file)."""
+    return [part for r in recordings for part in (r.realisations() if isinstance(r, Recording) else [r])]
+
+
 def clipped_channels(rec: Recording, extremes: dict | None = None) -> dict:
     """{name: number of samples at the channel's extremes} for channels that look clipped.
 

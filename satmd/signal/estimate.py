@@ -13,7 +13,7 @@ from numbers import Real
 
 import numpy as np
 
-from ..conventions import ESTIMATE_REL_FLOOR, RECORDING_CHANNELS
+from ..conventions import ESTIMATE_REL_FLOOR, RECORDING_CHANNELS, TINY
 from ..errors import DataWarning, DataError, renamed_keyword
 from ..validation import LOAD_HINT, Interval, Whole, check_data, validate_params
 from ..io.frfdata import FRFData
@@ -279,7 +279,7 @@ def _estimate_realisations(recording: Recording, band_hz) -> FRFData:
     for c, y in ys.items():
         Y = np.fft.rfft(y, axis=-1)[..., lines]
         coherence[c] = np.abs(np.sum(Y * np.conj(U), axis=(0, 1))) ** 2 / np.maximum(
-            np.sum(np.abs(U) ** 2, axis=(0, 1)) * np.sum(np.abs(Y) ** 2, axis=(0, 1)), 1e-300)
+            np.sum(np.abs(U) ** 2, axis=(0, 1)) * np.sum(np.abs(Y) ** 2, axis=(0, 1)), TINY)
     f = bla.freq_hz
     lo = -np.inf if not band_hz or band_hz[0] is None else band_hz[0]
     hi = np.inf if not band_hz or band_hz[1] is None else band_hz[1]

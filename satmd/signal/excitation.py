@@ -233,7 +233,7 @@ def with_realisations(recording):
         return recording
     from dataclasses import replace
 
-    found = [detect_excitation(p) for p in parts]
+    found = [excitation_of(p) for p in parts]  # each read at the door on its own
     meta = {k: v for k, v in recording.meta.items()
             if k not in ("period_samples", "periods", "transient_periods", "steady_periods", "lines")}
     one = {(e.kind, e.period_samples, e.periods) for e in found}

@@ -22,7 +22,8 @@ from .outside import above_band, loop_poles, same_modes
 from .output_error import BAND_STEPS, TOP, in_band, output_error, with_band_modes_refined
 from .outputs import resolved_outputs
 from .simulations import cost, drives_of, fit_span, oversampling, stable, with_table
-from .spectra import at_the_door, drive_force, each_realisation, periodic_spectra, warmup_of
+from ..io.recdata import each_realisation
+from .spectra import at_the_door, drive_force, periodic_spectra, warmup_of
 from .starts import measured_start, simulated_shape, underlying_start, with_modes_above
 from .startup import band_top_hz, with_start_up_modes
 

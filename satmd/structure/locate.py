@@ -48,7 +48,8 @@ from ..numerics import unit_columns
 from ..errors import DataError
 from ..validation import NAMES, Band, validate_params
 from .laws import LAWS, SHAPE_GRID
-from .spectra import PeriodicSpectra, each_realisation, periodic_spectra
+from ..io.recdata import each_realisation
+from .spectra import PeriodicSpectra, periodic_spectra
 
 #: ΔBIC within which two places (or two laws) are equally supported (SPEC §11).
 EQUIVALENT = 10.0

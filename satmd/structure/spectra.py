@@ -105,12 +105,6 @@ def motion(accel, lines, fs_hz: float, period_samples: int):
     return np.fft.irfft(X, period_samples), np.fft.irfft(V, period_samples)
 
 
-def each_realisation(recordings) -> list:
-    """The recordings with a lab's realisations apart (`Recording.realisations`): each a periodic test of its
-    own, at its level (the F-16's odd multisines: ten random-phase realisations of three periods in one file)."""
-    return [part for r in recordings for part in (r.realisations() if hasattr(r, "realisations") else [r])]
-
-
 def periodic_spectra(recording) -> PeriodicSpectra:
     """`PeriodicSpectra` of a recording whose force is periodic (a multisine, a periodic chirp, ...).
 

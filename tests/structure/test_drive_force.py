@@ -165,7 +165,7 @@ def test_a_realisation_is_read_again_as_the_periodic_test_it_is():
     periods, whatever was read from the whole (two random-phase multisines one after another: six periods of
     which the first realisation's three were taken for a start-up)."""
     from satmd.signal.excitation import excitation_of, received
-    from satmd.structure.spectra import each_realisation
+    from satmd.io.recdata import each_realisation
 
     forces = [np.tile(multisine(PERIOD, FS, 5.0, 40.0, seed), 3) for seed in (5, 6)]
     meta = {"source": "lab.mat", "realisations": "2", "realisation_samples": str(forces[0].size)}

@@ -162,7 +162,7 @@ def with_joint(report, recordings, fit_joint: bool = True):
     from ...errors import DataError
     from ...structure import locate_joint
 
-    from ...structure.spectra import each_realisation
+    from ...io.recdata import each_realisation
 
     recordings = each_realisation(recordings)  # a lab's realisations: each a periodic test at its level
     responses = [c for c in recordings[0].channels if c != "force"] if recordings else []
