@@ -21,8 +21,7 @@ from .loop import PAIRS, with_loop_modes
 from .outside import above_band, loop_poles, same_modes
 from .output_error import BAND_STEPS, TOP, in_band, output_error, with_band_modes_refined
 from .outputs import resolved_outputs
-from .simulations import cost, drives_of, fit_span, oversampling, stable, with_table
-from ..io.recdata import each_realisation
+from .simulations import cost, drives_of, fit_span, fitted_realisations, oversampling, stable, with_table
 from .spectra import at_the_door, drive_force, periodic_spectra, warmup_of
 from .starts import measured_start, simulated_shape, underlying_start, with_modes_above
 from .startup import band_top_hz, with_start_up_modes
@@ -88,7 +87,7 @@ def fit_structure(recordings, between=None, law: str | None = None, channels=Non
     say = progress or stage  # the caller's, else whoever listens (`satmd discover` prints the stages)
     if len(recordings) < 2:
         raise DataError("a structure model needs recordings at two or more levels")
-    recordings = [at_the_door(r) for r in each_realisation(recordings)]  # each force read once, not at every start
+    recordings = [at_the_door(r) for r in fitted_realisations(recordings)]  # each force read once, not at each start
     spectra = [periodic_spectra(r) for r in recordings]
     names = tuple(channels or spectra[0].responses)
     for s in spectra:

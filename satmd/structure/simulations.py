@@ -13,6 +13,29 @@ FIT_PERIODS = 3  # steady periods of a periodic test in the output-error fit
 SHRINK = (1.0, 0.5, 0.25, 0.1, 0.03, 0.01, 0.0)  # scales of the start's joint tried until the loop is stable
 
 
+def fitted_realisations(recordings) -> list:
+    """The realisations the output-error fit simulates: of each file, as many of its realisations as make up
+    `FIT_PERIODS` steady periods (at least one; `Recording.realisations`), as a periodic test gives that many of
+    its own. The others repeat what those show at that level and would cost as much each (the F-16's odd
+    multisines: ten realisations of two steady periods a level; locating reads every one, it costs little)."""
+    from ..io.recdata import each_realisation
+    from ..signal.excitation import excitation_of
+
+    out = []
+    for recording in recordings:
+        steady = 0
+        for part in each_realisation([recording]):
+            if steady >= FIT_PERIODS:
+                break
+            out.append(part)
+            try:
+                exc = excitation_of(part)
+            except DataError:
+                break
+            steady += len(exc.steady) if exc.kind == "periodic" else FIT_PERIODS
+    return out
+
+
 def fit_span(recording) -> int:
     """Samples of a recording the output-error fit uses: a periodic force's first steady periods (the next ones
     repeat them, to the noise), with the leading transient, else the whole record."""

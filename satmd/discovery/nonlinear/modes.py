@@ -162,9 +162,6 @@ def with_joint(report, recordings, fit_joint: bool = True):
     from ...errors import DataError
     from ...structure import locate_joint
 
-    from ...io.recdata import each_realisation
-
-    recordings = each_realisation(recordings)  # a lab's realisations: each a periodic test at its level
     responses = [c for c in recordings[0].channels if c != "force"] if recordings else []
     if len(recordings) < 2 or len(responses) < 2 or not report.findings:
         return report
