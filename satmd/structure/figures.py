@@ -120,9 +120,7 @@ def _draw_evidence(bx, location):
 def _draw_fit_table(cx, fit):
     """Each recording's worst-channel NRMSE, simulated from its force: the lowest level's linear model against the
     model with the joint."""
-    from pathlib import Path
-
-    files = [Path(str(f)).stem for f in fit["files"]]
+    files = [_file_label(f) for f in fit["files"]]
     lin = [max(r) for r in fit["linear"]]
     nl = [max(r) for r in fit["nonlinear"]]
     at = np.arange(len(files))
@@ -133,6 +131,14 @@ def _draw_fit_table(cx, fit):
     cx.set_ylabel("worst-channel NRMSE")
     cx.set_title("simulated from each recording's force", fontsize=10)
     cx.legend(fontsize=8)
+
+
+def _file_label(source) -> str:
+    """A recording's file without its folder and suffix; a realisation of it with its number (``lab #2``)."""
+    from pathlib import Path
+
+    name, _, rest = str(source).partition(" (realisation ")
+    return f"{Path(name).stem} #{rest.rstrip(')')}" if rest else Path(name).stem
 
 
 def prediction_figure(prediction, path, title: str = ""):

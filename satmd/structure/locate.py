@@ -48,7 +48,7 @@ from ..numerics import unit_columns
 from ..errors import DataError
 from ..validation import NAMES, Band, validate_params
 from .laws import LAWS, SHAPE_GRID
-from ..io.recdata import each_realisation
+from .simulations import fitted_realisations
 from .spectra import PeriodicSpectra, periodic_spectra
 
 #: ΔBIC within which two places (or two laws) are equally supported (SPEC §11).
@@ -209,7 +209,7 @@ def prepare(recordings, band_hz=None, channels=None):
     the reference FRF per channel, the joint's transfer columns per channel (`paths`), the modal fit)."""
     from ..modal import fit_modes
 
-    items = [r if isinstance(r, PeriodicSpectra) else periodic_spectra(r) for r in each_realisation(recordings)]
+    items = [r if isinstance(r, PeriodicSpectra) else periodic_spectra(r) for r in fitted_realisations(recordings)]
     if len(items) < 2:
         raise DataError("locating a joint needs recordings at two or more levels")
     ref = min(items, key=lambda s: s.level)

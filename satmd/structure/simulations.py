@@ -14,17 +14,21 @@ SHRINK = (1.0, 0.5, 0.25, 0.1, 0.03, 0.01, 0.0)  # scales of the start's joint t
 
 
 def fitted_realisations(recordings) -> list:
-    """The realisations the output-error fit simulates: of each file, as many of its realisations as make up
-    `FIT_PERIODS` steady periods (at least one; `Recording.realisations`), as a periodic test gives that many of
-    its own. The others repeat what those show at that level and would cost as much each (the F-16's odd
-    multisines: ten realisations of two steady periods a level; locating reads every one, it costs little)."""
+    """The realisations a structure's joint is located from and fitted on: of each file, as many of its
+    realisations as make up `FIT_PERIODS` steady periods (at least one; `Recording.realisations`), as a periodic
+    test gives that many of its own. The others repeat what those show at that level and would cost as much
+    each (the F-16's odd multisines hold nine or ten realisations of two steady periods a level)."""
     from ..io.recdata import each_realisation
     from ..signal.excitation import excitation_of
 
     out = []
     for recording in recordings:
+        parts = each_realisation([recording])
+        if len(parts) == 1:  # one record: its excitation is read at its door, once
+            out.append(recording)
+            continue
         steady = 0
-        for part in each_realisation([recording]):
+        for part in parts:
             if steady >= FIT_PERIODS:
                 break
             out.append(part)

@@ -283,6 +283,9 @@ def where_it_misses(model, recordings) -> dict | None:
         ``inside_band`` (the NRMSE's two parts: their squares add up to its square), ``measured_above_band``
         (the response there over the channel's RMS) and ``band_top_hz``.
     """
+    from ...structure.simulations import fitted_realisations
+
+    recordings = fitted_realisations(recordings)  # the table's rows: a file's realisations each a row
     fits = [max(row) for row in model.fit["nonlinear"]]
     floor = min(max(row) for row in model.fit["linear"])
     i = int(np.argmax(fits))
