@@ -85,3 +85,24 @@ def test_a_joint_is_located_from_files_of_realisations():
         files.append(Recording(parts[0].fs_hz, {c: np.concatenate([p[c] for p in parts]) for c in parts[0].channels},
                                meta=meta))
     assert locate_joint(files).between == ("acc3", "acc4")
+
+
+def test_where_the_model_misses_is_found_among_the_fitted_realisations():
+    """The fit table has a row per fitted realisation: its worst row is that realisation, not a file (one file of
+    two realisations: the second is the worst; it was an IndexError)."""
+    from types import SimpleNamespace
+
+    from satmd.discovery.nonlinear.modes import where_it_misses
+
+    seen = []
+
+    class TwoRows:
+        fit = {"linear": [[0.01, 0.012], [0.2, 0.3]], "nonlinear": [[0.01, 0.012], [0.1, 0.32]]}
+
+        def predict(self, recording):
+            seen.append(recording.meta.get("realisation"))
+            return SimpleNamespace(nrmse=[0.1, 0.32], channels=["acc1", "acc2"], level=8.0, band_top_hz=40.0,
+                                   above_band={"nrmse": [0.05, 0.30], "measured": [0.1, 0.45]})
+
+    found = where_it_misses(TwoRows(), [_realisations(3, 2)])
+    assert found["recording"] == 1 and seen == ["2"]
