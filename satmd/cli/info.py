@@ -142,6 +142,10 @@ def recording_lines(rec, path, channel_map=None) -> list[str]:
     cmd = f"satmd estimate-frf {path}" + (f" --map {channel_map}" if channel_map else "")
     lines = [f"time recording: {len(rec.channels)} channel(s), {rec.fs_hz:.6g} Hz, {rec.n_samples} samples "
              f"({rec.duration_s:.6g} s)"]
+    parts = rec.realisations()
+    if len(parts) > 1:
+        lines.append(f"  {len(parts)} realisations of {parts[0].n_samples} samples, one after another: their FRF "
+                     "is the best linear approximation over them (each periodic), each is simulated from its start")
     width = max(len(n) for n in rec.channels)
     for name, v in rec.channels.items():
         unit = rec.units.get(name, "") or "?"

@@ -60,3 +60,11 @@ def test_a_map_still_picks_one_realisation(lab_file):
     path, _ = lab_file
     one = load_recording(path, channel_map="force=Force[2],a1=Acceleration[1,2],a2=Acceleration[2,2]")
     assert estimate_frf(one).estimator["method"] == "periodic"
+
+
+def test_info_says_the_file_holds_realisations(lab_file, capsys):
+    from satmd.cli import main
+
+    path, _ = lab_file
+    assert main(["info", str(path)]) == 0
+    assert f"{REALISATIONS} realisations of {PERIOD * PERIODS} samples, one after another" in capsys.readouterr().out
