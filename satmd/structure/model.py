@@ -189,7 +189,7 @@ class StructureModel:
     def predict(self, recording, file: str | None = None) -> Prediction:
         """Simulate a recording's force through the model and compare with its responses (SPEC §11). A recording
         of several realisations (`Recording.realisations`) is simulated one realisation at a time, each from its
-        own start, and judged over all of them."""
+        own start or going on from the one before (`_simulated_realisations`), and judged over all of them."""
         name = file or str(recording.meta.get("source", "recording"))
         missing = [c for c in self.channels if c not in recording.channels]
         if missing or "force" not in recording.channels:
@@ -199,7 +199,7 @@ class StructureModel:
         measured = np.array([np.asarray(recording[c], float) for c in self.channels])
         if not (np.all(np.isfinite(force)) and np.all(np.isfinite(measured))):
             raise DataError(f"{name}: NaN or inf in the force or a response")
-        parts = [self._simulated(part) for part in recording.realisations()]
+        parts, going_on = self._simulated_realisations(recording.realisations())
         measured, lin, nl = (np.concatenate([p[i] for p in parts], axis=1) for i in range(3))
         peaks = [p[3] for p in parts if p[3] is not None]
         peak = max(peaks) if peaks else None
@@ -214,16 +214,35 @@ class StructureModel:
                           fs, {c: np.array([m, a, b]) for c, m, a, b in zip(self.channels, measured, lin, nl)},
                           top, {"nrmse": [e for e, _ in split], "measured": [t for _, t in split]},
                           self.band_hz, None if self.band_hz is None else share_outside(force, fs, self.band_hz),
-                          None if not self.reach or peak is None else peak / self.reach, len(parts))
+                          None if not self.reach or peak is None else peak / self.reach, len(parts), going_on)
 
-    def _simulated(self, recording):
-        """(measured, linear, nonlinear, the joint's peak force) of one realisation: responses (C, N) about
-        their means (`centred`: an offset is the sensor's)."""
+    def _simulated_realisations(self, parts):
+        """(each realisation's `_simulated`, how many go on from the one before). A lab that changes the phases
+        without stopping the shaker starts each realisation in the last one's motion, one that stops starts it
+        at rest: each after the first is simulated both ways, and the one its responses are closer to kept (the
+        one before from its own start: the structure forgets it within a realisation)."""
+        out, going_on = [self._simulated(parts[0])], 0
+        for before, part in zip(parts, parts[1:]):
+            alone, after = self._simulated(part), self._simulated(part, before)
+            misses = [sum(nrmse(s, m) for s, m in zip(sim[2], sim[0])) for sim in (alone, after)]
+            out.append(after if misses[1] < misses[0] else alone)
+            going_on += int(misses[1] < misses[0])
+        return out, going_on
+
+    def _simulated(self, recording, before=None):
+        """(measured, linear, nonlinear, the joint's peak force) of one realisation, from its own start or
+        (``before``) going on from that one's: responses (C, N) about their means (`centred`: an offset is the
+        sensor's)."""
         recording = at_the_door(recording)
         measured = np.array([np.asarray(recording[c], float) for c in self.channels])
-        drive = Drive(self, drive_force(recording), float(recording.fs_hz), warmup_of(recording))
-        lin = drive.outputs(None)
-        nl = drive.outputs(self.joint) if self.joint is not None else lin
+        force, warm = drive_force(recording), warmup_of(recording)
+        if before is not None:
+            before = at_the_door(before)
+            force, warm = np.concatenate([drive_force(before), force]), 0  # it settles within the one before
+        drive = Drive(self, force, float(recording.fs_hz), warm)
+        n = measured.shape[1]
+        lin = drive.outputs(None)[:, -n:]
+        nl = drive.outputs(self.joint)[:, -n:] if self.joint is not None else lin
         return measured, lin, nl, drive.joint_peak
 
     def to_dict(self) -> dict:

@@ -32,6 +32,7 @@ class Prediction:
     outside_band: float | None = None  # the share of this force's power outside it: there the model extrapolates
     joint_reach: float | None = None  # the joint's largest force here over the largest in the fitted recordings
     realisations: int = 1  # a lab's realisations in one file, each simulated from its own start
+    going_on: int = 0  # of them, those simulated going on from the one before (`StructureModel.predict`)
 
     def to_dict(self) -> dict:
         out = {"file": self.file, "level": round(self.level, 6), "extrapolated": self.extrapolated,
@@ -46,7 +47,7 @@ class Prediction:
         if self.joint_reach is not None:
             out["joint_force_over_fitted"] = round(self.joint_reach, 4)
         if self.realisations > 1:
-            out["realisations"] = self.realisations
+            out["realisations"], out["realisations_going_on"] = self.realisations, self.going_on
         return out
 
     def plot(self, path, title: str = ""):
@@ -58,7 +59,8 @@ class Prediction:
     def report(self) -> str:
         flag = " (extrapolated: outside the fitted levels)" if self.extrapolated else ""
         rows = ", ".join(f"{c} {n:.3f} (linear {ln:.3f})" for c, n, ln in zip(self.channels, self.nrmse, self.linear_nrmse))
-        several = f" over {self.realisations} realisations, each simulated from its start" if self.realisations > 1 else ""
+        several = (f" over {self.realisations} realisations ({self.going_on} going on from the one before, the "
+                   f"others from their start)" if self.realisations > 1 else "")
         text = f"{self.file}: force {self.level:.4g} N RMS{flag}; NRMSE{several} {rows}"
         if self.outside_band is not None and self.fitted_band_hz is not None and self.outside_band >= SHOWN_OUTSIDE:
             lo, hi = self.fitted_band_hz

@@ -36,7 +36,7 @@ def test_each_realisation_is_simulated_from_its_own_start():
     rec = Recording(FS, {"force": np.concatenate(forces), "acc1": np.concatenate(responses)}, meta=meta)
     prediction = model.predict(rec)
     assert prediction.nrmse[0] < 0.01 and prediction.to_dict()["realisations"] == 2
-    assert "over 2 realisations" in prediction.report()
+    assert prediction.going_on == 0 and "over 2 realisations (0 going on from the one before" in prediction.report()
     through = model.simulate(np.concatenate(forces), FS)[0]
     assert plain_nrmse(through, np.concatenate(responses)) > 0.05
 
@@ -106,3 +106,18 @@ def test_where_the_model_misses_is_found_among_the_fitted_realisations():
 
     found = where_it_misses(TwoRows(), [_realisations(3, 2)])
     assert found["recording"] == 1 and seen == ["2"]
+
+
+def test_a_realisation_measured_without_stopping_goes_on_from_the_one_before():
+    """Realisations measured one after another without stopping the shaker (one simulation through them all) are
+    predicted going on from the one before, as closely as one realisation alone; each from rest they missed by 0.15."""
+    fr, zeta = np.array([9.0, 31.0]), np.array([0.01, 0.015])
+    wn = 2 * np.pi * fr
+    poles = -zeta * wn + 1j * wn * np.sqrt(1 - zeta ** 2)
+    model = StructureModel(LinearStructure(("acc1",), poles, (poles ** 2 / (2j * poles.imag))[None, :],
+                                           np.array([2.0])), None, (1.0, 1.0))
+    forces = [np.tile(multisine(PERIOD, FS, 5.0, 40.0, seed), 4) for seed in (3, 4, 5)]
+    through = model.simulate(np.concatenate(forces), FS)[0]
+    meta = {"source": "test", "realisations": "3", "realisation_samples": str(forces[0].size)}
+    prediction = model.predict(Recording(FS, {"force": np.concatenate(forces), "acc1": through}, meta=meta))
+    assert prediction.going_on == 2 and prediction.nrmse[0] < 0.01
