@@ -202,8 +202,8 @@ class Recording:
 
     def realisations(self) -> list:
         """The recording's realisations, each a recording of its own (a lab's matrix of realisations read whole,
-        meta ``realisations`` and ``realisation_samples``); ``[self]`` for one. Each starts from whatever the
-        excitation left before it, so each is simulated on its own."""
+        meta ``realisations`` and ``realisation_samples``); ``[self]`` for one. Each is read again at the door
+        (its excitation, its steady periods): the whole record's reading describes none of them."""
         try:
             count, n = int(self.meta.get("realisations", 1)), int(self.meta.get("realisation_samples", 0))
         except ValueError:
