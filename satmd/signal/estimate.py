@@ -13,7 +13,7 @@ from numbers import Real
 
 import numpy as np
 
-from ..conventions import ESTIMATE_REL_FLOOR, RECORDING_CHANNELS, TINY
+from ..conventions import ESTIMATE_REL_FLOOR, RECORDING_CHANNELS
 from ..errors import DataWarning, DataError, renamed_keyword
 from ..validation import LOAD_HINT, Interval, Whole, check_data, validate_params
 from ..io.frfdata import FRFData
@@ -268,22 +268,13 @@ def _estimate_realisations(recording: Recording, band_hz) -> FRFData:
     """The best linear approximation over a lab's random-phase realisations (`periodic.multisine_frf`), its std
     from their spread: noise and the nonlinear distortion that changes with the phases (Pintelon & Schoukens)."""
     from .chain import clipping_findings
-    from .periodic import multisine_arrays, multisine_frf
+    from .periodic import in_band, multisine_frf
 
     source, responses = _check_force(recording)
     _check_constant(recording, source, responses)
     bla = multisine_frf(recording)
-    u, ys, lines = multisine_arrays(recording)
-    U = np.fft.rfft(u, axis=-1)[..., lines]
-    coherence = {}  # over every steady period of every realisation
-    for c, y in ys.items():
-        Y = np.fft.rfft(y, axis=-1)[..., lines]
-        coherence[c] = np.abs(np.sum(Y * np.conj(U), axis=(0, 1))) ** 2 / np.maximum(
-            np.sum(np.abs(U) ** 2, axis=(0, 1)) * np.sum(np.abs(Y) ** 2, axis=(0, 1)), TINY)
     f = bla.freq_hz
-    lo = -np.inf if not band_hz or band_hz[0] is None else band_hz[0]
-    hi = np.inf if not band_hz or band_hz[1] is None else band_hz[1]
-    keep = (f >= lo) & (f <= hi)
+    keep = in_band(f, band_hz)
     if keep.sum() < 4:
         raise DataError(f"band {band_hz[0]}:{band_hz[1]} Hz holds {int(keep.sum())} of the excited lines "
                         f"({f[0]:.4g}–{f[-1]:.4g} Hz)")
@@ -299,7 +290,7 @@ def _estimate_realisations(recording: Recording, band_hz) -> FRFData:
             "measurement": [x.to_dict() for x in clipping_findings(recording)]}
     meta = {"source": str(source), "estimator": "realisations", "band_hz": f"{f[0]:.6g}:{f[-1]:.6g}",
             "noise_dof": f"{2 * (m - 1)}", "noise": f"spread over {m} realisations (noise and nonlinear distortion)"}
-    return FRFData(f, frf, std, meta, coherence={c: v[keep] for c, v in coherence.items()}, estimator=info,
+    return FRFData(f, frf, std, meta, coherence={c: v[keep] for c, v in bla.coherence.items()}, estimator=info,
                    bias_bound=np.full(f.size, ESTIMATE_REL_FLOOR))
 
 

@@ -36,6 +36,20 @@ def periodic_spectra(recording, excitation, channel) -> np.ndarray:
     return np.fft.rfft(blocks, axis=1)[:, list(excitation.lines)]
 
 
+def in_band(freq_hz, band_hz) -> np.ndarray:
+    """Which of ``freq_hz`` lie in ``band_hz`` = (lo, hi), either None (no bound), or None (all)."""
+    lo = -np.inf if not band_hz or band_hz[0] is None else band_hz[0]
+    hi = np.inf if not band_hz or band_hz[1] is None else band_hz[1]
+    return (freq_hz >= lo) & (freq_hz <= hi)
+
+
+def coherence_over(U, Y, axis) -> np.ndarray:
+    """The ordinary coherence at each line over the spectra's blocks (periods, realisations) along ``axis``."""
+    cross = np.abs(np.sum(Y * np.conj(U), axis=axis)) ** 2
+    power = np.sum(np.abs(U) ** 2, axis=axis) * np.sum(np.abs(Y) ** 2, axis=axis)
+    return np.clip(cross / np.maximum(power, TINY), 0.0, 1.0)
+
+
 def periodic_frf(recording, excitation, responses, band_hz=None):
     """(freq_hz, frf, std, coherence, noise_dof) at the excited lines within ``band_hz``.
 
@@ -55,9 +69,7 @@ def periodic_frf(recording, excitation, responses, band_hz=None):
     """
     lines = np.asarray(excitation.lines, int)
     f = lines * recording.fs_hz / excitation.period_samples
-    lo = -np.inf if not band_hz or band_hz[0] is None else band_hz[0]
-    hi = np.inf if not band_hz or band_hz[1] is None else band_hz[1]
-    keep = (f >= lo) & (f <= hi)
+    keep = in_band(f, band_hz)
     if keep.sum() < 2:
         raise DataError(f"band {band_hz[0]}:{band_hz[1]} Hz holds {int(keep.sum())} of the {lines.size} lines the "
                         f"periodic force excites ({f[0]:.4g}–{f[-1]:.4g} Hz)")
@@ -70,9 +82,7 @@ def periodic_frf(recording, excitation, responses, band_hz=None):
         ch = RECORDING_CHANNELS[r]
         frf[ch] = G
         std[ch] = np.sqrt(np.maximum(var, 0.0) / 2.0)
-        coh[ch] = np.clip(np.abs(np.sum(Y * np.conj(U), axis=0)) ** 2
-                          / np.maximum(np.sum(np.abs(U) ** 2, axis=0) * np.sum(np.abs(Y) ** 2, axis=0), TINY),
-                          0.0, 1.0)
+        coh[ch] = coherence_over(U, Y, axis=0)
     return f[keep], frf, std, coh, 2.0 * (P - 1)
 
 
@@ -225,10 +235,12 @@ def multisine_frf(recording):
     from ..io.frfdata import FRFData
 
     u, outs, lines = multisine_arrays(recording)
-    chans, std, info = {}, {}, {}
+    U = np.fft.rfft(u, axis=-1)[..., lines]
+    chans, std, coherence, info = {}, {}, {}, {}
     for c, y in outs.items():
         b = multisine_bla(u, y, lines, recording.fs_hz)
         chans[c], std[c] = b["bla"], b["std"]
+        coherence[c] = coherence_over(U, np.fft.rfft(y, axis=-1)[..., lines], axis=(0, 1))  # every steady period
         share = b["var_nl"] / np.maximum(b["var_total"], TINY)
         if np.isfinite(share).any():  # one realisation holds no estimate of the distortion's variance
             info[f"var_nl/var_total {c}"] = float(np.nanmedian(share))
@@ -236,4 +248,4 @@ def multisine_frf(recording):
     meta.update({k: f"{v:.3g}" for k, v in info.items()})
     if "force_rms" in recording.meta:
         meta["force_rms"] = recording.meta["force_rms"]
-    return FRFData(b["freq_hz"], chans, std, meta)
+    return FRFData(b["freq_hz"], chans, std, meta, coherence=coherence)
