@@ -43,6 +43,10 @@ def register(sub):
     p.add_argument("--map", default=None, metavar="force=#1,a1=NODE:DIR,a2=#3",
                    help="which UFF records / WAV channels / .mat or .npz variables (Name or Name[row]) / CSV columns "
                         "are force, a1 and a2 (a3, a4, ... are read too; FRFs are estimated for a1 and a2)")
+    p.add_argument("--channels", default=None, metavar="all|acc1,acc3,...",
+                   help="a structure's FRFs: each of these response channels over the force (all: every channel "
+                        "but the force), each estimated as A1 is, written as one table (.csv), arrays (.npz, "
+                        ".mat) or UFF 58 records (.uff)")
     add_recording_options(p)
     p.add_argument("--scale", default=None, metavar="force=K,acc1=K,...",
                    help="calibration of WAV channels: SI units per stored unit")
@@ -92,11 +96,12 @@ def _run(args):
             lacking = next(p for p, r in zip(args.recordings, recs) if not r.has_force)
             raise SatmdError(f"{safe_text(lacking)}: no force channel; several files give one FRF of one test "
                              "(a transmissibility is estimated from one output-only file)")
+        if args.channels is not None:
+            return _every_channel(args, recs, out)
         others = [n for n in accelerometers(rec.channels) if n not in RECORDING_CHANNELS]
         if others:  # read (satmd info lists them), but the rig's FRFs are A1 and A2
             print(f"satmd estimate-frf: note: {', '.join(others)} not estimated: the FRFs are A1 = acc1/force and "
-                  f"A2 = acc2/force; map another accelerometer onto a1 or a2 (--map) to estimate its FRF",
-                  file=sys.stderr)
+                  f"A2 = acc2/force; --channels all estimates every channel's", file=sys.stderr)
         if rec.has_force:
             overlay = [f"--{n}" for n in DEFAULT_FREE if getattr(args, n, None) is not None]
             if overlay:
@@ -143,10 +148,8 @@ def _run(args):
     else:
         how = f"Welch {m['estimator']}, nperseg={m['nperseg']} ({m['resolution_hz']} Hz), {m['segments']} averages"
     median = float(np.median(np.concatenate(list(coh.values()))))
-    if isinstance(data, FRFData) and len(args.recordings) > 1:
-        est = data.estimator
-        how += (f", the best linear approximation over {est['realisations']} realisations (files)"
-                if est.get("realisations") else f", one FRF from {len(args.recordings)} files of one test")
+    if isinstance(data, FRFData):
+        how += _several(data.estimator, args.recordings)
     print(f"wrote {safe_text(out)}: {kind}, {len(freq)} points {freq[0]:.6g}..{freq[-1]:.6g} Hz, {how}, "
           f"median coherence {median:.3f}")
     low = {name: float(np.median(g)) for name, g in coh.items() if np.median(g) < LOW_COHERENCE}
@@ -159,6 +162,57 @@ def _run(args):
         plot_estimate(freq, curves, coh, args.plot, title=f"{Path(args.recording).name}: {kind}")
         print(f"plot: {args.plot}")
     return 0
+
+
+def _every_channel(args, recs, out: Path) -> int:
+    """``--channels``: the FRF of each response channel over the force, written as `ChannelFRFs`."""
+    from ..signal import estimate_frfs
+    from ..signal.estimate import describe_estimate
+
+    where = safe_text(args.recording)
+    if not recs[0].has_force:
+        raise SatmdError(f"{where}: no force channel (channels: {', '.join(recs[0].channels)}); --channels gives "
+                         "each response over the force")
+    overlay = [f"--{n}" for n in DEFAULT_FREE if getattr(args, n, None) is not None]
+    if overlay:
+        raise SatmdError(f"{', '.join(overlay)}: the model overlay applies to a rig's transmissibility, not to "
+                         "--channels")
+    wanted = None if args.channels.strip() == "all" else [c.strip() for c in args.channels.split(",") if c.strip()]
+    try:
+        frfs = estimate_frfs(recs, wanted, estimator=args.estimator, width_hz=args.width, excitation=args.excitation,
+                             period_s=args.period_s, nperseg=args.nperseg, window=args.window,
+                             overlap=args.overlap, band_hz=parse_band(args.band))
+    except SatmdError as exc:
+        text = _as_typed(str(exc))
+        raise SatmdError(text if text.startswith(where) else f"{where}: {text}") from None
+    frfs.save(out)
+    freq, coh = frfs.freq_hz, dict(zip(frfs.channels, frfs.coherence))
+    for finding in frfs.estimator.get("measurement", []):
+        print(f"satmd estimate-frf: measurement: {finding['explanation']}; remedy: {finding['remedy']}",
+              file=sys.stderr)
+    kind = f"FRFs of {len(frfs.channels)} channels ({', '.join(frfs.channels)}) over the force"
+    how = describe_estimate(frfs.estimator) + _several(frfs.estimator, args.recordings)
+    print(f"wrote {safe_text(out)}: {kind}, {freq.size} points {freq[0]:.6g}..{freq[-1]:.6g} Hz, {how}, "
+          f"median coherence {float(np.median(frfs.coherence)):.3f}")
+    low = {n: float(np.median(g)) for n, g in coh.items() if np.median(g) < LOW_COHERENCE}
+    if low:
+        print(f"satmd estimate-frf: warning: low coherence ({', '.join(f'{n} {g:.2f}' for n, g in low.items())}, "
+              "median over the band): these responses are barely related to the force; check the channels "
+              "(--map), the sensors and the excitation before trusting their FRFs", file=sys.stderr)
+    if args.plot:
+        curves = {c: (h, s, None) for c, h, s in zip(frfs.channels, frfs.frf, frfs.std)}
+        plot_estimate(freq, curves, coh, args.plot, title=f"{Path(args.recording).name}: {kind}")
+        print(f"plot: {args.plot}")
+    return 0
+
+
+def _several(estimator: dict, recordings) -> str:
+    """What an estimate from several files of one test combined ("" for one file)."""
+    if len(recordings) < 2:
+        return ""
+    if estimator.get("realisations"):
+        return f", the best linear approximation over {estimator['realisations']} realisations (files)"
+    return f", one FRF from {len(recordings)} files of one test"
 
 
 def _as_typed(message: str) -> str:

@@ -54,9 +54,37 @@ def describe(path, channel_map=None, freq_axis=None) -> list[str]:
                                       or "none"))
     if suffix not in _FORMATS:
         raise FormatError(path, f"unknown file type {suffix!r} (known: {', '.join(sorted(_FORMATS))})")
+    if _every_channel(path, suffix, variables if suffix in (".npz", ".mat") else None):
+        return lines + channel_frf_lines(path)
     if is_recording(path):
         return lines + recording_lines(load_recording(path, channel_map=channel_map), path, channel_map)
     return lines + frf_lines(load_frf(path, **({"channel_map": channel_map} if channel_map else {})))
+
+
+def _every_channel(path, suffix: str, variables) -> bool:
+    """Whether the file holds `ChannelFRFs` (a structure's FRFs of every channel)."""
+    from ..io.channelfrfs import MAGIC
+
+    if variables is not None:
+        return {"frf", "channels", "freq_hz"} <= set(variables)
+    if suffix != ".csv":
+        return False
+    with open(path, encoding="utf-8", errors="replace") as fh:
+        return fh.readline().rstrip("\r\n") == MAGIC
+
+
+def channel_frf_lines(path) -> list[str]:
+    """FRFs of every channel: their channels, grid, how they were estimated and their median coherence."""
+    from ..io import load_channel_frfs
+    from ..signal.estimate import describe_estimate
+
+    frfs = load_channel_frfs(path)
+    f = frfs.freq_hz
+    how = describe_estimate(frfs.estimator)
+    return [f"FRFs of every channel: {len(frfs.channels)} ({', '.join(frfs.channels)}) over the force "
+            f"[{frfs.units}], {f.size} points {f[0]:.6g}..{f[-1]:.6g} Hz",
+            *([f"estimated as: {how}"] if how else []),
+            "median coherence: " + ", ".join(f"{c} {np.median(g):.3f}" for c, g in zip(frfs.channels, frfs.coherence))]
 
 
 def _size(n: float) -> str:
@@ -155,8 +183,8 @@ def recording_lines(rec, path, channel_map=None) -> list[str]:
         lines.append(f"  clipped? {name}: {count} samples at its extremes")
     others = [n for n in accelerometers(rec.channels) if n not in RECORDING_CHANNELS]
     if others:  # read and listed above; the rig's FRFs are A1 and A2 only
-        lines.append(f"{', '.join(others)}: read; FRFs are estimated for acc1 and acc2 (map another accelerometer "
-                     f"onto a1 or a2 with --map to estimate its FRF)")
+        lines.append(f"{', '.join(others)}: read; a rig's FRFs are acc1's and acc2's, a structure's every "
+                     f"channel's (`{cmd} --channels all -o FRFs.csv`)")
     if rec.has_force and ("acc1" in rec.channels or "acc2" in rec.channels):
         lines.append(f"force and responses present: estimate FRFs with `{cmd} -o FRF.csv`")
     elif "acc1" in rec.channels and "acc2" in rec.channels:

@@ -21,6 +21,7 @@ from pathlib import Path
 from ..errors import DataError, DataTypeError, FormatError
 from ..validation import validate_params
 from ._common import DataWarning, writer_for
+from .channelfrfs import ChannelFRFs, load_channel_frfs
 from .csvfrf import read_csv, write_csv
 from .frfdata import CHANNELS, UNITS, FRFData
 from .matfile import read_frf_variables, write_frf_variables
@@ -123,4 +124,5 @@ def __getattr__(name):
 __all__ = [
     "FRFData", "CHANNELS", "UNITS", "load_frf", "save_frf", "READERS", "WRITERS", "DataWarning",
     "Recording", "load_recording", "save_recording", "is_recording", "clipped_channels",
+    "ChannelFRFs", "load_channel_frfs",
 ]

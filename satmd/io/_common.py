@@ -244,6 +244,9 @@ def split_csv(path, text: str, magic: str):
             continue
         if stripped.startswith("#"):
             body = stripped[1:].strip()
+            if body.lower().startswith("satmd-frfs"):  # `ChannelFRFs`: a structure's every channel
+                raise FormatError(path, "FRFs of every channel of a structure (ChannelFRFs, satmd-frfs v1); this "
+                                        "reads a rig's A1 and A2 (satmd-frf v1)", line=lineno)
             if body.lower().startswith(magic):
                 if body.split()[1:] != ["v1"]:
                     raise FormatError(path, f"unsupported format version {body!r} (this reader knows {magic} v1)",

@@ -246,7 +246,9 @@ def read_frf_variables(path) -> FRFData:
                 into[ch] = vector_variable(path, ch + suffix, v[ch + suffix])
                 used.add(ch + suffix)
     if not channels:
-        raise FormatError(path, f"no FRF channel variable (any of {', '.join(CHANNELS)})")
+        every = " (it holds FRFs of every channel of a structure, ChannelFRFs: this reads a rig's A1 and A2)" \
+            if {"frf", "channels"} <= set(v) else ""
+        raise FormatError(path, f"no FRF channel variable (any of {', '.join(CHANNELS)}){every}")
     warn_unused(path, v, used | {"meta"})
     meta = {"source": str(path), "format": path.suffix.lower().lstrip(".")}
     try:
@@ -271,14 +273,14 @@ def write_frf_variables(data: FRFData, path) -> Path:
             out[ch + "_std"] = data.std[ch]
         if ch in data.coherence:
             out[ch + "_coh"] = data.coherence[ch]
-    return _write(out, path)
+    return write_variables(out, path)
 
 
 def write_recording_variables(fs_hz: float, signals: dict, path) -> Path:
-    return _write({"fs_hz": np.float64(fs_hz), **signals}, path)
+    return write_variables({"fs_hz": np.float64(fs_hz), **signals}, path)
 
 
-def _write(variables: dict, path) -> Path:
+def write_variables(variables: dict, path) -> Path:
     path = Path(path)
     with atomic_write(path) as fh:  # an open file: np.savez would otherwise append '.npz'
         if path.suffix.lower() == ".npz":

@@ -323,4 +323,5 @@ def test_info_lists_every_channel(tmp_path, capsys):
     assert "7 channel(s)" in out
     for name in ("force", *ACCS):
         assert f"\n  {name} " in out, (name, out)
-    assert "acc3, acc4, acc5, acc6: read; FRFs are estimated for acc1 and acc2" in out
+    assert "acc3, acc4, acc5, acc6: read; a rig's FRFs are acc1's and acc2's, a structure's every channel's" in out
+    assert "--channels all -o FRFs.csv" in out
