@@ -38,6 +38,7 @@ def run(args):
 def describe(path, channel_map=None, freq_axis=None) -> list[str]:
     """Lines of text describing the file; raises SatmdError when nothing in it is readable."""
     from ..io import is_recording, load_frf, load_recording
+    from ..io.channelfrfs import is_channel_frfs
 
     path = Path(path)
     suffix = path.suffix.lower()
@@ -54,23 +55,11 @@ def describe(path, channel_map=None, freq_axis=None) -> list[str]:
                                       or "none"))
     if suffix not in _FORMATS:
         raise FormatError(path, f"unknown file type {suffix!r} (known: {', '.join(sorted(_FORMATS))})")
-    if _every_channel(path, suffix, variables if suffix in (".npz", ".mat") else None):
+    if suffix in (".csv", ".npz", ".mat") and is_channel_frfs(path):
         return lines + channel_frf_lines(path)
     if is_recording(path):
         return lines + recording_lines(load_recording(path, channel_map=channel_map), path, channel_map)
     return lines + frf_lines(load_frf(path, **({"channel_map": channel_map} if channel_map else {})))
-
-
-def _every_channel(path, suffix: str, variables) -> bool:
-    """Whether the file holds `ChannelFRFs` (a structure's FRFs of every channel)."""
-    from ..io.channelfrfs import MAGIC
-
-    if variables is not None:
-        return {"frf", "channels", "freq_hz"} <= set(variables)
-    if suffix != ".csv":
-        return False
-    with open(path, encoding="utf-8", errors="replace") as fh:
-        return fh.readline().rstrip("\r\n") == MAGIC
 
 
 def channel_frf_lines(path) -> list[str]:

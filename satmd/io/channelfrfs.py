@@ -6,7 +6,7 @@ its channels are (``acc1`` … ``accN``, or a lab's names). They are written as 
 frequency: ``<channel>_re``, ``_im``, ``_std``, ``_coh`` each), as arrays (``.npz``, ``.mat``: ``freq_hz``,
 ``channels``, ``frf`` channel × frequency, ``std``, ``coherence``), or as UFF 58 records (one FRF, std and
 coherence each per channel, the response node N for ``accN``, the channel's name in ID line 1), which modal
-software reads. CSV and arrays read back (`load_channel_frfs`).
+software reads. Each reads back (`load_channel_frfs`).
 """
 from __future__ import annotations
 
@@ -21,6 +21,7 @@ from .atomic import atomic_write
 
 MAGIC = "# satmd-frfs v1: the FRF of every response channel over the force"
 SUFFIXES = (".csv", ".npz", ".mat", ".uff", ".unv")
+UFF_ID = "satmd-frfs v1"  # ID line 2 of each UFF record written here
 
 
 @dataclass(frozen=True)
@@ -105,7 +106,7 @@ class ChannelFRFs:
         parts = []
         for i, ch in enumerate(self.channels):
             node = int(ch[3:]) if ch.startswith("acc") and ch[3:].isdigit() else i + 1
-            common = dict(rsp=(node, 3), ref=(0, 0), id2="satmd-frfs v1", binary=True)
+            common = dict(rsp=(node, 3), ref=(0, 0), id2=UFF_ID, binary=True)
             parts.append(dataset58(self.freq_hz, self.frf[i], func_type=4, tag=ch,
                                    ordinate=(12, "Acceleration", "m/s^2"), denominator=(13, "Force", "N"), **common))
             parts.append(dataset58(self.freq_hz, self.std[i], func_type=0, tag=f"{ch}_std",
@@ -115,12 +116,33 @@ class ChannelFRFs:
         return write_datasets(parts, path)
 
 
+def is_channel_frfs(path) -> bool:
+    """Whether ``path`` holds FRFs of every channel as `ChannelFRFs.save` writes them."""
+    path = Path(path)
+    suffix = path.suffix.lower()
+    try:
+        if suffix == ".csv":
+            with open(path, encoding="utf-8", errors="replace") as fh:
+                return fh.readline().rstrip("\r\n") == MAGIC
+        if suffix in (".npz", ".mat"):
+            from .matfile import load_variables
+
+            return {"frf", "channels", "freq_hz"} <= set(load_variables(path))
+        if suffix in (".uff", ".unv"):
+            from .uff58 import read_records
+
+            return any(str(r.get("id2", "")).strip() == UFF_ID for r in read_records(path)[0])
+    except (OSError, DataError):
+        return False
+    return False
+
+
 def load_channel_frfs(path) -> ChannelFRFs:
     """FRFs of every channel as `ChannelFRFs.save` wrote them.
 
     Parameters
     ----------
-    path : a .csv, .npz or .mat file
+    path : a .csv, .npz, .mat or .uff file (the UFF without the estimator's description)
 
     Returns
     -------
@@ -135,8 +157,10 @@ def load_channel_frfs(path) -> ChannelFRFs:
     suffix = path.suffix.lower()
     if suffix == ".csv":
         return _read_csv(path)
+    if suffix in (".uff", ".unv"):
+        return _read_uff(path)
     if suffix not in (".npz", ".mat"):
-        raise FormatError(path, "FRFs of every channel are read from .csv, .npz or .mat")
+        raise FormatError(path, "FRFs of every channel are read from .csv, .npz, .mat or .uff")
     from .matfile import load_variables
 
     v = load_variables(path)
@@ -146,6 +170,20 @@ def load_channel_frfs(path) -> ChannelFRFs:
                            str(np.ravel(v["units"])[0]), json.loads(str(np.ravel(v["estimator"])[0])), str(path))
     except KeyError as exc:
         raise FormatError(path, f"no variable {exc.args[0]!r}: not FRFs of every channel") from None
+
+
+def _read_uff(path: Path) -> ChannelFRFs:
+    from .uff58 import read_records
+
+    records = {r.tag: r for r in read_records(path)[0] if str(r.get("id2", "")).strip() == UFF_ID and r.tag}
+    names = [t for t, r in records.items() if r.func_type == 4]
+    parts = [(records[c], records.get(f"{c}_std"), records.get(f"{c}_coh")) for c in names]
+    if not names or any(p is None for part in parts for p in part):
+        raise FormatError(path, "not FRFs of every channel as satmd writes them (each channel's FRF, std and "
+                                "coherence records, ID line 2 'satmd-frfs v1')")
+    frf, std, coh = ([r.data for r in column] for column in zip(*parts))  # type: ignore[union-attr]
+    return ChannelFRFs(parts[0][0].x, tuple(names), np.array(frf), np.real(std), np.real(coh), "m/s^2/N", {},
+                       str(path))
 
 
 def _read_csv(path: Path) -> ChannelFRFs:
@@ -169,4 +207,4 @@ def _read_csv(path: Path) -> ChannelFRFs:
                        notes.get("units", ""), json.loads(notes.get("estimator", "{}")), str(path))
 
 
-__all__ = ["ChannelFRFs", "load_channel_frfs"]
+__all__ = ["ChannelFRFs", "load_channel_frfs", "is_channel_frfs"]

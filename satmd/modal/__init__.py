@@ -35,7 +35,8 @@ from __future__ import annotations
 from .fit import ModalFit, Mode, fit_modes
 from .levels import follow_modes
 from .poles import stable_poles
+from .shapes import ModalSurvey, survey
 from .tracking import TrackedMode, read_trends, track_modes
 
-__all__ = ["fit_modes", "track_modes", "follow_modes", "read_trends", "stable_poles", "Mode", "ModalFit",
+__all__ = ["fit_modes", "survey", "ModalSurvey", "track_modes", "follow_modes", "read_trends", "stable_poles", "Mode", "ModalFit",
            "TrackedMode"]

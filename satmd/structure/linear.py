@@ -19,6 +19,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import DataError
+from ..modal.shapes import driving_point_of
 
 
 @dataclass(frozen=True)
@@ -191,18 +192,8 @@ def _pair_counts(freq_hz) -> list:
 def driving_point(linear: LinearStructure):
     """The channel at the force's point, found: the one whose receptance modal constants ``A_r / λ_r²`` all
     have the driving point's sign (a positive mass-normalised ``φ_d²``, so −Re(A/λ²)·… > 0 on every mode);
-    None when no channel, or more than one, does."""
-    const = modal_constants(linear.residues, linear.poles)
-    weight = np.abs(linear.residues) / np.abs(linear.residues).max(axis=1, keepdims=True)
-    strong = weight > 0.05
-    found = [c for c, k, s in zip(linear.channels, const, strong) if np.all(k[s] > 0)]
-    return found[0] if len(found) == 1 else None
-
-
-def modal_constants(residues, poles) -> np.ndarray:
-    """Each mode's receptance modal constant (φ_a φ_b for a mass-normalised mode) from accelerance residues: the
-    receptance residue is A / λ², and its constant ≈ 2 i ω (A / λ²) for light damping."""
-    return (2j * np.abs(poles) * np.asarray(residues) / poles ** 2).real
+    None when no channel, or more than one, does (`satmd.modal.shapes.driving_point_of`)."""
+    return driving_point_of(linear.channels, linear.residues, linear.poles)
 
 
 def discretise(poles, fs_hz: float):

@@ -67,7 +67,7 @@ def passive_sign(model) -> int:
     point's shapes too little to give a sign (0.42), a quadratic damping was fitted with every mode's constant
     reversed: its force fed the structure, held back at the fitted levels by the linear terms, and at 1.5 times
     the top level the simulation ran away."""
-    from .linear import modal_constants
+    from ..modal.shapes import modal_constants
 
     lin, j = model.linear, model.joint
     const = modal_constants(np.asarray(j.stroke_of(lin), complex) * np.asarray(j.coupling, complex), lin.poles)

@@ -9,7 +9,7 @@ from satmd.cli import main
 from satmd.errors import DataError
 from satmd.io import ChannelFRFs, Recording, load_channel_frfs, save_recording
 from satmd.signal import estimate_frf, estimate_frfs
-from tests.structure.chain import chain_matrices, simulate_chain
+from tests.structure.chain import chain_matrices, linear_chain_test
 
 N = 5
 
@@ -18,7 +18,7 @@ N = 5
 def chain():
     """A linear five-mass chain tested with a multisine, 1 % noise on every channel (the acquisition's
     anti-alias filter on), and its exact accelerances at the force's point (mass 1)."""
-    rec = simulate_chain(n=N, law=lambda d, v: 0.0 * d, levels=(1.0,), periods=6, seed=3, anti_alias=True)[0]
+    rec = linear_chain_test()
     M, K, C = chain_matrices(N)
 
     def exact(f_hz):
@@ -45,8 +45,8 @@ def test_every_channel_matches_the_exact_frf_within_its_std(chain):
     frfs = estimate_frfs(rec, ["acc2", "acc4", "acc5"])
     truth = exact(frfs.freq_hz)[[1, 3, 4]]
     z2 = np.abs(frfs.frf - truth) ** 2 / (2 * frfs.std ** 2)  # σ on each of Re and Im, estimated over periods
-    # z² is F(2, dof) distributed (the std from 2(5 − 1) = 8 degrees of freedom): 97.4 % below 6. Another
-    # channel's exact FRF in place of the truth: 6 % (measured)
+    # z² is F(2, dof) distributed (the std from five steady periods, 2(5 − 1) = 8 degrees of freedom): 97.4 % below
+    # 6. Another channel's exact FRF in place of the truth: 6 % (measured)
     assert frfs.estimator["noise_dof"] == 8
     assert 0.93 < np.mean(z2 < 6) <= 1.0, np.mean(z2 < 6)
     assert np.median(np.abs(frfs.frf - truth) / np.abs(truth)) < 0.02

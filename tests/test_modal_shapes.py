@@ -1,0 +1,95 @@
+"""A structure's modes and shapes (`satmd.modal.survey`, `satmd modes`), against a chain's exact mass-normalised
+modes from its matrices (Newton's law, no satmd code)."""
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+from scipy import linalg
+
+from satmd.cli import main
+from satmd.errors import DataError
+from satmd.io import save_recording
+from satmd.modal import survey
+from satmd.signal import estimate_frfs
+from tests.structure.chain import chain_matrices, linear_chain_test
+
+N = 5
+
+
+def _exact(f_hz):
+    """The chain's accelerances (force on mass 1) and its mass-normalised modes, φ_1 > 0."""
+    M, K, C = chain_matrices(N)
+    w = 2 * np.pi * np.asarray(f_hz)
+    x = np.array([np.linalg.solve(K - wi ** 2 * np.diag(M) + 1j * wi * C, np.eye(N)[0]) for wi in w])
+    w2, phi = linalg.eigh(K, np.diag(M))
+    return (-(w ** 2)[:, None] * x).T, np.sqrt(w2) / (2 * np.pi), (phi * np.sign(phi[0])).T
+
+
+def test_exact_frfs_give_the_mass_normalised_modes():
+    f = np.linspace(3.0, 90.0, 600)
+    H, f_n, phi = _exact(f)
+    found = survey(f, {f"acc{i + 1}": H[i] for i in range(N)})
+    assert found.driving_point == "acc1" and found.normalised == "mass"
+    np.testing.assert_allclose([m.f_hz for m in found.fit.modes], f_n, rtol=1e-4)
+    np.testing.assert_allclose(found.shapes, phi, atol=2e-3)  # light-damping constants: ζ up to 7 %
+    assert np.all(found.complexity < 1e-3)  # proportional damping: real modes
+
+
+def test_shapes_of_a_noisy_test_within_a_few_percent():
+    frfs = estimate_frfs(linear_chain_test())
+    found = survey(frfs.freq_hz, dict(zip(frfs.channels, frfs.frf)), dict(zip(frfs.channels, frfs.std)))
+    _, f_n, phi = _exact([1.0])
+    assert found.driving_point == "acc1" and len(found.fit.modes) == N
+    np.testing.assert_allclose([m.f_hz for m in found.fit.modes], f_n, rtol=2e-3)
+    assert np.max(np.abs(found.shapes - phi)) < 0.03, np.round(found.shapes - phi, 3)
+
+
+def test_another_driving_point_named_is_refused_or_scaled():
+    f = np.linspace(3.0, 90.0, 600)
+    H, _, phi = _exact(f)
+    frf = {f"acc{i + 1}": H[i] for i in range(N)}
+    with pytest.raises(DataError, match="acc3 is not the driving point: its modal constants are not all positive"):
+        survey(f, frf, driving_point="acc3")
+    with pytest.raises(DataError, match="the driving point 'acc9' is not a channel"):
+        survey(f, frf, driving_point="acc9")
+    unit = survey(f, {c: frf[c] for c in ("acc2", "acc3", "acc5")})  # the driving point not measured
+    assert unit.driving_point is None and unit.normalised == "largest"
+    top = phi[:, [1, 2, 4]] / np.take_along_axis(phi[:, [1, 2, 4]], np.argmax(np.abs(phi[:, [1, 2, 4]]), 1)[:, None], 1)
+    np.testing.assert_allclose(unit.shapes, top, atol=5e-3)
+    assert "name the driving point for a mass scale" in unit.report()
+
+
+def test_cli_modes_from_a_recording_and_from_its_frfs(tmp_path, capsys):
+    rec = linear_chain_test()
+    path = save_recording(rec, tmp_path / "gvt.csv")
+    assert main(["modes", str(path), "--json"]) == 0
+    doc = json.loads(capsys.readouterr().out)
+    assert doc["driving_point"] == "acc1" and doc["normalised"] == "mass"
+    assert [round(m["f_hz"]) for m in doc["modes"]] == [9, 26, 42, 54, 61]
+    assert set(doc["modes"][0]["shape"]) == {"acc1", "acc2", "acc3", "acc4", "acc5"}
+    # the first three modes alone: acc2's constants are positive on each too (φ_1 φ_2 > 0), so no sensor alone is
+    # the driving point, and the shapes are scaled to their largest sensor
+    assert main(["modes", str(path), "--json", "--band", "5:50"]) == 0
+    doc = json.loads(capsys.readouterr().out)
+    assert doc["driving_point"] is None and doc["normalised"] == "largest" and len(doc["modes"]) == 3
+    assert 5.0 <= doc["band_hz"][0] and doc["band_hz"][1] <= 50.0
+    frfs = estimate_frfs(rec).save(tmp_path / "frfs.uff")
+    assert main(["modes", str(frfs), "--driving-point", "acc1", "--plot", str(tmp_path / "m.png")]) == 0
+    said = capsys.readouterr().out
+    assert "shapes mass-normalised through the driving point acc1" in said and (tmp_path / "m.png").exists()
+    assert main(["modes", str(frfs), "--driving-point", "acc4"]) == 2
+    assert "acc4 is not the driving point" in capsys.readouterr().err
+
+
+def test_cli_modes_of_a_rigs_frf_file(tmp_path, capsys):
+    """A SATMD rig's A1 and A2: two modes, the primary mass (a1) at the force, each FRF file alone."""
+    data = tmp_path / "rig.csv"
+    assert main(["simulate", "-o", str(data), "--noise", "0.01", "--seed", "1"]) == 0
+    capsys.readouterr()
+    assert main(["modes", str(data), "--json"]) == 0
+    doc = json.loads(capsys.readouterr().out)
+    assert doc["channels"] == ["a1", "a2"] and doc["driving_point"] == "a1" and len(doc["modes"]) == 2
+    assert main(["modes", str(data), str(data)]) == 2
+    assert "one FRF file at a time" in capsys.readouterr().err
