@@ -143,6 +143,21 @@ def structure_cases(base) -> list[dict]:
     add(case("structure levels", "cli", "refuse", ["real.npz", "Acceleration[1,9]", "1..2, 1..3"],
              argv=["discover", "{work}/real.npz", "--map", "force=Force[1],a1=Acceleration[1,9],a2=Acceleration[2,1]"],
              files={"real.npz": real}, label="a realization that is not there"))
+    # a structure's FRFs of every channel and its modes (`estimate-frf --channels`, `satmd modes`)
+    add(case("structure FRFs", "cli", "answer", argv=["estimate-frf", "{base}/s8.csv", "--channels", "all", "-o",
+                                                      "{work}/frfs.uff"]))
+    add(case("structure FRFs", "cli", "answer", argv=["modes", "{base}/s8.csv", "--json"]))
+    add(case("structure FRFs", "cli", "refuse", ["acc9"],
+             argv=["estimate-frf", "{base}/s8.csv", "--channels", "acc2,acc9", "-o", "{work}/frfs.csv"]))
+    add(case("structure FRFs", "cli", "refuse", ["acc9"], argv=["modes", "{base}/s8.csv", "--driving-point", "acc9"]))
+    add(case("structure FRFs", "cli", "refuse", ["s8_still.csv"], argv=["modes", "{base}/s8_still.csv"]))
+    head = "# satmd-frfs v1: the FRF of every response channel over the force\nfreq_hz,acc1_re,acc1_im,acc1_std,acc1_coh\n"
+    for label, body in (("a value not a number", "1,2,3,x,1\n"), ("a row cut short", "1,2,3\n"),
+                        ("a frequency that falls", "2,1,1,0.1,1\n1,1,1,0.1,1\n"), ("NaN", "1,nan,1,0.1,1\n"),
+                        ("no rows", "")):
+        for cmd in (["modes", "{work}/f.csv"], ["info", "{work}/f.csv"], ["identify", "{work}/f.csv"]):
+            add(case("structure FRFs", "cli", "refuse", ["f.csv"], argv=cmd, files={"f.csv": (head + body).encode()},
+                     label=label))
     return cases
 
 
@@ -269,7 +284,7 @@ def generate(base) -> list[dict]:
                          files={name: spec}, args=["{work}/" + name]))
             if suffix in (".csv", ".wav"):
                 for cmd in (["identify", "{work}/" + name], ["estimate-frf", "{work}/" + name, "-o", "{work}/o.csv"],
-                            ["info", "{work}/" + name]):
+                            ["info", "{work}/" + name], ["modes", "{work}/" + name]):
                     add(case("not a regular file", "cli", "refuse", [name], argv=cmd, files={name: spec}))
         add(case("not a regular file", "api", "refuse", ["model.json"], op="load_model", files={"m/model.json": spec},
                  args=["{work}/m"]))

@@ -122,8 +122,11 @@ def is_channel_frfs(path) -> bool:
     suffix = path.suffix.lower()
     try:
         if suffix == ".csv":
+            from .limits import MAX_TEXT_BYTES, check_file
+
+            check_file(path, MAX_TEXT_BYTES)  # a FIFO or a device refused before it is opened
             with open(path, encoding="utf-8", errors="replace") as fh:
-                return fh.readline().rstrip("\r\n") == MAGIC
+                return fh.readline(len(MAGIC) + 2).rstrip("\r\n") == MAGIC
         if suffix in (".npz", ".mat"):
             from .matfile import load_variables
 
@@ -154,6 +157,15 @@ def load_channel_frfs(path) -> ChannelFRFs:
         Another kind of file, or one damaged (its file and what is wrong named).
     """
     path = Path(path)
+    try:
+        return _read(path)
+    except FormatError:
+        raise
+    except DataError as exc:  # what the file holds is not FRFs (NaN, a falling grid): said with the file's name
+        raise FormatError(path, str(exc)) from None
+
+
+def _read(path: Path) -> ChannelFRFs:
     suffix = path.suffix.lower()
     if suffix == ".csv":
         return _read_csv(path)
@@ -187,7 +199,9 @@ def _read_uff(path: Path) -> ChannelFRFs:
 
 
 def _read_csv(path: Path) -> ChannelFRFs:
-    lines = path.read_text(encoding="utf-8").splitlines()
+    from ._common import read_text, text_lines
+
+    lines = [ln for ln in text_lines(read_text(path)) if ln.strip()]
     if not lines or lines[0] != MAGIC:
         raise FormatError(path, f"line 1 is not {MAGIC!r}")
     notes = {k.strip("# "): v.strip() for k, v in (ln.split(":", 1) for ln in lines[1:] if ln.startswith("#"))}
