@@ -93,7 +93,8 @@ def survey(freq_hz, frf: dict, std: dict | None = None, band_hz=None, driving_po
     frf : {channel: (M,) complex accelerance}, every channel over the same force
     std : {channel: (M,) std of the real and imaginary parts}, or None
     band_hz : (lo, hi) Hz to fit (default: all of ``freq_hz``)
-    driving_point : the channel at the force's point (default: found from the residues' signs, `driving_point_of`)
+    driving_point : the channel at the force's point (default: found from the residues' signs, `driving_point_of`;
+        where several sensors pass, the one whose constants are positive on every mode, weak ones too)
     **fit_options : `fit_modes`' n_modes, max_order
 
     Returns
@@ -115,6 +116,9 @@ def survey(freq_hz, frf: dict, std: dict | None = None, band_hz=None, driving_po
     residues = np.array([[m.residues[c] for m in fit.modes] for c in names])  # (channels, modes)
     receptance = 2j * np.abs(poles) * residues / poles ** 2  # ≈ φ_o φ_d, complex where the mode is
     found = driving_point_of(names, residues, poles)
+    if found is None:  # several sensors positive on every mode they see (near one another): the one positive on all
+        everywhere = [c for c, k in zip(names, receptance.real) if np.all(k > 0)]
+        found = everywhere[0] if len(everywhere) == 1 else None
     if driving_point is not None and found != driving_point:
         d = names.index(driving_point)
         if np.any(receptance[d].real <= 0):
