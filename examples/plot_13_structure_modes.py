@@ -1,6 +1,6 @@
 """
 A structure's FRFs and modes: every accelerometer, one set of poles
-==================================================================
+===================================================================
 
 A ground vibration test's first answer is its modes: each one's frequency and damping, and how it moves the
 structure's sensors. Here the F-16 at its lowest level (J.P. Noël and M. Schoukens, "F-16 aircraft benchmark
