@@ -75,20 +75,25 @@ def _frfs(args):
             frfs = estimate_frfs(recordings)
         except SatmdError as err:
             raise SatmdError(str(err) if first in str(err) else f"{where}: {err}") from None
-        return frfs.freq_hz, dict(zip(frfs.channels, frfs.frf)), dict(zip(frfs.channels, frfs.std)), where
+        return frfs.freq_hz, dict(zip(frfs.channels, frfs.frf)), _std(frfs), where
     if len(paths) > 1:
         raise SatmdError(f"{paths[1]}: one FRF file at a time (several files are recordings of one test)")
     if args.map and is_channel_frfs(first):
         raise SatmdError(f"--map: {first} holds FRFs of named channels; it applies to recordings")
     if is_channel_frfs(first):
         frfs = load_channel_frfs(first)
-        return frfs.freq_hz, dict(zip(frfs.channels, frfs.frf)), dict(zip(frfs.channels, frfs.std)), where
+        return frfs.freq_hz, dict(zip(frfs.channels, frfs.frf)), _std(frfs), where
     data = load_frf(first, **({"channel_map": args.map} if args.map else {}))
     accelerations = {c: v for c, v in data.channels.items() if c in ACCEL_CHANNELS}
     if not accelerations:
         raise SatmdError(f"{first}: no acceleration FRF (a1, a2): the modes' shapes are read from accelerances")
     std = {c: data.std[c] for c in accelerations if c in data.std} if data.has_std else None
     return data.freq_hz, accelerations, std if std and len(std) == len(accelerations) else None, where
+
+
+def _std(frfs):
+    """{channel: std}, or None where some point has none (the fit then weighs the channels by their RMS)."""
+    return dict(zip(frfs.channels, frfs.std)) if np.all(frfs.std > 0) else None
 
 
 def plot_survey(found, freq, frf, path, title=""):

@@ -78,7 +78,7 @@ def estimate_frfs(recording, channels=None, **settings) -> ChannelFRFs:
             a = f"a{k + 1}"
             rows[c] = (data.channels[a], data.std.get(a, np.zeros(grid.size)),
                        data.coherence.get(a, np.ones(grid.size)))
-    unit = recording.units.get(names[0], "m/s^2")
+    unit = recording.units.get(names[0]) or "m/s^2"
     assert grid is not None  # one pair at least: ``names`` is not empty
     return ChannelFRFs(grid, tuple(names), np.array([rows[c][0] for c in names]),
                        np.array([rows[c][1] for c in names]), np.array([rows[c][2] for c in names]),
@@ -89,7 +89,7 @@ def _as_rig(recording: Recording, pair) -> Recording:
     """``recording``'s force and the channels ``pair`` as a rig's acc1 (and acc2)."""
     channels = {"force": recording.channels["force"]}
     channels.update({f"acc{k + 1}": recording.channels[c] for k, c in enumerate(pair)})
-    units = {f"acc{k + 1}": recording.units.get(c, "") for k, c in enumerate(pair)}
+    units = {f"acc{k + 1}": recording.units.get(c) or "m/s^2" for k, c in enumerate(pair)}
     units["force"] = recording.units.get("force", "N")
     return Recording(recording.fs_hz, channels, units, dict(recording.meta))
 
