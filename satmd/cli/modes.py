@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 import sys
+from pathlib import Path
 
 import numpy as np
 
@@ -18,14 +19,19 @@ def register(sub):
                                    "first, as estimate-frf --channels all does), FRFs of every channel "
                                    "(estimate-frf --channels), or a rig's FRF file.")
     p.add_argument("inputs", nargs="+", metavar="FILE",
-                   help="a time recording (several files of one test give one FRF), or one FRF file")
+                   help="a time recording (several files of one test give one FRF), FRFs of every channel, or "
+                        "FRF files of one structure over one grid (a roving test: one file a point, each named by "
+                        "its file)")
     p.add_argument("--map", default=None, metavar="MAP",
                    help="recordings: which variables or columns are the force and the sensors, e.g. "
                         "force=Force,a1=Acceleration[1],a2=Acceleration[2],a3=Acceleration[3]")
     add_recording_options(p)
+    p.add_argument("--freq-axis", default=None, metavar="START:STEP",
+                   help="frequency axis in Hz of .txt FRF files (one complex value per line)")
     p.add_argument("--band", default=None, metavar="LO:HI", help="fit the modes between LO and HI Hz")
     p.add_argument("--driving-point", default=None, metavar="NAME",
-                   help="the sensor at the force's point (default: found, or none)")
+                   help="the sensor at the force's point (default: found, or none); taken at its word, the modes "
+                        "where its modal constants have the other sign said")
     p.add_argument("--json", action="store_true", help="print the modes as JSON")
     p.add_argument("--plot", default=None, metavar="FIG.png", help="the FRFs with the fit, and the modes' shapes")
     p.set_defaults(func=run)
@@ -76,19 +82,35 @@ def _frfs(args):
         except SatmdError as err:
             raise SatmdError(str(err) if first in str(err) else f"{where}: {err}") from None
         return frfs.freq_hz, dict(zip(frfs.channels, frfs.frf)), _std(frfs), where
-    if len(paths) > 1:
-        raise SatmdError(f"{paths[1]}: one FRF file at a time (several files are recordings of one test)")
     if args.map and is_channel_frfs(first):
         raise SatmdError(f"--map: {first} holds FRFs of named channels; it applies to recordings")
-    if is_channel_frfs(first):
+    if len(paths) == 1 and is_channel_frfs(first):
         frfs = load_channel_frfs(first)
         return frfs.freq_hz, dict(zip(frfs.channels, frfs.frf)), _std(frfs), where
-    data = load_frf(first, **({"channel_map": args.map} if args.map else {}))
-    accelerations = {c: v for c, v in data.channels.items() if c in ACCEL_CHANNELS}
-    if not accelerations:
-        raise SatmdError(f"{first}: no acceleration FRF (a1, a2): the modes' shapes are read from accelerances")
-    std = {c: data.std[c] for c in accelerations if c in data.std} if data.has_std else None
-    return data.freq_hz, accelerations, std if std and len(std) == len(accelerations) else None, where
+    options = {k: v for k, v in (("channel_map", args.map), ("freq_axis", args.freq_axis)) if v}
+    freq, frf, std = None, {}, {}
+    for path in paths:
+        if is_recording(path) or is_channel_frfs(path):
+            raise SatmdError(f"{path}: FRF files of one structure are read together, not with recordings or FRFs "
+                             "of every channel")
+        data = load_frf(path, **options)
+        accelerations = {c: v for c, v in data.channels.items() if c in ACCEL_CHANNELS}
+        if not accelerations:
+            raise SatmdError(f"{path}: no acceleration FRF (a1, a2): the modes' shapes are read from accelerances")
+        if freq is None:
+            freq = data.freq_hz
+        elif data.freq_hz.shape != freq.shape or not np.allclose(data.freq_hz, freq, rtol=1e-9, atol=0):
+            raise SatmdError(f"{path}: another frequency grid than {first}'s ({data.freq_hz.size} points "
+                             f"{data.freq_hz[0]:g}..{data.freq_hz[-1]:g} Hz against {freq.size}, "
+                             f"{freq[0]:g}..{freq[-1]:g})")
+        for c, v in accelerations.items():  # one file: its channels; several: each channel named by its file
+            name = c if len(paths) == 1 else (Path(path).stem if len(accelerations) == 1 else f"{Path(path).stem}:{c}")
+            if name in frf:
+                raise SatmdError(f"{path}: a second FRF named {name!r} (files of one name in two folders?)")
+            frf[name] = v
+            if c in data.std:
+                std[name] = data.std[c]
+    return freq, frf, std if len(std) == len(frf) and all(np.all(s > 0) for s in std.values()) else None, where
 
 
 def _std(frfs):

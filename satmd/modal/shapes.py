@@ -50,6 +50,8 @@ class ModalSurvey:
     complexity : (modes,) 0 for a real (normal) mode, up to 1
     driving_point : the channel at the force's point (named or found), or None
     normalised : ``"mass"`` or ``"largest"``
+    other_sign_hz : the modes where a named driving point's constant has the sign no driving point has (a delay
+        or a sign convention in the measurement chain, or not the force's point): their mass scale is doubtful
     """
 
     fit: ModalFit
@@ -58,10 +60,12 @@ class ModalSurvey:
     complexity: np.ndarray
     driving_point: str | None
     normalised: str
+    other_sign_hz: tuple = ()
 
     def to_dict(self) -> dict:
         """The modes (f, ζ, intervals), each with its shape by channel and its complexity."""
         return {"channels": list(self.channels), "driving_point": self.driving_point, "normalised": self.normalised,
+                "other_sign_hz": list(self.other_sign_hz),
                 "band_hz": list(self.fit.band_hz), "chi2_reduced": self.fit.chi2_reduced,
                 "modes": [{**m.to_dict(), "shape": dict(zip(self.channels, map(float, s))), "complexity": float(c)}
                           for m, s, c in zip(self.fit.modes, self.shapes, self.complexity)]}
@@ -74,8 +78,11 @@ class ModalSurvey:
         f_text = [f"{m.f_hz:.4g} [{m.f_ci95[0]:.4g}, {m.f_ci95[1]:.4g}]" for m in self.fit.modes]
         z_text = [f"{100 * m.zeta:.3g} [{100 * m.zeta_ci95[0]:.2g}, {100 * m.zeta_ci95[1]:.2g}]" for m in self.fit.modes]
         wf, wz = max(map(len, f_text + ["f [Hz]"])), max(map(len, z_text + ["ζ [%]"]))
+        odd = (f"; {self.driving_point}'s modal constants have the other sign at "
+               f"{', '.join(f'{f:.4g}' for f in self.other_sign_hz)} Hz (a delay or a sign convention in the chain, or "
+               "not the force's point): their mass scale is doubtful" if self.other_sign_hz else "")
         lines = [f"{len(self.fit.modes)} modes {self.fit.band_hz[0]:.4g}–{self.fit.band_hz[1]:.4g} Hz over "
-                 f"{len(self.channels)} sensors; shapes {how}",
+                 f"{len(self.channels)} sensors; shapes {how}{odd}",
                  f"{'f [Hz]':<{wf}s}  {'ζ [%]':<{wz}s}  " + " ".join(f"{c:>8s}" for c in self.channels)
                  + "  complexity"]
         for ft, zt, s, c in zip(f_text, z_text, self.shapes, self.complexity):
@@ -104,7 +111,8 @@ def survey(freq_hz, frf: dict, std: dict | None = None, band_hz=None, driving_po
     Raises
     ------
     DataError
-        A driving point that is not a channel, or one whose constants are not positive (not at the force).
+        A driving point that is not a channel. One named whose constants are not all positive is taken at its
+        word, and the modes where they are not are said (``other_sign_hz``).
     """
     names = tuple(frf)
     if driving_point is not None and driving_point not in names:
@@ -119,12 +127,9 @@ def survey(freq_hz, frf: dict, std: dict | None = None, band_hz=None, driving_po
     if found is None:  # several sensors positive on every mode they see (near one another): the one positive on all
         everywhere = [c for c, k in zip(names, receptance.real) if np.all(k > 0)]
         found = everywhere[0] if len(everywhere) == 1 else None
-    if driving_point is not None and found != driving_point:
-        d = names.index(driving_point)
-        if np.any(receptance[d].real <= 0):
-            raise DataError(f"{driving_point} is not the driving point: its modal constants are not all positive "
-                            f"({', '.join(f'{m.f_hz:.4g} Hz' for m, k in zip(fit.modes, receptance[d].real) if k <= 0)}"
-                            " of the other sign)")
+    odd: tuple = ()
+    if driving_point is not None:  # the user's word, with the modes whose sign disagrees said
+        odd = tuple(m.f_hz for m, k in zip(fit.modes, receptance[names.index(driving_point)].real) if k <= 0)
     point = driving_point or found
     turn = np.exp(-0.5j * np.angle(np.sum(receptance ** 2, axis=0)))  # the rotation that makes each mode most real
     real = (receptance * turn).real.T  # (modes, channels)
@@ -134,7 +139,7 @@ def survey(freq_hz, frf: dict, std: dict | None = None, band_hz=None, driving_po
         d = names.index(point)
         real = real * np.sign(real[:, d:d + 1] + TINY)
         shapes = real / np.sqrt(np.maximum(real[:, d:d + 1], TINY))  # φ_o = (φ_o φ_d) / φ_d
-        return ModalSurvey(fit, names, shapes, complexity, point, "mass")
+        return ModalSurvey(fit, names, shapes, complexity, point, "mass", odd)
     largest = np.take_along_axis(real, np.argmax(np.abs(real), axis=1)[:, None], axis=1)
     return ModalSurvey(fit, names, real / largest, complexity, None, "largest")
 
