@@ -200,10 +200,42 @@ def _every_channel(args, recs, out: Path) -> int:
               "median over the band): these responses are barely related to the force; check the channels "
               "(--map), the sensors and the excitation before trusting their FRFs", file=sys.stderr)
     if args.plot:
-        curves = {c: (h, s, None) for c, h, s in zip(frfs.channels, frfs.frf, frfs.std)}
-        plot_estimate(freq, curves, coh, args.plot, title=f"{Path(args.recording).name}: {kind}")
+        title = f"{Path(args.recording).name}: {kind}"
+        if len(frfs.channels) > SIDE_BY_SIDE:
+            plot_overlaid(frfs, args.plot, title)
+        else:
+            curves = {c: (h, s, None) for c, h, s in zip(frfs.channels, frfs.frf, frfs.std)}
+            plot_estimate(freq, curves, coh, args.plot, title=title)
         print(f"plot: {args.plot}")
     return 0
+
+
+SIDE_BY_SIDE = 4  # FRFs plotted a column each; more are overlaid (a GVT's eight would make a figure 35 inches wide)
+
+
+def plot_overlaid(frfs, path, title=""):
+    """Every channel's |H|, phase and coherence overlaid, one colour a channel."""
+    from ..plots import pyplot, save
+
+    plt = pyplot()
+    fig, axes = plt.subplots(3, 1, figsize=(9, 8.5), sharex=True)
+    for k, (name, h, g) in enumerate(zip(frfs.channels, frfs.frf, frfs.coherence)):
+        colour = f"C{k % 10}"
+        axes[0].semilogy(frfs.freq_hz, np.abs(h), color=colour, lw=0.8, label=name)
+        axes[1].plot(frfs.freq_hz, np.degrees(np.angle(h)), color=colour, lw=0.6)
+        axes[2].plot(frfs.freq_hz, g, color=colour, lw=0.6)
+    axes[0].set_ylabel(f"|H| [{frfs.units}]")
+    axes[0].legend(fontsize=8, ncol=min(len(frfs.channels), 8))
+    axes[1].set_ylabel("phase [deg]")
+    axes[2].set_ylabel("coherence γ²")
+    axes[2].set_ylim(0, 1.05)
+    axes[2].set_xlabel("frequency [Hz]")
+    for ax in axes:
+        ax.grid(True, which="both", alpha=0.3)
+    if title:
+        fig.suptitle(title)
+    fig.tight_layout()
+    return save(fig, path)
 
 
 def _several(estimator: dict, recordings) -> str:

@@ -84,7 +84,8 @@ def test_bad_channels_refused_naming_them(chain):
 def test_cli_channels_all_writes_every_channel(chain, tmp_path, capsys):
     path = save_recording(chain[0], tmp_path / "gvt.csv")
     out = tmp_path / "frfs.csv"
-    assert main(["estimate-frf", str(path), "--channels", "all", "-o", str(out)]) == 0
+    assert main(["estimate-frf", str(path), "--channels", "all", "-o", str(out), "--plot", str(tmp_path / "f.png")]) == 0
+    assert (tmp_path / "f.png").stat().st_size > 0  # five channels: overlaid in one column
     said = capsys.readouterr().out
     assert f"FRFs of {N} channels (acc1, acc2, acc3, acc4, acc5) over the force" in said
     assert load_channel_frfs(out).channels == tuple(f"acc{i}" for i in range(1, N + 1))
