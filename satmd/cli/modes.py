@@ -81,12 +81,12 @@ def _frfs(args):
             frfs = estimate_frfs(recordings)
         except SatmdError as err:
             raise SatmdError(str(err) if first in str(err) else f"{where}: {err}") from None
-        return frfs.freq_hz, dict(zip(frfs.channels, frfs.frf)), _std(frfs), where
+        return (*_arrays(frfs), where)
     if args.map and is_channel_frfs(first):
         raise SatmdError(f"--map: {first} holds FRFs of named channels; it applies to recordings")
     if len(paths) == 1 and is_channel_frfs(first):
         frfs = load_channel_frfs(first)
-        return frfs.freq_hz, dict(zip(frfs.channels, frfs.frf)), _std(frfs), where
+        return (*_arrays(frfs), where)
     options = {k: v for k, v in (("channel_map", args.map), ("freq_axis", args.freq_axis)) if v}
     freq, frf, std = None, {}, {}
     for path in paths:
@@ -110,12 +110,17 @@ def _frfs(args):
             frf[name] = v
             if c in data.std:
                 std[name] = data.std[c]
-    return freq, frf, std if len(std) == len(frf) and all(np.all(s > 0) for s in std.values()) else None, where
+    return freq, frf, _weights(std) if len(std) == len(frf) else None, where
 
 
-def _std(frfs):
-    """{channel: std}, or None where some point has none (the fit then weighs the channels by their RMS)."""
-    return dict(zip(frfs.channels, frfs.std)) if np.all(frfs.std > 0) else None
+def _arrays(frfs) -> tuple:
+    """(freq, {channel: FRF}, {channel: std} or None) of `ChannelFRFs`."""
+    return frfs.freq_hz, dict(zip(frfs.channels, frfs.frf)), _weights(dict(zip(frfs.channels, frfs.std)))
+
+
+def _weights(std: dict):
+    """``std`` ({channel: std}), or None where some point has none (the fit then weighs the channels by their RMS)."""
+    return std if all(np.all(s > 0) for s in std.values()) else None
 
 
 def plot_survey(found, freq, frf, path, title=""):

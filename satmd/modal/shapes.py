@@ -28,13 +28,17 @@ def modal_constants(residues, poles) -> np.ndarray:
     return (2j * np.abs(poles) * np.asarray(residues) / poles ** 2).real
 
 
-def driving_point_of(channels, residues, poles):
+def driving_point_of(channels, residues, poles, weak_too: bool = False):
     """The channel at the force's point, found: the one whose modal constants (`modal_constants`) are positive on
-    every mode it sees (`STRONG`), as ``φ_d²`` is; None when no channel, or more than one, has that."""
+    every mode it sees (`STRONG`), as ``φ_d²`` is; None when no channel, or more than one, has that. ``weak_too``:
+    where several pass (sensors near one another, in phase on every strong mode), the one positive on every mode,
+    weak ones too, where one alone is."""
     const = modal_constants(residues, poles)
     size = np.abs(np.asarray(residues))
     strong = size > STRONG * np.maximum(size.max(axis=1, keepdims=True), TINY)
     found = [c for c, k, s in zip(channels, const, strong) if np.all(k[s] > 0)]
+    if len(found) > 1 and weak_too:
+        found = [c for c, k in zip(channels, const) if c in found and np.all(k > 0)]
     return found[0] if len(found) == 1 else None
 
 
@@ -123,10 +127,7 @@ def survey(freq_hz, frf: dict, std: dict | None = None, band_hz=None, driving_po
     poles = np.array([m.pole for m in fit.modes])
     residues = np.array([[m.residues[c] for m in fit.modes] for c in names])  # (channels, modes)
     receptance = 2j * np.abs(poles) * residues / poles ** 2  # ≈ φ_o φ_d, complex where the mode is
-    found = driving_point_of(names, residues, poles)
-    if found is None:  # several sensors positive on every mode they see (near one another): the one positive on all
-        everywhere = [c for c, k in zip(names, receptance.real) if np.all(k > 0)]
-        found = everywhere[0] if len(everywhere) == 1 else None
+    found = driving_point_of(names, residues, poles, weak_too=True)
     odd: tuple = ()
     if driving_point is not None:  # the user's word, with the modes whose sign disagrees said
         odd = tuple(m.f_hz for m, k in zip(fit.modes, receptance[names.index(driving_point)].real) if k <= 0)
