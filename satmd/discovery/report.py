@@ -146,7 +146,8 @@ class DiscoveryReport:
             assert self.adequacy is not None  # only an Adequacy says "not adequate"
             lines.append(f"    MODEL NOT ADEQUATE: {self.adequacy.summary}. No physics is named: the SATMD model, "
                          "with any vocabulary effects, does not describe these data.")
-            lines += [f"      - {r.kind}: {r.message}" for r in self.adequacy_reasons]
+            lines += [f"      - {r.kind}: {r.message}" for r in self.adequacy_reasons  # the summary's said above
+                      if r.message != self.adequacy.summary]
             if self.withdrawn:
                 lines.append(f"    withdrawn: {', '.join(self.withdrawn)} (what the search fitted before the model was "
                              "found not to describe the data)")

@@ -102,7 +102,7 @@ class Adequacy:
         if self.adequate:
             return "model adequate: the SATMD model can describe these data"
         lines = [f"MODEL NOT ADEQUATE: {self.summary}"]
-        lines += [f"    - {r.kind}: {r.message}" for r in self.reasons]
+        lines += [f"    - {r.kind}: {r.message}" for r in self.reasons if r.message != self.summary]  # the others
         return "\n".join(lines)
 
     def __str__(self):

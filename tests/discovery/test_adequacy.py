@@ -107,6 +107,8 @@ def test_another_structure_gets_no_physics():
     assert not rep.model_adequate and rep.effects == []
     assert set(_kinds(rep)) & {"poor_fit", "implausible"}
     assert "MODEL NOT ADEQUATE" in rep.report()
+    for text in (rep.report(), rep.adequacy.report()):  # each reason said once: the summary's is not listed again
+        assert all(text.count(r.message) == 1 for r in rep.adequacy.reasons), text
 
 
 def test_in_model_data_are_adequate():

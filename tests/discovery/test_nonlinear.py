@@ -215,3 +215,19 @@ def test_nonlinear_findings_are_typed_and_read_as_their_json():
                            "equivalent_linear": {}, "modes": [{"trend": "softening"}], "explanation": "x"}
     with pytest.raises(KeyError):
         f["moving"]
+
+
+def test_tests_that_could_not_run_for_one_reason_are_said_once():
+    """Four levels' "distortion_lines#k: not run (same reason)" read as one line; a test that ran, or another
+    reason, keeps its own (the JSON keeps every test)."""
+    from satmd.discovery.nonlinear.stats import NonlinearTest
+
+    why = "no detection lines: the force reaches every line up to 1.5x the band"
+    tests = [NonlinearTest(f"distortion_lines#{k}", np.nan, [], 1e-3, {"reason": why}) for k in (1, 2, 3, 4)]
+    tests += [NonlinearTest("distortion#5", np.nan, [], 1e-3, {"reason": "a sweep"}),
+              NonlinearTest("level_dependence", 0.0, [(7.0, 7.4)], 2.5e-4)]
+    rep = NonlinearReport(True, tests, [], [])
+    lines = [x for x in rep.report().splitlines() if x.startswith("    test ")]
+    assert lines[0] == f"    test distortion_lines#1–#4: not run ({why})"
+    assert lines[1] == "    test distortion#5: not run (a sweep)" and lines[2].startswith("    test level_dependence: p = 0")
+    assert len(lines) == 3 and len(rep.to_dict()["tests"]) == 6

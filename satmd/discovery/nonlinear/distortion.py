@@ -71,7 +71,7 @@ class NonlinearReport:
         if not self.detected and self.tests and all(t.not_run for t in self.tests):
             head = "linearity not tested: no test could run on these data"
         lines = [f"[[Nonlinearity]] {head}"]
-        lines += [f"    test {t.report()}" for t in self.tests]
+        lines += [f"    test {line}" for line in _test_lines(self.tests)]
         for f in self.findings:
             lines.append(f"  - {f['name']}: {f['explanation']}")
             if f.get("equivalent"):
@@ -85,6 +85,24 @@ class NonlinearReport:
 
     def __str__(self):
         return self.report()
+
+
+def _test_lines(tests) -> list:
+    """Each test's line, the recordings' tests that could not run for one reason said once
+    (``distortion_lines#1–#4: not run (...)``: four levels' identical lines told a reader nothing more)."""
+    lines, k = [], 0
+    while k < len(tests):
+        t, j = tests[k], k + 1
+        if t.not_run:
+            base = t.name.split("#")[0]
+            while j < len(tests) and tests[j].not_run == t.not_run and tests[j].name.split("#")[0] == base:
+                j += 1
+        if j - k > 1:
+            lines.append(f"{t.name}–#{tests[j - 1].name.split('#')[-1]}: not run ({t.not_run})")
+        else:
+            lines.append(t.report())
+        k = j
+    return lines
 
 
 # --- detection on one recording ----------------------------------------------------------------------------
