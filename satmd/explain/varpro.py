@@ -26,7 +26,7 @@ _PIVOT = 1e-12
 
 class _Projector:
     """Least squares on ``A = [1, cols...]`` (the column of ones optional), factored once: the residual and
-    Kaufman's Jacobian at one point share the factor (each made its own: a third of a ranking fit's time).
+    Kaufman's Jacobian at one point share the factor (each made its own: a fifth of a ranking search's time).
 
     The normal equations of the centred, column-scaled columns (a few columns: far cheaper
     than ``lstsq``); nearly dependent columns get ``lstsq``'s minimum-norm answer."""
