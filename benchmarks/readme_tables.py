@@ -344,7 +344,8 @@ def measured() -> str:
         + f"; median {se['median_time_s']:.2f} s | same |",
         f"| discovery with noise estimated / two simultaneous effects | {ne['correct_of_detectable']}/"
         f"{ne['detectable']} / {se2['correct_of_detectable']}/{se2['detectable']} of the detectable ones | same |",
-        f"| start-up: `import satmd`, `satmd --help` (fresh interpreter each, median of {st['repeats']}) | "
+        f"| start-up: `import satmd`, `satmd --help` (fresh interpreter each, median of {st['repeats']}"
+        f"{', bytecode cached as installed' if st.get('bytecode') else ''}) | "
         f"{st['median_cpu_s']['import_satmd']:.2f} s / {st['median_cpu_s']['satmd_help']:.2f} s of CPU "
         f"(heavy modules loaded at import: {heavy}); wall {st['median_s']['import_satmd']:.2f} s / "
         f"{st['median_s']['satmd_help']:.2f} s on a {st['cpu_count']}-core machine at load average "
