@@ -23,7 +23,9 @@ demo: $(STAMP)
 # The suite on every core (pytest-xdist: the tests are independent), one BLAS thread a worker: two
 # workers of two BLAS threads each would fight over two cores. A module's tests on one worker (loadscope):
 # spread test by test, both workers built the same module fixtures (simulations, fits): 500 s → 358 s.
-TEST_ENV := OMP_NUM_THREADS=1 OPENBLAS_NUM_THREADS=1 MKL_NUM_THREADS=1
+# Bytecode is written and read whatever the caller's environment says (PYTHONDONTWRITEBYTECODE set: each
+# worker and each `satmd` the docs' and README's blocks run compiled satmd's modules afresh).
+TEST_ENV := OMP_NUM_THREADS=1 OPENBLAS_NUM_THREADS=1 MKL_NUM_THREADS=1 PYTHONDONTWRITEBYTECODE=
 PYTEST_XDIST := -n auto --dist loadscope
 test: $(STAMP)
 	$(TEST_ENV) $(PY) -m pytest -q $(PYTEST_XDIST)

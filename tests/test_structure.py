@@ -27,6 +27,7 @@ from __future__ import annotations
 
 import ast
 import itertools
+from collections.abc import Mapping, Sequence
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parent.parent / "satmd"
@@ -41,9 +42,40 @@ def _module_name(path: Path) -> str:
     return ".".join(parts[:-1] if parts[-1] == "__init__" else parts)
 
 
+class _Lazy:
+    """A table of this file made on first use, not on import: every test worker imports (collects) this file,
+    one runs its tests, and the package's syntax trees and graphs took 4-6 s to make."""
+
+    def __init__(self, make):
+        self._make, self._made = make, None
+
+    def made(self):
+        if self._made is None:
+            self._made = self._make()
+        return self._made
+
+    def __getitem__(self, key):
+        return self.made()[key]
+
+    def __iter__(self):
+        return iter(self.made())
+
+    def __len__(self):
+        return len(self.made())
+
+
+class _LazyMapping(_Lazy, Mapping):
+    pass
+
+
+class _LazyList(_Lazy, Sequence):
+    pass
+
+
 MODULES = {_module_name(p): p for p in sorted(ROOT.rglob("*.py"))}
 PACKAGES = {_module_name(p) for p in MODULES.values() if p.name == "__init__.py"}
-TREES = {name: ast.parse(path.read_text(encoding="utf-8"), str(path)) for name, path in MODULES.items()}
+TREES = _LazyMapping(lambda: {name: ast.parse(path.read_text(encoding="utf-8"), str(path))
+                              for name, path in MODULES.items()})
 
 
 def _package_of(module: str) -> str:
@@ -98,7 +130,7 @@ def _reexports(package: str) -> dict:
     return out
 
 
-REEXPORTS = {p: _reexports(p) for p in PACKAGES}
+REEXPORTS = _LazyMapping(lambda: {p: _reexports(p) for p in PACKAGES})
 
 
 def _defining_module(package: str, name: str, seen=()) -> str:
@@ -135,8 +167,8 @@ def _edges(module: str, typed: bool = False, trees=None) -> dict:
     return out
 
 
-GRAPH = {m: _edges(m) for m in MODULES}
-TYPED_GRAPH = {m: _edges(m, typed=True) for m in MODULES}
+GRAPH = _LazyMapping(lambda: {m: _edges(m) for m in MODULES})
+TYPED_GRAPH = _LazyMapping(lambda: {m: _edges(m, typed=True) for m in MODULES})
 
 
 def _cycles(graph: dict) -> list[list[str]]:
@@ -200,11 +232,12 @@ def _in_progress(name: str) -> bool:
     return any(name == p or name.startswith(p + ".") for p in IN_PROGRESS)
 
 
-CYCLES = _cycles(GRAPH)
+CYCLES = _LazyList(lambda: _cycles(GRAPH))
 # the same without the package under restructuring, so that a circle through it hides no other
-SETTLED = {m: {t: k for t, k in e.items() if not _in_progress(t)} for m, e in GRAPH.items() if not _in_progress(m)}
-LONG = sorted((n, len(MODULES[n].read_text(encoding="utf-8").splitlines())) for n in MODULES)
-LONG = [(n, k) for n, k in LONG if k > MAX_LINES]
+SETTLED = _LazyMapping(lambda: {m: {t: k for t, k in e.items() if not _in_progress(t)} for m, e in GRAPH.items()
+                                if not _in_progress(m)})
+LONG = _LazyList(lambda: [(n, k) for n, k in sorted((n, len(MODULES[n].read_text(encoding="utf-8").splitlines()))
+                                                    for n in MODULES) if k > MAX_LINES])
 
 
 def _private_imports() -> list[str]:
@@ -235,7 +268,7 @@ def _private_imports() -> list[str]:
     return out
 
 
-PRIVATE = _private_imports()
+PRIVATE = _LazyList(_private_imports)
 
 
 def test_the_graph_sees_the_package():
@@ -391,7 +424,7 @@ def _convention_literals(trees=None) -> list[str]:
     return out
 
 
-LITERALS = _convention_literals()
+LITERALS = _LazyList(_convention_literals)
 
 
 def test_no_convention_literal_outside_the_conventions():
