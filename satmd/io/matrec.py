@@ -7,8 +7,9 @@ a channel map says
 variable, or one row of a matrix of signals, counted from 1; the long axis of a
 matrix is time; any number of accelerometers ``a<N>``). An array of more axes (a lab's realizations: the
 F-16 benchmark's odd multisines hold ``Acceleration`` 3×9×49152, channel × realization × time) takes one index
-per axis but time, ``Acceleration[1,5]``; without a map every realization is read, one after another (the
-recording's `Recording.realisations`); axes of length one are dropped (3×1×N reads as 3×N). The sample rate
+per axis but time, ``Acceleration[1,5]``; without a map, or with one that names the force whole
+(``force=Force,a1=Acceleration[1]``), every realization is read, one after another (the recording's
+`Recording.realisations`); axes of length one are dropped (3×1×N reads as 3×N). The sample rate
 is given, or a variable (`FS_NAMES`, any case), or a uniform time vector (`TIME_NAMES`).
 """
 from __future__ import annotations
@@ -215,6 +216,51 @@ def _realisations(path, v):
     return flat, used, {"realisations": str(r), "realisation_samples": str(n)}
 
 
+def _mapped_realisations(path, v, roles):
+    """`_realisations` as a channel map names the signals: the force a variable of realisation × time, given whole
+    (``force=Force``), each response with one index fewer than its array has axes but time, the realisation axis left
+    free (``a1=Acceleration[1]`` of channel × realisation × time: the F-16 benchmark's odd multisines), or a
+    variable of the force's shape. None when the map's force is one signal."""
+    name, index = _source(path, roles["force"], "force") if "force" in roles else (None, None)
+    key = None if name is None or index is not None else _lookup(v, name)
+    if key is None or np.asarray(v[key]).dtype.kind not in "biuf":
+        return None
+    force = _squeezed(np.asarray(v[key]))
+    if force.ndim != 2 or min(force.shape) < 2 or min(force.shape) > MAX_REALISATIONS:
+        return None
+    force = _signal_rows(force)
+    r, n = force.shape
+    signals = {"force": force}
+    for role, spec in roles.items():
+        if role == "force":
+            continue
+        name, index = _source(path, spec, role)
+        k = _lookup(v, name)
+        if k is None:
+            raise FormatError(path, f"map {role}={spec}: no variable {name!r}; found: {', '.join(sorted(v))}")
+        a = _squeezed(np.asarray(v[k]))
+        a = np.moveaxis(a, int(np.argmax(a.shape)), -1) if a.ndim >= 2 else a
+        axes = a.shape[:-1]
+        free = [i for i, m in enumerate(axes) if m == r]  # the realisation axis: the force's count
+        if a.shape[-1] != n or len(axes) != (0 if index is None else len(index)) + 1 or not free:
+            raise FormatError(path, f"map {role}={spec}: {k!r} has shape {_shape(np.asarray(v[k]))}, the force "
+                                    f"{key} {r}×{n} (realisation × time): each response needs the force's "
+                                    f"realisations (an index for every other axis), or pick one realisation, "
+                                    f"e.g. force={key}[1]")
+        at = free[-1]  # channel × realisation × time where both fit (the F-16's order)
+        rest = [i for i in range(len(axes)) if i != at]
+        picked = np.moveaxis(a, at, 0)
+        for i, m in zip(index or (), [axes[j] for j in rest]):
+            if not 1 <= i <= m:
+                raise FormatError(path, f"map {role}={spec}: {k!r} has shape {_shape(np.asarray(v[k]))}: its index "
+                                        f"runs 1..{m} (the realisations, {r}, are read one after another)")
+        picked = picked[(slice(None), *[i - 1 for i in index or ()])]
+        signals[role] = picked
+    flat = {role: vector_variable(path, roles[role], x.reshape(-1)) for role, x in signals.items()}
+    used = {_lookup(v, _source(path, spec, role)[0]) for role, spec in roles.items()}
+    return flat, used, {"realisations": str(r), "realisation_samples": str(n)}
+
+
 def read_recording_variables(path, channel_map=None, fs_hz=None):
     """(fs_hz, {name: series}) from a .mat / .npz recording.
 
@@ -223,7 +269,8 @@ def read_recording_variables(path, channel_map=None, fs_hz=None):
     ``acc1`` from row 1), or as ``channel_map`` says (``"force=Force,a1=Acceleration[2],a3=Acceleration[1]"``:
     a variable, or one row of a matrix of signals, counted from 1; any ``a<N>``).
     The sample rate is ``fs_hz``, or a variable (`FS_NAMES`, any case), or a time vector. A force of several
-    realisations (realisation × time) is read whole, its realisations one after another (`_realisations`).
+    realisations (realisation × time) is read whole, its realisations one after another (`_realisations`), with
+    a map too where it names the force whole (``force=Force,a1=Acceleration[1]``, `_mapped_realisations`).
 
     Returns
     -------
@@ -235,11 +282,11 @@ def read_recording_variables(path, channel_map=None, fs_hz=None):
         raise FormatError(path, "it holds 'freq_hz' (it looks like FRFs), no sample rate")
     fs, fs_key = _sample_rate(path, v, fs_hz)
     meta: dict = {}
-    several = None if channel_map else _realisations(path, v)
+    roles = _parse_variable_map(path, channel_map) if channel_map else None
+    several = _mapped_realisations(path, v, roles) if roles else _realisations(path, v)
     if several is not None:
         signals, used, meta = several
-    elif channel_map:
-        roles = _parse_variable_map(path, channel_map)
+    elif roles:
         signals = {role: _signal(path, v, spec, role) for role, spec in roles.items()}
         used = {_lookup(v, _source(path, spec, role)[0]) for role, spec in roles.items()}
     else:

@@ -174,6 +174,29 @@ def test_realizations_are_read_one_at_a_time(tmp_path, suffix):
         load_recording(every, channel_map="force=Force[1],a1=Acceleration[1,5]")
 
 
+def test_a_map_that_names_the_force_whole_reads_every_realisation(tmp_path):
+    """``force=Force,a1=Acceleration[1],...`` (the F-16's map) on a file of realisations reads them all, one after
+    another, as the file read without a map does (it was refused: "'Force' has shape 4×400, several signals")."""
+    rng = np.random.default_rng(5)
+    force, accel = rng.normal(size=(4, N)), rng.normal(size=(3, 4, N))
+    p = tmp_path / "odd.npz"
+    np.savez(p, Force=force, Acceleration=accel, Fs=np.float64(FS))
+    mapped = load_recording(p, channel_map="force=Force,a1=Acceleration[3],a2=Acceleration[1]")
+    assert list(mapped.channels) == ["force", "acc1", "acc2"] and mapped.meta["realisations"] == "4"
+    np.testing.assert_array_equal(mapped.realisations()[2]["acc1"], accel[2, 2])
+    np.testing.assert_array_equal(mapped["acc2"], load_recording(p)["acc1"])
+    np.savez(p, Force=force, Acceleration=accel.transpose(1, 0, 2), Fs=np.float64(FS))  # realisation × channel
+    np.testing.assert_array_equal(load_recording(p, channel_map="force=Force,a1=Acceleration[3]")["acc1"],
+                                  accel[2].reshape(-1))
+    with pytest.raises(FormatError, match=r"acc1=Acceleration\[4\]: 'Acceleration' has shape 4×3×400: its index "
+                                          r"runs 1\.\.3"):
+        load_recording(p, channel_map="force=Force,a1=Acceleration[4]")
+    np.savez(p, Force=force, Acceleration=accel, Other=rng.normal(size=(3, N)), Fs=np.float64(FS))
+    with pytest.raises(FormatError, match=r"acc2=Other: 'Other' has shape 3×400, the force Force 4×400 "
+                                          r"\(realisation × time\)"):
+        load_recording(p, channel_map="force=Force,a1=Acceleration[1],a2=Other")
+
+
 def test_realisations_are_read_in_either_axis_order_and_a_mismatch_is_named(tmp_path):
     """Realisation × channel × time reads as channel × realisation × time does; responses with another number of
     realisations than the force are refused, naming both shapes."""
