@@ -112,10 +112,13 @@ def acquisition_of(model, drives, band_top_hz: float) -> Acquisition | None:
         f = np.fft.rfftfreq(measured.shape[1], 1.0 / fs)
         band = np.digitize(f, edges) - 1  # -1 in the force's band; BANDS at Nyquist itself
         spectra.append((S, R, w, f, band))
-        for b in range(BANDS):
-            i = band == b
-            num[b] += np.sum(w * R[:, i] * np.conj(S[:, i]))
-            den[b] += float(np.sum(w * np.abs(S[:, i]) ** 2))
+        with np.errstate(over="ignore", invalid="ignore"):  # a candidate's share far beyond the records: said below
+            for b in range(BANDS):
+                i = band == b
+                num[b] += np.sum(w * R[:, i] * np.conj(S[:, i]))
+                den[b] += float(np.sum(w * np.abs(S[:, i]) ** 2))
+    if not (np.all(np.isfinite(num)) and np.all(np.isfinite(den))):  # it ran away within the records: no gain
+        return None
     seen = den > MIN_SHARE * max(float(den.sum()), TINY)
     if not np.any(seen):
         return None

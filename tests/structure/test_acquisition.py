@@ -79,6 +79,22 @@ def test_an_unfiltered_record_gets_no_acquisition_filter(chain):
     assert acquisition_of(model, plain, 45.0) is None
 
 
+def test_a_candidate_that_ran_far_away_gets_no_gain_and_no_warning(chain, recwarn):
+    """A candidate's share of the records finite but far beyond them (its spectrum's power overflows): no gain,
+    and no NumPy overflow warning on the user's screen (the F-16's loop modes printed one through `discover`)."""
+    model, plain, _, _, fs = chain
+
+    class FarAway:
+        def __init__(self, drive):
+            self.linear, self.skip, self.fs = drive.linear, drive.skip, drive.fs
+
+        def outputs(self, joint):
+            return self.linear[:, self.skip:] + 1e160 * np.sin(np.arange(self.linear.shape[1] - self.skip))
+
+    assert acquisition_of(model, [(FarAway(d), y) for d, y in plain], 45.0) is None
+    assert not [w for w in recwarn if issubclass(w.category, RuntimeWarning)]
+
+
 def test_the_gain_is_one_in_the_band_and_round_trips(tmp_path):
     gain = Acquisition(40.0, np.array([60.0, 90.0, 120.0]), np.array([0.9 - 0.2j, 0.4 - 0.5j, 0.05 + 0j]))
     f = np.array([0.0, 10.0, 40.0, 60.0, 75.0, 200.0])
