@@ -88,6 +88,7 @@ class Acquisition:
         return cls(float(d["band_top_hz"]), freq, gain[:, 0] + 1j * gain[:, 1])
 
 
+@np.errstate(over="ignore", invalid="ignore")  # a candidate's share far beyond the records: its sums are not finite
 def acquisition_of(model, drives, band_top_hz: float) -> Acquisition | None:
     """The chain's gain on the joint's share above ``band_top_hz`` from ``drives`` [(Drive, measured (C, N))] of
     a fitted ``model``, or None where the joint puts nothing above the band or the gain does not bring the
@@ -112,14 +113,14 @@ def acquisition_of(model, drives, band_top_hz: float) -> Acquisition | None:
         f = np.fft.rfftfreq(measured.shape[1], 1.0 / fs)
         band = np.digitize(f, edges) - 1  # -1 in the force's band; BANDS at Nyquist itself
         spectra.append((S, R, w, f, band))
-        with np.errstate(over="ignore", invalid="ignore"):  # a candidate's share far beyond the records: said below
-            for b in range(BANDS):
-                i = band == b
-                num[b] += np.sum(w * R[:, i] * np.conj(S[:, i]))
-                den[b] += float(np.sum(w * np.abs(S[:, i]) ** 2))
-    if not (np.all(np.isfinite(num)) and np.all(np.isfinite(den))):  # it ran away within the records: no gain
+        for b in range(BANDS):
+            i = band == b
+            num[b] += np.sum(w * R[:, i] * np.conj(S[:, i]))
+            den[b] += float(np.sum(w * np.abs(S[:, i]) ** 2))
+    total = float(den.sum())
+    if not (np.all(np.isfinite(num)) and np.isfinite(total)):  # a candidate that ran far away: no gain
         return None
-    seen = den > MIN_SHARE * max(float(den.sum()), TINY)
+    seen = den > MIN_SHARE * max(total, TINY)
     if not np.any(seen):
         return None
     gain = num / np.maximum(den, TINY)
@@ -138,4 +139,4 @@ def acquisition_of(model, drives, band_top_hz: float) -> Acquisition | None:
         C = chain.at(f[above])
         before += float(np.sum(w * np.abs(R[:, above] - S[:, above]) ** 2))
         after += float(np.sum(w * np.abs(R[:, above] - C * S[:, above]) ** 2))
-    return chain if after < (1 - MIN_GAIN) * before else None
+    return chain if np.isfinite(before) and after < (1 - MIN_GAIN) * before else None
