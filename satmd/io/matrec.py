@@ -254,7 +254,7 @@ def _mapped_realisations(path, v, roles):
             if not 1 <= i <= m:
                 raise FormatError(path, f"map {role}={spec}: {k!r} has shape {_shape(np.asarray(v[k]))}: its index "
                                         f"runs 1..{m} (the realisations, {r}, are read one after another)")
-        picked = picked[(slice(None), *[i - 1 for i in index or ()])]
+        picked = picked[(slice(None),) + tuple(i - 1 for i in index or ())]
         signals[role] = picked
     flat = {role: vector_variable(path, roles[role], x.reshape(-1)) for role, x in signals.items()}
     used = {_lookup(v, _source(path, spec, role)[0]) for role, spec in roles.items()}
