@@ -172,6 +172,17 @@ def _response_matrix(path, v):
     return found[0], {f"acc{i + 1}": vector_variable(path, f"{found[0]}[{i + 1}]", r) for i, r in enumerate(rows)}
 
 
+def _force_realisations(v, key):
+    """Variable ``key`` as a force of several realisations, realisation × time (`MAX_REALISATIONS` at most); None
+    when it is absent, not numbers, or one signal."""
+    if key is None or np.asarray(v[key]).dtype.kind not in "biuf":
+        return None
+    force = _squeezed(np.asarray(v[key]))
+    if force.ndim != 2 or min(force.shape) < 2 or min(force.shape) > MAX_REALISATIONS:
+        return None
+    return _signal_rows(force)
+
+
 def _realisations(path, v):
     """(signals, used, meta) where the force is a matrix of realisations (realisation × time, `MAX_REALISATIONS`
     at most): each channel is its realisations one after another, and ``meta`` says where each starts
@@ -180,12 +191,9 @@ def _realisations(path, v):
     realisation × time (the F-16 benchmark's odd multisines: 3×9×49152; realisation × channel read as well).
     None when the force is one signal."""
     key = _lookup(v, "force")
-    if key is None or np.asarray(v[key]).dtype.kind not in "biuf":
+    force = _force_realisations(v, key)
+    if force is None:
         return None
-    force = _squeezed(np.asarray(v[key]))
-    if force.ndim != 2 or min(force.shape) < 2 or min(force.shape) > MAX_REALISATIONS:
-        return None
-    force = _signal_rows(force)
     r, n = force.shape
     signals, used = {"force": force}, {key}
     for name in ordered({k.lower() for k in v if is_role(k.lower()) and k.lower() != "force"}):
@@ -223,12 +231,9 @@ def _mapped_realisations(path, v, roles):
     variable of the force's shape. None when the map's force is one signal."""
     name, index = _source(path, roles["force"], "force") if "force" in roles else (None, None)
     key = None if name is None or index is not None else _lookup(v, name)
-    if key is None or np.asarray(v[key]).dtype.kind not in "biuf":
+    force = _force_realisations(v, key)
+    if force is None:
         return None
-    force = _squeezed(np.asarray(v[key]))
-    if force.ndim != 2 or min(force.shape) < 2 or min(force.shape) > MAX_REALISATIONS:
-        return None
-    force = _signal_rows(force)
     r, n = force.shape
     signals = {"force": force}
     for role, spec in roles.items():
