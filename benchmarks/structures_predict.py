@@ -37,6 +37,14 @@ from tests.structure.chain import simulate_chain  # noqa: E402
 FIT_LEVELS, HELD, BEYOND = (1.0, 8.0), 3.0, 12.0
 KINDS = ("hardening", "softening", "friction", "quadratic_damping", "clearance")
 F16_MAP = "force=Force,a1=Acceleration[1],a2=Acceleration[2],a3=Acceleration[3]"
+#: the laws' shapes whose force on a measured stroke might drive the F-16's response above the band (d, v the
+#: stroke and its velocity, ds, vs their RMS at the top level)
+HARMONIC_SHAPES = {
+    "cubic d³": lambda d, v, ds, vs: d ** 3, "quadratic damping v|v|": lambda d, v, ds, vs: v * np.abs(v),
+    "friction tanh(v/0.1σv)": lambda d, v, ds, vs: np.tanh(v / (0.1 * vs)),
+    "softening tanh(d/0.3σd)": lambda d, v, ds, vs: np.tanh(d / (0.3 * ds)),
+    "clearance at σd": lambda d, v, ds, vs: np.sign(d) * np.maximum(np.abs(d) - ds, 0.0),
+    "d|d|": lambda d, v, ds, vs: d * np.abs(d), "v³": lambda d, v, ds, vs: v ** 3}
 PUBLISHED_L6 = {"nrmse": [0.134, 0.099, 0.237], "model": "deep state-space network (nonlinearbenchmark.org results)"}
 
 
@@ -86,7 +94,8 @@ def f16() -> dict | None:
                            "units": j.units, "poles": int(whole.linear.poles.size), "fit_s": round(t2 - t1, 1)},
             "published_level6": PUBLISHED_L6,
             "harmonics": harmonics_source([recs[lv] for lv in (1, 3, 7)], list(whole.channels)),
-            "bursts": harmonics_bursts([recs[lv] for lv in (1, 3, 5, 7)], list(whole.channels))}
+            "bursts": harmonics_bursts([recs[lv] for lv in (1, 3, 5, 7)], list(whole.channels)),
+            "one_source": harmonics_one_source({lv: recs[lv] for lv in (3, 5, 7)}, list(whole.channels))}
 
 
 def harmonics_source(recordings, channels) -> dict:
@@ -101,12 +110,7 @@ def harmonics_source(recordings, channels) -> dict:
 
     spectra = [periodic_spectra(r) for r in recordings]
     top = max(spectra, key=lambda s: s.level)
-    shapes = {"cubic d³": lambda d, v, ds, vs: d ** 3, "quadratic damping v|v|": lambda d, v, ds, vs: v * np.abs(v),
-              "friction tanh(v/0.1σv)": lambda d, v, ds, vs: np.tanh(v / (0.1 * vs)),
-              "softening tanh(d/0.3σd)": lambda d, v, ds, vs: np.tanh(d / (0.3 * ds)),
-              "clearance at σd": lambda d, v, ds, vs: np.sign(d) * np.maximum(np.abs(d) - ds, 0.0),
-              "d|d|": lambda d, v, ds, vs: d * np.abs(d), "v³": lambda d, v, ds, vs: v ** 3,
-              "linear stroke d": lambda d, v, ds, vs: d}
+    shapes = {**HARMONIC_SHAPES, "linear stroke d": lambda d, v, ds, vs: d}
     pairs = [*combinations(channels, 2), *((c, "ground") for c in channels)]
     rows = []
     for a, b in pairs:
@@ -160,6 +164,70 @@ def main(argv=None) -> int:
 def _shown(nrmse: float) -> str:
     """An NRMSE as the table shows it: a simulation a thousand times the response ran away, whatever its size."""
     return f"{nrmse:.3f}" if np.isfinite(nrmse) and nrmse < 1e3 else "ran away"
+
+
+def _above_band_transfer(inputs: dict, outputs: dict, fitted, held, window: int) -> float:
+    """The share of ``outputs[held]`` (a spectrum at the lines above the band) that a transfer from ``inputs``
+    predicts, the transfer fitted on the levels ``fitted`` by least squares: in each window of ``window`` lines a
+    complex gain linear in frequency (a structure's FRF is smooth over a few lines; no poles to find)."""
+    size = outputs[held].size
+    predicted = np.zeros(size, complex)
+    for i0 in range(0, size, window):
+        cut = slice(i0, min(i0 + window, size))
+        x = (np.arange(cut.start, cut.stop) - i0 - window / 2) / window
+        X = np.vstack([np.column_stack([inputs[lv][cut], inputs[lv][cut] * x]) for lv in fitted])
+        coef, *_ = np.linalg.lstsq(X, np.concatenate([outputs[lv][cut] for lv in fitted]), rcond=None)
+        predicted[cut] = np.column_stack([inputs[held][cut], inputs[held][cut] * x]) @ coef
+    return float(1 - np.sum(np.abs(outputs[held] - predicted) ** 2) / np.sum(np.abs(outputs[held]) ** 2))
+
+
+def harmonics_one_source(recordings: dict, channels, fitted=(3, 7), held: int = 5, window_hz: float = 2.0) -> dict:
+    """Whether the F-16's response above the band has one source, and whether that source is a law of a stroke:
+    the same test for both, a smooth transfer fitted on the levels ``fitted`` and judged at ``held`` (FNSI's
+    question without its poles, `_above_band_transfer`). From one channel's response above the band to another's:
+    where one place drives them all, the transfer holds from level to level. From a law's force on a measured
+    stroke (every pair and to the ground, the laws of `harmonics_source`, scaled at the top level so one law serves
+    every level) to each channel's response. And how the waveform above the band keeps its shape from level to
+    level beside the response in the band (the levels share one multisine, scaled)."""
+    from itertools import combinations
+
+    from satmd.structure.outside import TOP_SHARE
+    from satmd.structure.spectra import periodic_spectra
+
+    spectra = {lv: periodic_spectra(r) for lv, r in recordings.items()}
+    s = spectra[held]
+    n = s.period_samples
+    lines = np.arange(max(int(sp.lines.max()) for sp in spectra.values()) + 1, int(TOP_SHARE * (n // 2)) + 1)
+    window = max(4, int(round(window_hz * n / s.fs_hz)))
+    above = {c: {lv: sp.whole[c][lines] for lv, sp in spectra.items()} for c in channels}
+    from_channel = {f"{a}→{b}": round(_above_band_transfer(above[a], above[b], fitted, held, window), 3)
+                    for a in channels for b in channels if a != b}
+    top = spectra[max(spectra)]
+    laws = []
+    for a, b in [*combinations(channels, 2), *((c, "ground") for c in channels)]:
+        d_top, v_top = top.relative(a, b)
+        ds, vs = float(np.std(d_top)) or 1.0, float(np.std(v_top)) or 1.0
+        for name, g in HARMONIC_SHAPES.items():
+            forces = {lv: np.fft.rfft(g(*sp.relative(a, b), ds, vs), n)[lines] for lv, sp in spectra.items()}
+            laws.append({"between": [a, b], "law": name, "explained": [
+                round(_above_band_transfer(forces, above[c], fitted, held, window), 3) for c in channels]})
+    best_law = max(laws, key=lambda r: max(r["explained"]))
+
+    def waveform(lv, c, band: bool):
+        X = np.zeros(n // 2 + 1, complex)
+        if band:
+            X[spectra[lv].lines] = spectra[lv].responses[c]
+        else:
+            X[lines] = above[c][lv]
+        return np.fft.irfft(X, n)
+
+    pairs = [(lo, hi) for lo, hi in combinations(sorted(spectra), 2)]
+    shape = [{"levels": [lo, hi], "channel": c,
+              "in_band": round(float(np.corrcoef(waveform(lo, c, True), waveform(hi, c, True))[0, 1]), 3),
+              "above_band": round(float(np.corrcoef(waveform(lo, c, False), waveform(hi, c, False))[0, 1]), 3)}
+             for lo, hi in pairs for c in channels]
+    return {"fitted": list(fitted), "held": held, "window_hz": window_hz, "from_channel": from_channel,
+            "best_law": best_law, "waveform": shape}
 
 
 def harmonics_bursts(recordings, channels, fast: float = 1.5) -> dict:
@@ -254,6 +322,9 @@ def readme_markdown(result: dict) -> str:
         if f.get("bursts"):
             lines.append("")
             lines.append(_bursts_text(f["bursts"], names))
+        if f.get("one_source"):
+            lines.append("")
+            lines.append(_one_source_text(f["one_source"]))
     return "\n".join(lines)
 
 
@@ -273,6 +344,28 @@ def _bursts_text(b: dict, names: list) -> str:
             f"{' and '.join(second['between'])}, {second['lift']:.1f}×). A contact between those two sensors that "
             "knocks: a law of the measured stroke does not time its knocks, and the model leaves them out.")
 
+
+def _one_source_text(o: dict) -> str:
+    """Whether one place drives the F-16's response above the band, and whether a law of a stroke does
+    (`harmonics_one_source`), in words."""
+    pairs = sorted(o["from_channel"].items(), key=lambda kv: -kv[1])
+    (first, x), (second, y) = pairs[0], pairs[1]
+    best = o["best_law"]
+    top = [w for w in o["waveform"] if w["levels"] == sorted({lv for w in o["waveform"] for lv in w["levels"]})[-2:]]
+    fitted = " and ".join(str(lv) for lv in o["fitted"])
+    return (f"One place drives it, and not by a law of these strokes: through a transfer fitted on levels {fitted} "
+            f"(a gain smooth over {o['window_hz']:g} Hz) and judged at level {o['held']}, {_said(first, x)} "
+            f"({_said(second, y)}); by the same test the best law's force on any measured stroke "
+            f"({best['law']} between {' and '.join(best['between'])}) predicts {max(best['explained']):.0%}. From level "
+            f"{top[0]['levels'][0]} to level {top[0]['levels'][1]}, one multisine scaled, the response in the band keeps "
+            f"its waveform (correlation {min(w['in_band'] for w in top):.2f}–{max(w['in_band'] for w in top):.2f}) and "
+            f"the one above it does not ({min(w['above_band'] for w in top):.2f}–{max(w['above_band'] for w in top):.2f}).")
+
+
+def _said(arrow: str, share: float) -> str:
+    """An arrow ("acc1→acc3") and its share, in words."""
+    a, b = arrow.split("→")
+    return f"{a}'s response above the band predicts {share:.0%} of {b}'s"
 
 if __name__ == "__main__":
     raise SystemExit(main())
