@@ -28,16 +28,26 @@ def modal_constants(residues, poles) -> np.ndarray:
     return (2j * np.abs(poles) * np.asarray(residues) / poles ** 2).real
 
 
+def driving_point_candidates(channels, residues, poles) -> list:
+    """The channels that may be at the force's point: those whose modal constants (`modal_constants`) are positive
+    on every mode they see (`STRONG`), as ``φ_d²`` is. With few modes in the band several sensors pass (all in phase
+    with the force on each), and none where a mode's sign is off (a delay, a sensor mounted the other way)."""
+    if len(poles) == 0:
+        return []
+    const = modal_constants(residues, poles)
+    size = np.abs(np.asarray(residues))
+    strong = size > STRONG * np.maximum(size.max(axis=1, keepdims=True), TINY)
+    return [c for c, k, s in zip(channels, const, strong) if np.all(k[s] > 0)]
+
+
 def driving_point_of(channels, residues, poles, weak_too: bool = False):
     """The channel at the force's point, found: the one whose modal constants (`modal_constants`) are positive on
     every mode it sees (`STRONG`), as ``φ_d²`` is; None when no channel, or more than one, has that. ``weak_too``:
     where several pass (sensors near one another, in phase on every strong mode), the one positive on every mode,
     weak ones too, where one alone is."""
-    const = modal_constants(residues, poles)
-    size = np.abs(np.asarray(residues))
-    strong = size > STRONG * np.maximum(size.max(axis=1, keepdims=True), TINY)
-    found = [c for c, k, s in zip(channels, const, strong) if np.all(k[s] > 0)]
+    found = driving_point_candidates(channels, residues, poles)
     if len(found) > 1 and weak_too:
+        const = modal_constants(residues, poles)
         found = [c for c, k in zip(channels, const) if c in found and np.all(k > 0)]
     return found[0] if len(found) == 1 else None
 
@@ -145,4 +155,4 @@ def survey(freq_hz, frf: dict, std: dict | None = None, band_hz=None, driving_po
     return ModalSurvey(fit, names, real / largest, complexity, None, "largest")
 
 
-__all__ = ["ModalSurvey", "survey", "modal_constants", "driving_point_of"]
+__all__ = ["ModalSurvey", "survey", "modal_constants", "driving_point_candidates", "driving_point_of"]

@@ -4,11 +4,10 @@ from __future__ import annotations
 import numpy as np
 
 from .newtons import passive_sign, path_sign
+from .reciprocity import PLACES, RIVAL  # the spectra's next places simulated here, where no driving point weighs them
 
 SPARSE_MARGIN = 0.1
-PLACES = 5      # the spectra's best places simulated on every level (`best_place`)
 PLACE_LAWS = 2  # laws fitted at each next place: the best place's best simulated
-RIVAL = 0.1     # a next place is simulated where its ΔBIC to the best is within this share of the joint's evidence
 FINISH_MARGIN = 0.15  # a named law whose first fit came within this share of the chosen one's is finished too
 FINISHED_RIVALS = 2   # at most this many (`close_rivals`)
 
@@ -44,6 +43,8 @@ def best_place(fit, loc, model, laws, others, files):
     cubic 75 and 99) were fourth or fifth by the spectra, within `RIVAL` of the evidence; simulated, two of the
     three fitted the levels best at their true place (the beam 0.177 against 0.202, its held-out levels
     0.012-0.052 against 0.034-0.73)."""
+    if loc.reciprocal:  # the places the spectra could not tell apart were weighed with the mode shapes' inputs
+        return model
     rivals = [tuple(e["between"]) for e in loc.location[1:PLACES] if e["delta_bic"] <= RIVAL * loc.evidence]
     if not rivals or not laws or model.joint is None:
         return model

@@ -99,7 +99,7 @@ def fit_structure(recordings, between=None, law: str | None = None, channels=Non
     if between is None or law is None:
         if location is None:
             say("locating the joint among every pair of sensors ...")
-        loc = location or locate_joint(spectra, channels=names)
+        loc = location or locate_joint(spectra, channels=names, driving_point=driving_point)
         if not loc.detected:
             return replace(fit.linear_only(files), band_hz=fitted_band(spectra))
         place_given, law_given = between is not None, law is not None

@@ -47,6 +47,7 @@ from ..conventions import TINY
 from ..numerics import unit_columns
 from ..errors import DataError
 from ..validation import NAMES, Band, validate_params
+from . import reciprocity
 from .laws import LAWS, SHAPE_GRID
 from .simulations import fitted_realisations
 from .spectra import PeriodicSpectra, periodic_spectra
@@ -96,6 +97,12 @@ class JointLocation:
         """Whether a joint explains the change between levels better than noise does (ΔBIC > `EQUIVALENT`)."""
         return self.evidence > EQUIVALENT
 
+    @property
+    def reciprocal(self) -> bool:
+        """Whether the place was chosen among the spectra's closest with the inputs the mode shapes give
+        (`reciprocity`): the first entries of ``location`` say ``"inputs": "reciprocal"``, their ΔBIC so weighed."""
+        return bool(self.location) and self.location[0].get("inputs") == "reciprocal"
+
     def to_dict(self) -> dict:
         """The SPEC §11 fields: between, location, law, equivalent (laws), levels."""
         return {"name": "joint", "detected": self.detected, "evidence_delta_bic": round(float(self.evidence), 1),
@@ -120,6 +127,14 @@ class JointLocation:
         lines = [f"joint between {a} and {b}" + (f" (next: {' and '.join(nxt['between'])}, ΔBIC {nxt['delta_bic']:.0f})"
                                                 if nxt else ""),
                  f"law: {self.law} ({LAWS[self.law].description})"]
+        if self.reciprocal:
+            weighed = [e for e in self.location if e.get("inputs") == "reciprocal"]
+            first = min(weighed, key=lambda e: e["spectra_delta_bic"])
+            lines.append(f"placed among the {len(weighed)} places the spectra could not tell apart with each mode's "
+                         f"input from the mode shapes (reciprocity through {self.location[0]['driving_point']})"
+                         + (f"; with free inputs {' and '.join(first['between'])} came first, this place ΔBIC "
+                            f"{self.location[0]['spectra_delta_bic']:.0f} behind" if first is not self.location[0]
+                            else ""))
         if self.equivalent_places:
             lines.append("equally supported places: " + "; ".join(" and ".join(e["between"]) for e in self.equivalent_places))
         if self.equivalent_laws:
@@ -128,7 +143,7 @@ class JointLocation:
 
 
 @validate_params({"laws": [None, NAMES], "band_hz": [None, Band()], "channels": [None, NAMES]})
-def locate_joint(recordings, laws=None, band_hz=None, channels=None) -> JointLocation:
+def locate_joint(recordings, laws=None, band_hz=None, channels=None, driving_point: str | None = None) -> JointLocation:
     """Between which two sensors a joint acts and which law it follows, from recordings at several levels.
 
     Parameters
@@ -138,6 +153,8 @@ def locate_joint(recordings, laws=None, band_hz=None, channels=None) -> JointLoc
     laws : law names to compare (default every law of `satmd.structure.laws.LAWS`)
     band_hz : (lo, hi) Hz of the excited band to use (default all of it)
     channels : the response channels (default every channel but the force)
+    driving_point : the channel at the force's point, where places the spectra cannot tell apart are weighed
+        with the inputs the mode shapes give (`reciprocity`); default: each channel the residues' signs allow
 
     Returns
     -------
@@ -156,10 +173,19 @@ def locate_joint(recordings, laws=None, band_hz=None, channels=None) -> JointLoc
     bic: dict = {(p, law_.name): best_shape(p, law_, others, ref, H, names, rows, transfer)[0]
                  for p in places for law_ in chosen}
     bic[None] = _evidence(None, None, others, ref, H, names, rows, transfer)
-    at = min(places, key=lambda p: (min(bic[(p, law_.name)] for law_ in chosen), p))
+    per_place = {p: min(bic[(p, law_.name)] for law_ in chosen) for p in places}
+    ranked = sorted(places, key=lambda p: (per_place[p], p))
+    weigh = reciprocity.rivals(ranked, per_place, bic[None] - per_place[ranked[0]])
+    reciprocal: dict = {}
+    if bic[None] - per_place[ranked[0]] > EQUIVALENT and len(weigh) > 1:
+        drives = reciprocity.drives(modal, names, driving_point)
+        freq = ref.lines[rows[id(ref)]] * ref.fs_hz / ref.period_samples
+        reciprocal = reciprocity.weighed(weigh, drives, modal, freq, names, lambda p, tr: min(
+            best_shape(p, law_, others, ref, H, names, rows, tr)[0] for law_ in chosen)) if drives else {}
+    at = min(reciprocal, key=lambda p: (reciprocal[p][0], p)) if reciprocal else ranked[0]
     real = real_inputs(transfer)
     named = {law_.name: best_shape(at, law_, others, ref, H, names, rows, real, refine=True) for law_ in chosen}
-    return _verdict(bic, places, chosen, ref, items, modal, named)
+    return _verdict(bic, places, chosen, ref, items, modal, named, reciprocal)
 
 
 def shape_of(recordings, between, law_name: str, channels=None):
@@ -335,13 +361,22 @@ def _regression(place, law_, others, ref, H, names, rows, transfer, aux=None):
     return float(r @ r), total, y.size, n_par + S.shape[1]
 
 
-def _verdict(bic, places, laws, ref, items, modal, named) -> JointLocation:
+def _verdict(bic, places, laws, ref, items, modal, named, reciprocal=None) -> JointLocation:
     """The places ranked by their best law's evidence (each mode's input complex: a place is found whatever the
-    phase its modes take the force in); the laws at the best place ranked by ``named``, {law: (BIC, shape)} with
-    real inputs (`real_inputs`)."""
+    phase its modes take the force in), those ``reciprocal`` weighed, {place: (BIC, driving point)}, first by that
+    (`reciprocity`); the laws at the best place ranked by ``named``, {law: (BIC, shape)} with real inputs
+    (`real_inputs`)."""
     per_place = {p: min(((bic[(p, law_.name)], law_.name) for law_ in laws)) for p in places}
     ranked = sorted(places, key=lambda p: (per_place[p][0], p))
     best_bic = per_place[ranked[0]][0]
+    delta = {p: per_place[p][0] - best_bic for p in places}
+    weighed: dict = {}
+    if reciprocal:
+        top = sorted(reciprocal, key=lambda p: (reciprocal[p][0], p))
+        ranked = top + [p for p in ranked if p not in reciprocal]
+        weighed = {p: {"inputs": "reciprocal", "driving_point": reciprocal[p][1],
+                       "spectra_delta_bic": round(float(delta[p]), 1)} for p in top}
+        delta.update({p: reciprocal[p][0] - reciprocal[top[0]][0] for p in top})
     at = ranked[0]
     law_bic = sorted(((named[law_.name][0], law_.name) for law_ in laws))
     plain = [x for x in law_bic if x[1] != "sparse"]
@@ -350,8 +385,8 @@ def _verdict(bic, places, laws, ref, items, modal, named) -> JointLocation:
         chosen_bic, chosen = plain[0]
     else:
         chosen_bic, chosen = law_bic[0]
-    location = [{"between": list(p), "delta_bic": round(float(per_place[p][0] - best_bic), 1),
-                 "law": chosen if p == at else per_place[p][1]} for p in ranked]
+    location = [{"between": list(p), "delta_bic": round(float(delta[p]), 1),
+                 "law": chosen if p == at else per_place[p][1], **weighed.get(p, {})} for p in ranked]
     laws_out = [{"law": n, "delta_bic": round(float(v - chosen_bic), 1)} for v, n in law_bic]
     return JointLocation(
         between=tuple(at), location=location, law=chosen, laws=laws_out,

@@ -97,3 +97,18 @@ def test_the_laws_tried_at_a_next_place_are_the_best_simulated_named_ones():
     fits = _Fits({(("acc1", "acc2"), w): x for w, x in (("sparse", 0.01), ("cubic", 0.04), ("friction", 0.02))})
     models = [fits.law(("acc1", "acc2"), w, None) for w in ("sparse", "cubic", "friction")]
     assert ranked_laws(models) == ["friction", "cubic", "sparse"]
+
+
+def test_a_place_weighed_with_the_mode_shapes_inputs_is_not_simulated_against_the_next():
+    """Where `locate_joint` weighed the places the spectra could not tell apart with each mode's input from the mode
+    shapes (`reciprocity`), the place stands: no next place is fitted (as first fitted, with free inputs, a pair
+    around the true one fitted the levels of independent ground vibration tests better)."""
+    fits = _Fits({(("acc1", "acc2"), "cubic"): 0.05, (("acc2", "acc3"), "cubic"): 0.01})
+    model = fits.law(("acc1", "acc2"), "cubic", None)
+    loc = _located(50.0)
+    weighed = [{**e, "inputs": "reciprocal", "driving_point": "acc1", "spectra_delta_bic": d}
+               for e, d in zip(loc.location[:2], (50.0, 0.0))]
+    loc = JointLocation(loc.between, [*weighed, *loc.location[2:]], loc.law, loc.laws, [], [], "L1", [1.0, 8.0],
+                        evidence=1000.0)
+    assert loc.reciprocal and best_place(fits, loc, model, ["cubic"], ["softening"], None) is model
+    assert fits.calls == [(("acc1", "acc2"), "cubic")]  # the located model's own fit, nothing after it
