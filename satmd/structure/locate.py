@@ -47,7 +47,7 @@ from ..conventions import TINY
 from ..numerics import unit_columns
 from ..errors import DataError
 from ..validation import NAMES, Band, validate_params
-from . import reciprocity
+from . import choice
 from .laws import LAWS, SHAPE_GRID
 from .simulations import fitted_realisations
 from .spectra import PeriodicSpectra, periodic_spectra
@@ -100,7 +100,7 @@ class JointLocation:
     @property
     def reciprocal(self) -> bool:
         """Whether the place was chosen among the spectra's closest with the inputs the mode shapes give
-        (`reciprocity`): the first entries of ``location`` say ``"inputs": "reciprocal"``, their ΔBIC so weighed."""
+        (`choice.weighed`): the first entries of ``location`` say ``"inputs": "reciprocal"``, their ΔBIC so weighed."""
         return bool(self.location) and self.location[0].get("inputs") == "reciprocal"
 
     def to_dict(self) -> dict:
@@ -128,13 +128,7 @@ class JointLocation:
                                                 if nxt else ""),
                  f"law: {self.law} ({LAWS[self.law].description})"]
         if self.reciprocal:
-            weighed = [e for e in self.location if e.get("inputs") == "reciprocal"]
-            first = min(weighed, key=lambda e: e["spectra_delta_bic"])
-            lines.append(f"placed among the {len(weighed)} places the spectra could not tell apart with each mode's "
-                         f"input from the mode shapes (reciprocity through {self.location[0]['driving_point']})"
-                         + (f"; with free inputs {' and '.join(first['between'])} came first, this place ΔBIC "
-                            f"{self.location[0]['spectra_delta_bic']:.0f} behind" if first is not self.location[0]
-                            else ""))
+            lines.append(choice.told(self.location))
         if self.equivalent_places:
             lines.append("equally supported places: " + "; ".join(" and ".join(e["between"]) for e in self.equivalent_places))
         if self.equivalent_laws:
@@ -154,7 +148,7 @@ def locate_joint(recordings, laws=None, band_hz=None, channels=None, driving_poi
     band_hz : (lo, hi) Hz of the excited band to use (default all of it)
     channels : the response channels (default every channel but the force)
     driving_point : the channel at the force's point, where places the spectra cannot tell apart are weighed
-        with the inputs the mode shapes give (`reciprocity`); default: each channel the residues' signs allow
+        with the inputs the mode shapes give (`choice.weighed`); default: each channel the residues' signs allow
 
     Returns
     -------
@@ -164,9 +158,11 @@ def locate_joint(recordings, laws=None, band_hz=None, channels=None, driving_poi
     ------
     DataError
         Fewer than two recordings, a force that is not periodic, recordings of another design (period,
-        rate, channels), or fewer than two response channels.
+        rate, channels), fewer than two response channels, or a driving point that is not one of them.
     """
     ref, others, names, rows, H, transfer, modal = prepare(recordings, band_hz, channels)
+    if driving_point is not None and driving_point not in names:
+        raise DataError(f"the driving point {driving_point!r} is not a channel ({', '.join(names)})")
     items = [ref, *others]
     places = [(a, b) for a, b in itertools.combinations(names, 2)] + [(a, "ground") for a in names]
     chosen = [LAWS[n] for n in (laws or LAWS)]
@@ -175,12 +171,12 @@ def locate_joint(recordings, laws=None, band_hz=None, channels=None, driving_poi
     bic[None] = _evidence(None, None, others, ref, H, names, rows, transfer)
     per_place = {p: min(bic[(p, law_.name)] for law_ in chosen) for p in places}
     ranked = sorted(places, key=lambda p: (per_place[p], p))
-    weigh = reciprocity.rivals(ranked, per_place, bic[None] - per_place[ranked[0]])
+    weigh = choice.rivals(ranked, per_place, bic[None] - per_place[ranked[0]])
     reciprocal: dict = {}
     if bic[None] - per_place[ranked[0]] > EQUIVALENT and len(weigh) > 1:
-        drives = reciprocity.drives(modal, names, driving_point)
+        drives = choice.drives(modal, names, driving_point)
         freq = ref.lines[rows[id(ref)]] * ref.fs_hz / ref.period_samples
-        reciprocal = reciprocity.weighed(weigh, drives, modal, freq, names, lambda p, tr: min(
+        reciprocal = choice.weighed(weigh, drives, modal, freq, names, lambda p, tr: min(
             best_shape(p, law_, others, ref, H, names, rows, tr)[0] for law_ in chosen)) if drives else {}
     at = min(reciprocal, key=lambda p: (reciprocal[p][0], p)) if reciprocal else ranked[0]
     real = real_inputs(transfer)
@@ -364,7 +360,7 @@ def _regression(place, law_, others, ref, H, names, rows, transfer, aux=None):
 def _verdict(bic, places, laws, ref, items, modal, named, reciprocal=None) -> JointLocation:
     """The places ranked by their best law's evidence (each mode's input complex: a place is found whatever the
     phase its modes take the force in), those ``reciprocal`` weighed, {place: (BIC, driving point)}, first by that
-    (`reciprocity`); the laws at the best place ranked by ``named``, {law: (BIC, shape)} with real inputs
+    (`choice.weighed`); the laws at the best place ranked by ``named``, {law: (BIC, shape)} with real inputs
     (`real_inputs`)."""
     per_place = {p: min(((bic[(p, law_.name)], law_.name) for law_ in laws)) for p in places}
     ranked = sorted(places, key=lambda p: (per_place[p][0], p))

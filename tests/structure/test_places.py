@@ -101,7 +101,7 @@ def test_the_laws_tried_at_a_next_place_are_the_best_simulated_named_ones():
 
 def test_a_place_weighed_with_the_mode_shapes_inputs_is_not_simulated_against_the_next():
     """Where `locate_joint` weighed the places the spectra could not tell apart with each mode's input from the mode
-    shapes (`reciprocity`), the place stands: no next place is fitted (as first fitted, with free inputs, a pair
+    shapes (`choice.weighed`), the place stands: no next place is fitted (as first fitted, with free inputs, a pair
     around the true one fitted the levels of independent ground vibration tests better)."""
     fits = _Fits({(("acc1", "acc2"), "cubic"): 0.05, (("acc2", "acc3"), "cubic"): 0.01})
     model = fits.law(("acc1", "acc2"), "cubic", None)

@@ -1,4 +1,4 @@
-"""The joint's input to each mode from the mode shapes (`satmd.structure.reciprocity`): exact on a chain whose
+"""The joint's input to each mode from the mode shapes (`satmd.structure.choice`): exact on a chain whose
 modes are known in closed form, and what it decides on a ground vibration test satmd did not simulate."""
 from __future__ import annotations
 
@@ -12,7 +12,7 @@ import pytest
 from scipy.linalg import eigh
 
 from satmd.modal import fit_modes
-from satmd.structure.reciprocity import drives, reciprocal_inputs
+from satmd.structure.choice import drives, reciprocal_inputs
 
 M = np.diag([1.0, 1.5, 0.8, 1.2])
 K = 1e4 * np.array([[3.0, -1.0, 0.0, 0.0], [-1.0, 2.0, -1.0, 0.0], [0.0, -1.0, 2.5, -1.5], [0.0, 0.0, -1.5, 1.5]])
@@ -83,3 +83,11 @@ def test_places_the_spectra_cannot_tell_apart_are_weighed_with_the_mode_shapes(w
     weighed = [e for e in loc.location if e.get("inputs") == "reciprocal"]
     assert 1 < len(weighed) <= 5 and weighed[0]["spectra_delta_bic"] > 0  # not the spectra's first
     assert weighed[1]["delta_bic"] > 1000 and "reciprocity through" in loc.report()
+
+
+def test_a_driving_point_that_is_not_a_channel_is_refused(wing):
+    from satmd.errors import DataError
+    from satmd.structure import locate_joint
+
+    with pytest.raises(DataError, match="the driving point 'acc9' is not a channel"):
+        locate_joint(wing[1], driving_point="acc9")

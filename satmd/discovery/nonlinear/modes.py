@@ -193,7 +193,9 @@ def with_joint(report, recordings, fit_joint: bool = True):
     named = model.joint.law if model is not None and model.joint is not None else loc.law
     explanation = (f"a joint between {a} and {b} ({named}): its relative motion explains the change between "
                    f"the levels (ΔBIC {loc.location[1]['delta_bic']:.0f} to the next place, "
-                   f"{' and '.join(loc.location[1]['between'])})" if len(loc.location) > 1 else f"a joint between {a} and {b}")
+                   f"{' and '.join(loc.location[1]['between'])}"
+                   + (f", each mode's input from the mode shapes through {loc.location[0]['driving_point']})"
+                      if loc.reciprocal else ")") if len(loc.location) > 1 else f"a joint between {a} and {b}")
     if model is not None and model.joint is not None and tuple(model.joint.between) != tuple(loc.between):
         a, b = model.joint.between  # a next place by the spectra; simulated from the force, it fitted every level better
         gap = next(e["delta_bic"] for e in loc.location if tuple(e["between"]) == (a, b))
