@@ -13,7 +13,8 @@ the mode's shape there, which the measured column already holds (the reference r
 ``T_oj = Σ_r κ_rj A_or / (iω − λ_r) + c.c.`` plus each channel's own residual terms (the modes outside the
 band), with the joint's input to each mode, κ_rj, one for every channel (`paths`). The input is left free,
 not built from the mode shapes at the two sensors: their column of the structure was never measured, and a
-guess of it (reciprocity through the driving point) ranked the F-16's true place last. Places are ranked
+guess of it (reciprocity through the driving point) ranked the F-16's true place last; it weighs only the places
+the free inputs cannot tell apart (`choice.weighed`: a pair around the true one on a chain). Places are ranked
 with κ complex (a place is found whatever phase its modes take the force in); the laws at the best place
 with κ real (`real_inputs`: a law in the stroke and one in the velocity are then told apart) and each
 law's shape refined off its grid. On 40 chains (`benchmarks/structures_joint.py`) that placed 35 joints and

@@ -112,3 +112,17 @@ def test_a_place_weighed_with_the_mode_shapes_inputs_is_not_simulated_against_th
                         evidence=1000.0)
     assert loc.reciprocal and best_place(fits, loc, model, ["cubic"], ["softening"], None) is model
     assert fits.calls == [(("acc1", "acc2"), "cubic")]  # the located model's own fit, nothing after it
+
+
+def test_a_place_the_mode_shapes_confirm_is_still_simulated_against_the_spectra_s_next():
+    """Where the mode shapes' inputs keep the spectra's first place, the fits in time check it as before, the next
+    places taken by their ΔBIC with free inputs (`spectra_delta_bic`), not the reciprocal one."""
+    fits = _Fits({(("acc1", "acc2"), "cubic"): 0.05, (("acc2", "acc3"), "cubic"): 0.01})
+    model = fits.law(("acc1", "acc2"), "cubic", None)
+    loc = _located(50.0)
+    weighed = [{**e, "inputs": "reciprocal", "driving_point": "acc1", "spectra_delta_bic": d, "delta_bic": r}
+               for e, d, r in zip(loc.location[:2], (0.0, 50.0), (0.0, 3000.0))]
+    loc = JointLocation(loc.between, [*weighed, *loc.location[2:]], loc.law, loc.laws, [], [], "L1", [1.0, 8.0],
+                        evidence=1000.0)
+    chosen = best_place(fits, loc, model, ["cubic"], [], None)
+    assert chosen.joint.between == ("acc2", "acc3") and (("acc2", "acc3"), "cubic") in fits.calls
