@@ -14,9 +14,10 @@ o is ``Σ_r κ_r A_or / (iω − λ_r) + c.c.`` with ``κ_r = (A_ar − A_br) / 
 one scale left to the law's coefficients. Where places come within `RIVAL` of the evidence, they are weighed so,
 at every channel that may be the driving point (`satmd.modal.shapes.driving_point_candidates`: with few modes in
 the band several sensors pass) and every law, and the best is kept; where that moves the place off the spectra's
-first, the fits in time (`best_place`) leave it, their first fits following the free inputs' path. On those tests 29 had such places; weighed
-so, the place came out right in 83 of the 84 joints where the free inputs alone placed 74 and the fits in time
-that checked them (`choice.best_place`) 77 (`benchmarks/structures_gvt_locate.py`). The F-16's places are not
+first, the fits in time (`best_place`) leave it, their first fits following the free inputs' path. On those tests
+29 had such places: weighed so, the place came out right in 83 of the 84 joints where the free inputs alone placed
+74 (a script in /tmp, not kept), and with the fits in time still checking the places it confirms (a beam's
+support, 62, placed by them), `benchmarks/structures_gvt.py` places 84 of 84 where it placed 77. The F-16's places are not
 weighed: its next place is a quarter of the evidence behind, and reciprocity through its driving point (acc1)
 would rank its interface last, its sensors near the joint, not at its ends.
 """
