@@ -198,7 +198,7 @@ def with_joint(report, recordings, fit_joint: bool = True):
                       if loc.reciprocal else ")") if len(loc.location) > 1 else f"a joint between {a} and {b}")
     if model is not None and model.joint is not None and tuple(model.joint.between) != tuple(loc.between):
         a, b = model.joint.between  # a next place by the spectra; simulated from the force, it fitted every level better
-        gap = next(e["delta_bic"] for e in loc.location if tuple(e["between"]) == (a, b))
+        gap = next(e.get("spectra_delta_bic", e["delta_bic"]) for e in loc.location if tuple(e["between"]) == (a, b))
         explanation = (f"a joint between {a} and {b} ({named}): simulated from each force, a joint there fits every "
                        f"level better than at {' and '.join(loc.between)}, which the levels' spectra ranked first "
                        f"(ΔBIC {gap:.0f} ahead)")
