@@ -104,15 +104,18 @@ def _draw_sensors(ax, location):
 
 
 def _draw_evidence(bx, location):
-    """ΔBIC of every place to the best, the best in red."""
+    """ΔBIC of every place to the best, the best in red; places weighed with the mode shapes' inputs marked (their
+    ΔBIC is among themselves, `choice.weighed`)."""
     rows = location.location[::-1]
-    labels = [" – ".join(e["between"]) for e in rows]
+    labels = [" – ".join(e["between"]) + (" ◆" if e.get("inputs") == "reciprocal" else "") for e in rows]
     values = [max(e["delta_bic"], 0.0) + 1.0 for e in rows]
     colors = ["tab:red" if i == len(rows) - 1 and location.detected else "0.6" for i in range(len(rows))]
     bx.barh(labels, values, color=colors)
     bx.set_xscale("log")
     bx.set_xlabel("ΔBIC to the best place + 1 (lower is better)")
     bx.axvline(11.0, color="tab:orange", ls="--", lw=1, label="equally supported (ΔBIC ≤ 10)")
+    if location.reciprocal:
+        bx.plot([], [], " ", label=f"◆ weighed with the mode shapes' inputs (through {location.location[0]['driving_point']})")
     bx.legend(fontsize=8, loc="lower right")
     bx.tick_params(axis="y", labelsize=8)
 
