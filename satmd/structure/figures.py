@@ -114,8 +114,9 @@ def _draw_evidence(bx, location):
     bx.set_xscale("log")
     bx.set_xlabel("ΔBIC to the best place + 1 (lower is better)")
     bx.axvline(11.0, color="tab:orange", ls="--", lw=1, label="equally supported (ΔBIC ≤ 10)")
-    if location.reciprocal:
-        bx.plot([], [], " ", label=f"◆ weighed with the mode shapes' inputs (through {location.location[0]['driving_point']})")
+    weighed = [e for e in rows if e.get("inputs") == "reciprocal"]  # a `JointLocation` or its JSON's fields
+    if weighed:
+        bx.plot([], [], " ", label=f"◆ weighed with the mode shapes' inputs (through {weighed[-1]['driving_point']})")
     bx.legend(fontsize=8, loc="lower right")
     bx.tick_params(axis="y", labelsize=8)
 
